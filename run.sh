@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The project's two commands (see README.md):
+#   bash run.sh app    -> install into .venv (first time) and serve the dashboard on http://localhost:5006/app
+#   bash run.sh test   -> install into .venv (+ Debian's chromium) and run ruff and the whole test suite
+set -euo pipefail
+cd "$(dirname "$0")"
+PY=${PYTHON:-python3}
+VENV=.venv
+
+ensure_venv() {
+    if [ ! -x "$VENV/bin/python" ]; then
+        "$PY" -m venv "$VENV"
+    fi
+    "$VENV/bin/python" -m pip install -q --upgrade pip
+    "$VENV/bin/python" -m pip install -q -e ".$1"
+}
+
+case "${1:-}" in
+    app)
+        shift
+        ensure_venv ""
+        exec "$VENV/bin/bogie" serve "$@"
+        ;;
+    test)
+        shift
+        ensure_venv "[test]"
+        if [ ! -x /usr/bin/chromium ] || ! command -v buildah >/dev/null || ! command -v debootstrap >/dev/null; then
+            echo "run.sh: installing Debian packages chromium, buildah, debootstrap for the browser and image tests" >&2
+            SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+            $SUDO apt-get update -qq
+            DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium buildah debootstrap >/dev/null
+        fi
+        "$VENV/bin/ruff" check model app tests scripts
+        exec "$VENV/bin/python" -m pytest "$@"
+        ;;
+    *)
+        echo "usage: bash run.sh app [bogie serve options] | bash run.sh test [pytest options]" >&2
+        exit 2
+        ;;
+esac
