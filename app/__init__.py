@@ -1,0 +1,1 @@
+"""Panel dashboard for the bogie model (a thin layer over :mod:`model`)."""

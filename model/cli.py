@@ -1,0 +1,201 @@
+"""Command line ``bogie`` (also ``python -m model``).
+
+Every command accepts the operating point ``--s0``, ``--v`` [km/h], ``--n0`` [N], ``--bm``
+[N m s/rad] and ``--params FILE``.  Human-readable tables by default, ``--json`` for machines.
+Bad input: one line on stderr saying what is wrong and what is allowed, exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Callable
+
+import numpy as np
+
+from .parameters import ParameterError, load_parameters
+
+EXIT_BAD_INPUT = 2
+
+
+class UsageError(Exception):
+    """Bad input from the command line (reported in one line, exit status 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, no usage block
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
+def number(label: str, low: float = -math.inf, high: float = math.inf, low_open: bool = True,
+           high_open: bool = True, allowed: str = "") -> Callable[[str], float]:
+    """argparse type: a finite float within bounds, with a clear message otherwise."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{label} must be a number, got '{text}'") from None
+        ok_low = value > low if low_open else value >= low
+        ok_high = value < high if high_open else value <= high
+        if not math.isfinite(value) or not (ok_low and ok_high):
+            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: {allowed}")
+        return value
+
+    return parse
+
+
+def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.005) -> None:
+    parser.add_argument("--s0", type=number("--s0 (creepage)", 0, 1, allowed="must be in (0, 1)"),
+                        default=s0, help="longitudinal creepage s0 [-] (default %(default)s)")
+    parser.add_argument("--v", type=number("--v (speed, km/h)", 0, 1000,
+                                           allowed="must be in (0, 1000) km/h"),
+                        default=120.0, help="speed [km/h] (default %(default)s)")
+    parser.add_argument("--n0", type=number("--n0 (wheel force, N)", 0, 1e7,
+                                            allowed="must be in (0, 1e7) N"),
+                        default=None, help="static wheel force N0 [N] (default: parameter set)")
+    parser.add_argument("--bm", type=number("--bm (motor slope, N m s/rad)", 0, 1e9, low_open=False,
+                                            allowed="must be in [0, 1e9) N m s/rad"),
+                        default=None, help="motor slope b_M [N m s/rad] (default: parameter set)")
+    parser.add_argument("--params", default=None, metavar="FILE",
+                        help="parameter file (TOML; default: the calibrated set)")
+    parser.add_argument("--json", action="store_true", help="machine-readable JSON output")
+
+
+def load_model(args: argparse.Namespace):
+    """(model, operating point) from the common options."""
+    from .assembly import build_model
+    from .operating_point import OperatingPoint
+
+    parameters = load_parameters(args.params)
+    model = build_model(parameters)
+    n0 = parameters["wheel_force"] if args.n0 is None else args.n0
+    bm = parameters["motor_slope"] if args.bm is None else args.bm
+    op = OperatingPoint.from_kmh(args.s0, args.v, n0, bm) if args.s0 is not None else None
+    return model, op, (n0, bm)
+
+
+def emit(args: argparse.Namespace, data: dict, table: str) -> None:
+    if args.json:
+        print(json.dumps(data, indent=1, allow_nan=False))
+    else:
+        print(table)
+
+
+# --- commands ------------------------------------------------------------------------------------
+
+def cmd_eigen(args: argparse.Namespace) -> None:
+    from .eigen import eigen_analysis
+    from .modes import describe_modes
+
+    model, op, _ = load_model(args)
+    result = eigen_analysis(model, op)
+    descriptions = describe_modes(model, result, result.complex_index[: args.count])
+    complex_rows = [{"re": float(lam.real), "im_hz": float(lam.imag / (2 * np.pi)),
+                     "description": text}
+                    for lam, text in zip(result.complex_pairs[: args.count], descriptions,
+                                         strict=False)]
+    real_rows = [{"re": float(value)} for value in result.real[: args.count]]
+    data = {"operating_point": op.as_dict(), "stable": result.stable,
+            "max_real_part": result.max_real_part, "flutter_pairs": result.flutter,
+            "divergent_real": result.divergence, "rigid_body": result.n_rigid,
+            "complex": complex_rows, "real": real_rows}
+    lines = [f"operating point: s0 = {op.s0:g}, v = {op.v_kmh:g} km/h, N0 = {op.N0:g} N, "
+             f"b_M = {op.b_M:g} N m s/rad",
+             f"verdict: {'STABLE' if result.stable else 'UNSTABLE'} (largest Re = "
+             f"{result.max_real_part:.4g} 1/s; {result.flutter} flutter pair(s), "
+             f"{result.divergence} divergent real eigenvalue(s); {result.n_rigid} rigid-body "
+             "zero eigenvalues identified)", "",
+             f"{'#':>3} {'Re [1/s]':>10} {'Im [Hz]':>9}  description"]
+    for i, row in enumerate(complex_rows, start=1):
+        lines.append(f"{i:>3} {row['re']:>10.4f} {row['im_hz']:>9.3f}  {row['description']}")
+    lines += ["", "real eigenvalues [1/s], largest first: "
+              + ", ".join(f"{row['re']:.4g}" for row in real_rows)]
+    emit(args, data, "\n".join(lines))
+
+
+def cmd_limit(args: argparse.Namespace) -> None:
+    from .operating_point import KMH
+    from .stability import stability_limit
+
+    model, _, (n0, bm) = load_model(args)
+    limit = stability_limit(model, args.v * KMH, n0, bm)
+    emit(args, {"v_kmh": args.v, "s0_limit": limit.s0_limit, "N0": n0, "b_M": bm},
+         f"stability limit at {args.v:g} km/h: s0* = {limit.s0_limit:.6f} "
+         f"({limit.evaluations} eigen-analyses)")
+
+
+def cmd_export(args: argparse.Namespace) -> None:
+    from .export import export_system
+
+    model, op, _ = load_model(args)
+    export_system(model, op, args.out)
+    emit(args, {"out": args.out, "n_dof": model.n}, f"wrote {args.out} ({model.n} DOF)")
+
+
+def cmd_serve(args: argparse.Namespace) -> None:
+    from app.serve import serve
+
+    serve(port=args.port, address=args.address, allow_websocket_origin=args.allow_websocket_origin,
+          params=args.params)
+
+
+COMMANDS: dict[str, tuple[Callable, str]] = {}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="bogie", description="Locomotive bogie drive dynamics: eigenvalues, "
+                     "stability and traction-motor short-circuit response.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser("eigen", help="eigenvalues and stability at an operating point")
+    add_operating_point(p)
+    p.add_argument("--count", type=int, default=10, help="complex pairs / real values to list")
+    p.set_defaults(func=cmd_eigen)
+
+    p = sub.add_parser("limit", help="stability limit s0*(v) at a speed")
+    add_operating_point(p, s0=None)
+    p.set_defaults(func=cmd_limit)
+
+    p = sub.add_parser("export", help="export M, B, K, outputs at an operating point (.npz)")
+    add_operating_point(p)
+    p.add_argument("--out", required=True, help="output file (.npz)")
+    p.set_defaults(func=cmd_export)
+
+    p = sub.add_parser("serve", help="serve the dashboard (panel serve semantics)")
+    p.add_argument("--port", type=number("--port", 0, 65536, low_open=False,
+                                         allowed="must be 0…65535"), default=5006)
+    p.add_argument("--address", default="127.0.0.1")
+    p.add_argument("--allow-websocket-origin", action="append", default=None,
+                   help="host[:port] allowed to open the websocket (repeatable)")
+    p.add_argument("--params", default=None, metavar="FILE", help="parameter file (TOML)")
+    p.set_defaults(func=cmd_serve)
+
+    for register in EXTRA_COMMANDS:
+        register(sub)
+    return parser
+
+
+EXTRA_COMMANDS: list[Callable] = []  # register(subparsers) functions of other command modules
+
+
+def main(argv: list[str] | None = None) -> int:
+    from .operating_point import OperatingPointError
+
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        args.func(args)
+    except (UsageError, ParameterError, OperatingPointError, KeyError) as error:
+        message = error.args[0] if error.args else str(error)
+        print(f"bogie {args.command}: error: {message}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except BrokenPipeError:
+        return 0
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

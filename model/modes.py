@@ -1,0 +1,161 @@
+"""Mode identification: which parts move, in which direction, what deforms — and a Table-2-style
+sentence generated from that.
+
+For a mode shape Δq (complex), the kinetic-energy share of a component is
+``Re(Δqᴴ M_c Δq) / Re(Δqᴴ M Δq)`` and the strain-energy share of an element group
+``Re(Δqᴴ K_g Δq) / Re(Δqᴴ K Δq)``; ``M_c`` and ``K_g`` are the assembled contributions kept by
+:func:`model.assembly.build_model`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .assembly import BogieModel
+from .eigen import EigenResult
+
+# component (mass part) -> readable name
+COMPONENT_LABELS = {
+    "CB": "car body", "BF": "bogie frame", "track": "track",
+    **{f"ID{k}.{part}": f"{label} {k}" for k in (1, 2) for part, label in (
+        ("stator", "TM"), ("rotor", "rotor"), ("pinion", "pinion"), ("gear", "gear"),
+        ("hollow_shaft", "hollow shaft"), ("wheelset", "wheelset"))},
+}
+# element group (stiffness part) -> what deforms
+STRAIN_LABELS = {
+    "secondary": "secondary suspension", "track": "track",
+    **{f"ID{k}.{group}": f"{label} {k}" for k in (1, 2) for group, label in (
+        ("driving_shaft", "twisting of driving shaft"), ("gear_mesh", "gearing deformation"),
+        ("disc_clutch", "twisting of disc clutch"), ("claw_clutch", "claw clutch"),
+        ("hollow_shaft", "hollow shaft bending/torsion"), ("axle", "axle bending/torsion"),
+        ("rim_springs", "rim springs"), ("silent_blocks", "silent blocks"),
+        ("primary", "primary suspension"))},
+}
+AXIS_WORDS = {"x": "longitudinal", "y": "lateral", "z": "vertical", "rx": "roll", "ry": "pitch",
+              "rz": "yaw"}
+
+
+def merge_rims(model: BogieModel) -> dict[str, list[str]]:
+    """Mass parts grouped into components (the rims belong to their wheelset)."""
+    groups: dict[str, list[str]] = {}
+    for name in model.mass_parts:
+        component = name
+        if ".rim" in name:
+            component = name.split(".")[0] + ".wheelset"
+        groups.setdefault(component, []).append(name)
+    return groups
+
+
+@dataclass(frozen=True)
+class ModeCharacter:
+    """What a mode is made of."""
+
+    eigenvalue: complex  # [1/s]
+    kinetic: dict[str, float]  # component -> kinetic-energy share [-]
+    strain: dict[str, float]  # element group -> strain-energy share [-]
+    directions: dict[str, dict[str, float]]  # component -> axis -> share of its kinetic energy
+    description: str
+
+    @property
+    def frequency_hz(self) -> float:
+        return float(abs(self.eigenvalue.imag) / (2 * np.pi))
+
+    @property
+    def damping_ratio(self) -> float:
+        return float(-self.eigenvalue.real / abs(self.eigenvalue)) if self.eigenvalue else 0.0
+
+
+def _quadratic(part, q: np.ndarray) -> float:
+    x = q[part.index]
+    return float(np.real(np.conj(x) @ part.matrix @ x))
+
+
+def _axis_shares(model: BogieModel, parts: list[str], q: np.ndarray) -> dict[str, float]:
+    energy: dict[str, float] = {}
+    for name in parts:
+        part = model.mass_parts[name]
+        diagonal = np.diag(part.matrix) * np.abs(q[part.index]) ** 2
+        for index, value in zip(part.index, diagonal, strict=True):
+            axis = model.dofs.names[index].rsplit(".", 1)[1]
+            energy[axis] = energy.get(axis, 0.0) + float(value)
+    total = sum(energy.values()) or 1.0
+    return {axis: value / total for axis, value in energy.items()}
+
+
+def characterize(model: BogieModel, eigenvalue: complex, q: np.ndarray) -> ModeCharacter:
+    """Energy shares and description of one mode shape Δq."""
+    groups = merge_rims(model)
+    kinetic_raw = {c: sum(_quadratic(model.mass_parts[n], q) for n in names)
+                   for c, names in groups.items()}
+    total = sum(kinetic_raw.values()) or 1.0
+    kinetic = {c: value / total for c, value in kinetic_raw.items()}
+    strain_raw = {g: _quadratic(part, q) for g, part in model.stiffness_parts.items()}
+    total = sum(strain_raw.values()) or 1.0
+    strain = {g: value / total for g, value in strain_raw.items()}
+    directions = {c: _axis_shares(model, groups[c], q) for c in groups}
+    text = _describe(model, q, kinetic, strain, directions)
+    return ModeCharacter(complex(eigenvalue), kinetic, strain, directions, text)
+
+
+def _direction_words(component: str, shares: dict[str, float]) -> str:
+    ranked = sorted(shares.items(), key=lambda item: -item[1])
+    torsional = component.split(".")[-1] in ("rotor", "pinion", "gear")
+    words = []
+    for axis, share in ranked[:2]:
+        if words and share < 0.3 * ranked[0][1]:
+            break
+        word = "torsion" if torsional or (axis == "ry" and "hollow" in component) else AXIS_WORDS[axis]
+        if word not in words:
+            words.append(word)
+    return ("combined " + "–".join(words)) if len(words) > 1 else words[0]
+
+
+def _phase(model: BogieModel, q: np.ndarray, a: str, b: str, axis: str) -> str:
+    """'in phase' / 'opposite phase' of two components' motion along ``axis``."""
+    def representative(component: str) -> complex:
+        names = [n for n in model.dofs.names if n.startswith(component + ".") and n.endswith("." + axis)]
+        if not names:
+            return 0j
+        values = q[model.dofs.indices(names)]
+        return complex(values[np.argmax(np.abs(values))])
+
+    za, zb = representative(a), representative(b)
+    if za == 0 or zb == 0:
+        return ""
+    return "in phase" if np.real(za * np.conj(zb)) >= 0 else "opposite phase"
+
+
+def _describe(model, q, kinetic, strain, directions) -> str:
+    ranked = [c for c, share in sorted(kinetic.items(), key=lambda item: -item[1]) if share >= 0.1]
+    if not ranked:
+        ranked = [max(kinetic, key=kinetic.get)]
+    lead = ranked[0]
+    main_axis = max(directions[lead], key=directions[lead].get)
+    sentence = f"{_direction_words(lead, directions[lead])} of {COMPONENT_LABELS.get(lead, lead)}"
+    others = []
+    for component in ranked[1:4]:
+        axis = max(directions[component], key=directions[component].get)
+        label = COMPONENT_LABELS.get(component, component)
+        if axis == main_axis:
+            phase = _phase(model, q, lead, component, axis)
+            others.append(f"{label} {phase}".strip())
+        else:
+            others.append(f"{_direction_words(component, directions[component])} of {label}")
+    if others:
+        sentence += " with " + ", ".join(others)
+    deforms = [STRAIN_LABELS.get(g, g) for g, share in sorted(strain.items(), key=lambda i: -i[1])
+               if share >= 0.25][:2]
+    if deforms:
+        sentence += "; " + ", ".join(deforms)
+    return sentence
+
+
+def describe_modes(model: BogieModel, result: EigenResult, indices) -> list[str]:
+    """Descriptions of the modes ``indices`` of an eigen-analysis."""
+    return [mode_character(model, result, i).description for i in indices]
+
+
+def mode_character(model: BogieModel, result: EigenResult, index: int) -> ModeCharacter:
+    return characterize(model, result.eigenvalues[index], result.mode_shape(index))

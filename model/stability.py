@@ -1,0 +1,56 @@
+"""Stability limit s0*(v): the smallest creepage at which the bogie becomes unstable.
+
+Found by root finding (Brent) on the largest real part of the non-rigid eigenvalues, after an
+expanding bracket search; not by scanning a grid.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from scipy.optimize import brentq
+
+from .assembly import BogieModel
+from .eigen import eigen_analysis
+from .operating_point import OperatingPoint
+
+
+class NoStabilityLimit(ValueError):
+    """The bogie is stable (or unstable) over the whole searched creepage range."""
+
+
+@dataclass(frozen=True)
+class StabilityLimit:
+    v: float  # speed [m/s]
+    s0_limit: float  # critical creepage [-]
+    evaluations: int  # eigen-analyses used
+
+
+def max_real_part(model: BogieModel, op: OperatingPoint) -> float:
+    """Largest real part of the non-rigid eigenvalues [1/s]."""
+    return eigen_analysis(model, op, vectors=False).max_real_part
+
+
+def stability_limit(model: BogieModel, v: float, N0: float, b_M: float, s0_low: float = 1e-4,
+                    s0_high: float = 0.5, xtol: float = 1e-7) -> StabilityLimit:
+    """Smallest s0 in (s0_low, s0_high) where the largest real part crosses zero at speed v [m/s].
+
+    The bracket starts at ``s0_low`` (must be stable) and doubles an upper creepage until the bogie
+    is unstable; Brent's method then finds the crossing to ``xtol``.
+    """
+    count = 0
+
+    def growth(s0: float) -> float:
+        nonlocal count
+        count += 1
+        return max_real_part(model, OperatingPoint(s0, v, N0, b_M))
+
+    if growth(s0_low) > 0:
+        raise NoStabilityLimit(f"already unstable at s0 = {s0_low:g}")
+    low, high = s0_low, 2 * s0_low
+    while growth(high) <= 0:
+        low, high = high, 2 * high
+        if high > s0_high:
+            raise NoStabilityLimit(f"stable over the whole range s0 <= {s0_high:g}")
+    s0 = brentq(growth, low, high, xtol=xtol, rtol=1e-10)
+    return StabilityLimit(v, float(s0), count)
