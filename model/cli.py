@@ -188,7 +188,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         args.func(args)
-    except (UsageError, ParameterError, OperatingPointError, KeyError) as error:
+    except (UsageError, ParameterError, OperatingPointError, KeyError, ValueError) as error:
         message = error.args[0] if error.args else str(error)
         print(f"bogie {args.command}: error: {message}", file=sys.stderr)
         return EXIT_BAD_INPUT

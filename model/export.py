@@ -1,0 +1,40 @@
+"""Export of the linear system at an operating point as ``.npz`` (for other tools).
+
+Arrays: ``M``, ``B`` (all damping at the point: structural + b_M B_M + B_ad), ``K``, ``dofs``
+(names), ``dof_units``, ``f_mc`` (generalized force per unit short-circuit torque M_C [1 or 1/m…]),
+``motor_torque`` (M(s0, v) [N m]), ``C_q``, ``C_v``, ``outputs`` (names of y = C_q Δq + C_v Δq̇),
+``output_units``, ``output_steady`` (pre-fault values), ``operating_point`` (s0 [-], v [m/s],
+N0 [N], b_M [N m s/rad]).  Strings are numpy unicode arrays: load with ``allow_pickle=False``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .assembly import BogieModel
+from .operating_point import OperatingPoint, damping_matrix, motor_torque
+from .outputs import output_matrices
+
+
+def export_system(model: BogieModel, op: OperatingPoint, path: str | Path) -> None:
+    path = Path(path)
+    if path.suffix != ".npz":
+        raise ValueError(f"export file must end in .npz, got '{path.name}'")
+    if not path.parent.exists():
+        raise ValueError(f"directory '{path.parent}' does not exist")
+    outputs = output_matrices(model, op)
+    np.savez(
+        path,
+        M=model.M, B=damping_matrix(model, op), K=model.K,
+        dofs=np.array(model.dofs.names, dtype=str),
+        dof_units=np.array([model.dofs.unit(n) for n in model.dofs.names], dtype=str),
+        f_mc=model.short_circuit_force,
+        motor_torque=np.float64(motor_torque(model.parameters, op)),
+        C_q=outputs.C_q, C_v=outputs.C_v,
+        outputs=np.array(outputs.names, dtype=str),
+        output_units=np.array(outputs.units, dtype=str),
+        output_steady=outputs.steady,
+        operating_point=np.array([op.s0, op.v, op.N0, op.b_M]),
+    )
