@@ -1,0 +1,323 @@
+"""Invariants of the assembled bogie: properties every correct assembly has, whatever the
+parameter values (so they hold for the estimate and for every calibration of it).
+
+Each tolerance is relative to the norm of the matrix it concerns and says why it is what it is.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+
+from model import build_model, default_operating_point, eigen_analysis, load_parameters
+from model.assembly import DRIVES, dof_names
+from model.dofs import AXES6
+from model.eigen import state_space
+from model.operating_point import creep_coefficients, creep_damping
+from model.outputs import static_load
+from model.parameters import CALIBRATED_FILE, ESTIMATE_FILE
+
+EPS = np.finfo(float).eps
+N_DOF = 193
+
+# sign of each coordinate under the central symmetry (180° about z): x, y → −x, −y; z → z; the
+# rotations are axial vectors of a proper rotation and transform alike: rx, ry → −; rz → +.
+SYMMETRY_SIGN = {"x": -1.0, "y": -1.0, "z": 1.0, "rx": -1.0, "ry": -1.0, "rz": 1.0}
+
+
+@pytest.fixture(scope="module", params=["calibrated", "estimate"])
+def model(request):
+    path = {"calibrated": CALIBRATED_FILE, "estimate": ESTIMATE_FILE}[request.param]
+    return build_model(load_parameters(path))
+
+
+@pytest.fixture(scope="module")
+def calibrated():
+    return build_model(load_parameters())
+
+
+def _scaled(matrix: np.ndarray) -> np.ndarray:
+    """D^(−1/2) K D^(−1/2) with D = diag(K): unit diagonal, so metres and radians mix fairly."""
+    d = 1 / np.sqrt(np.diag(matrix))
+    return d[:, None] * matrix * d[None, :]
+
+
+def _drive_indices(model, prefix):
+    return [i for i, name in enumerate(model.dofs.names) if name.startswith(prefix + ".")]
+
+
+def _symmetry_map(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(indices of ID1, matching indices of ID2, diagonal sign matrix R)."""
+    i1 = _drive_indices(model, "ID1")
+    i2 = [model.dofs.index("ID2." + model.dofs.names[i].split(".", 1)[1]) for i in i1]
+    R = np.diag([SYMMETRY_SIGN[model.dofs.names[i].rsplit(".", 1)[1]] for i in i1])
+    return np.array(i1), np.array(i2), R
+
+
+# ------------------------------------------------------------------------------------------------
+# coordinates
+
+
+def test_dof_count_and_names(calibrated):
+    names = calibrated.dofs.names
+    assert len(names) == N_DOF == calibrated.n == len(dof_names())
+    assert len(set(names)) == len(names)
+    axes = "|".join(AXES6)
+    pattern = re.compile(rf"^(ID[12]\.[a-z]+[0-9]*|BF|CB)\.({axes})$")
+    bad = [name for name in names if not pattern.match(name)]
+    assert not bad, f"names not <subsystem>.<part>.<axis> (BF/CB: <body>.<axis>): {bad}"
+    # q = [q_ID1, q_BFCB, q_ID2] (eq. 1), the two drives with the same layout
+    first = [name.split(".", 1)[0] for name in names]
+    assert first == ["ID1"] * 93 + ["BF"] * 6 + ["CB"] + ["ID2"] * 93
+    assert [n[4:] for n in names[:93]] == [n[4:] for n in names[100:]]
+    for name in names:
+        assert calibrated.dofs.unit(name) == ("m" if name.rsplit(".", 1)[1] in "xyz" else "rad")
+
+
+def test_rims_index_their_own_coordinates(calibrated):
+    assert sorted(calibrated.rims) == ["ID1.rim12", "ID1.rim14", "ID2.rim12", "ID2.rim14"]
+    for rim, index in calibrated.rims.items():
+        assert [calibrated.dofs.names[i] for i in index] == [f"{rim}.{a}" for a in AXES6]
+
+
+# ------------------------------------------------------------------------------------------------
+# matrices
+
+
+def test_mass_matrix_symmetric_positive_definite(model):
+    M = model.M
+    # W^T M6 W products round differently above and below the diagonal: allow a few ulps of ||M||
+    assert np.allclose(M, M.T, rtol=0, atol=10 * EPS * np.abs(M).max())
+    sla.cholesky(0.5 * (M + M.T))  # raises LinAlgError unless positive definite
+    assert np.all(np.diag(M) > 0)
+
+
+def test_stiffness_symmetric_psd_with_exactly_two_zero_eigenvalues(model):
+    """Eigenvalues of the unit-diagonal scaled K: a backward-stable solver gives the true zeros
+    as O(n eps ||K_s||) ≈ 1e-13; we call |λ| < 100 n eps ||K_s|| (≈ 1e-11) zero.  The softest
+    real stiffness (soft secondary suspension of the car body) sits near 1e-7 for the estimate
+    and the calibrated set, four decades above, so the count is not a tolerance artefact."""
+    K = model.K
+    assert np.array_equal(K, K.T)
+    w = np.linalg.eigvalsh(_scaled(K))
+    tol = 100 * model.n * EPS * np.abs(w).max()
+    assert w.min() > -tol
+    assert np.count_nonzero(np.abs(w) < tol) == 2
+    assert w[2] > 100 * tol
+
+
+def test_damping_symmetric_psd(model):
+    B = model.B
+    assert np.array_equal(B, B.T)
+    w = np.linalg.eigvalsh(B)
+    assert w.min() > -100 * model.n * EPS * w.max()
+
+
+def test_rigid_body_modes_are_the_null_space_of_k(model):
+    R = model.rigid_body_modes
+    assert R.shape == (model.n, 2)
+    K = model.K
+    residual = np.linalg.norm(K @ R, axis=0)
+    assert np.all(residual <= 1e3 * EPS * np.linalg.norm(K, 2) * np.linalg.norm(R, axis=0))
+    # one per drivetrain, each confined to its drive's spins
+    for column, prefix in enumerate(DRIVES):
+        touched = {model.dofs.names[i] for i in np.flatnonzero(R[:, column])}
+        assert touched
+        assert all(name.startswith(prefix) and name.endswith(".ry") for name in touched)
+
+
+def test_parts_add_up_to_the_matrices(model):
+    """Energy bookkeeping: the per-component shares of M and per-group shares of K are complete."""
+    for parts, total in ((model.mass_parts, model.M), (model.stiffness_parts, model.K)):
+        summed = np.zeros_like(total)
+        for part in parts.values():
+            summed[np.ix_(part.index, part.index)] += part.matrix
+        assert np.allclose(summed, total, rtol=0, atol=1e-12 * np.abs(total).max())
+
+
+def test_rigid_translation_carries_the_total_mass(model):
+    """Translating everything by 1 m gives the kinetic-energy mass 2T/v² = Σ masses, computed
+    here from the parameters (beam masses ρ A L from the geometry)."""
+    p = model.parameters
+    rho = p["steel_density"]
+    hollow = np.pi * (p["hollow_shaft_outer_radius"] ** 2 - p["hollow_shaft_inner_radius"] ** 2)
+    hollow_length = abs(p["gear_lateral_position"] - p["claw_clutch_lateral_position"])
+    axle = np.pi * p["axle_radius"] ** 2 * 2 * p["journal_half_distance"]
+    per_drive = (p["stator_mass"] + p["rotor_mass"] + p["pinion_mass"] + p["gear_mass"]
+                 + rho * hollow * hollow_length + rho * axle + 2 * p["wheel_disc_mass"]
+                 + 2 * p["axle_box_mass"] + 2 * p["rim_mass"])
+    horizontal = 2 * per_drive + p["frame_mass"]
+    vertical = horizontal + p["car_body_mass"] + 4 * p["track_mass"]
+    for axis, expected in (("x", horizontal), ("y", horizontal), ("z", vertical)):
+        q = np.array([1.0 if name.endswith("." + axis) else 0.0 for name in model.dofs.names])
+        assert q @ model.M @ q == pytest.approx(expected, rel=1e-12), axis
+
+
+def test_drivetrain_rigid_spin_needs_rotor_at_minus_p(model):
+    """Turning a whole drivetrain with the wheel at 1 rad and rotor and pinion at c rad stores the
+    strain energy E(c) = a (c − c*)², a quadratic in c.  Its minimum must be c* = −p (one
+    external gear mesh reverses the sense, p = gear ratio) with E(c*) = 0 to rounding, and the
+    curvature a > 0 (any other ratio stores energy).  Turning the rotor alone against the pinion
+    twists the driving shaft."""
+    p = model.parameters["gear_ratio"]
+    K = model.K
+    scale = np.linalg.norm(K, 2)
+    for prefix in DRIVES:
+        wheel = np.zeros(model.n)  # wheel side: gear, hollow shaft, axle, rims
+        fast = np.zeros(model.n)  # motor side: rotor and pinion
+        for i, name in enumerate(model.dofs.names):
+            if name.startswith(prefix) and name.endswith(".ry") and ".stator." not in name:
+                (fast if (".rotor." in name or ".pinion." in name) else wheel)[i] = 1.0
+        a = fast @ K @ fast
+        c_star = -(wheel @ K @ fast) / a
+        assert c_star == pytest.approx(-p, rel=1e-10)
+        r = wheel - p * fast
+        assert abs(r @ K @ r) <= 1e3 * EPS * scale * (r @ r)
+        assert np.allclose(r, model.rigid_body_modes[:, DRIVES.index(prefix)])
+        for c in (-0.9 * p, -1.1 * p, p, 0.0):
+            r = wheel + c * fast
+            assert r @ K @ r == pytest.approx(a * (c + p) ** 2, rel=1e-8)
+            assert r @ K @ r > 1e6 * EPS * scale * (r @ r)
+        rotor_only = wheel - p * fast
+        rotor_only[model.dofs.index(f"{prefix}.rotor.ry")] += 0.1
+        k_ds = model.parameters["driving_shaft_stiffness"]
+        assert rotor_only @ K @ rotor_only == pytest.approx(k_ds * 0.1**2, rel=1e-9)
+
+
+def test_drive_2_mirrors_drive_1(model):
+    """Drive 2 is built from drive 1's description through the geometry transform
+    diag(−1, −1, 1) of positions and directions.  In coordinates that means M₂₂ = R M₁₁ R (same
+    for K, B) with R the sign map of the central symmetry, and the couplings to the frame
+    K₂,BF = R K₁,BF R_BF; the frame/car-body block itself is invariant (R_BF K R_BF = K)."""
+    i1, i2, R = _symmetry_map(model)
+    frame = [model.dofs.index(f"BF.{a}") for a in AXES6] + [model.dofs.index("CB.z")]
+    R_frame = np.diag([SYMMETRY_SIGN[a] for a in AXES6] + [1.0])
+    for label, matrix in (("M", model.M), ("K", model.K), ("B", model.B)):
+        scale = np.abs(matrix).max()
+        d1, d2 = matrix[np.ix_(i1, i1)], matrix[np.ix_(i2, i2)]
+        assert np.allclose(d2, R @ d1 @ R, rtol=0, atol=1e-12 * scale), label
+        c1, c2 = matrix[np.ix_(i1, frame)], matrix[np.ix_(i2, frame)]
+        assert np.allclose(c2, R @ c1 @ R_frame, rtol=0, atol=1e-12 * scale), label
+        f = matrix[np.ix_(frame, frame)]
+        assert np.allclose(f, R_frame @ f @ R_frame, rtol=0, atol=1e-12 * scale), label
+        # the drives do not couple directly
+        assert not np.any(matrix[np.ix_(i1, i2)]), label
+    # the rigid spins map onto each other (up to the sign of a spin, which R flips)
+    r1, r2 = model.rigid_body_modes[i1, 0], model.rigid_body_modes[i2, 1]
+    assert np.allclose(np.abs(R @ r1), np.abs(r2))
+
+
+# ------------------------------------------------------------------------------------------------
+# operating-point terms
+
+
+def test_creep_damping_nonsymmetric_on_rim_coordinates_only(model):
+    op = default_operating_point(model.parameters, s0=0.005, v_kmh=120.0)
+    B_ad = creep_damping(model, creep_coefficients(model.parameters, op))
+    rim_dofs = np.concatenate(list(model.rims.values()))
+    others = np.setdiff1d(np.arange(model.n), rim_dofs)
+    assert not np.any(B_ad[others, :])
+    assert not np.any(B_ad[:, others])
+    assert not np.allclose(B_ad, B_ad.T)
+    # blocks only within a rim, never between rims
+    for a, ia in model.rims.items():
+        for b, ib in model.rims.items():
+            if a != b:
+                assert not np.any(B_ad[np.ix_(ia, ib)])
+    # the four rims see the same block (same contact, vehicle axes)
+    blocks = [B_ad[np.ix_(i, i)] for i in model.rims.values()]
+    assert all(np.array_equal(blocks[0], blk) for blk in blocks[1:])
+
+
+def test_creep_damping_changes_sign_of_b11_across_the_creep_maximum(calibrated):
+    p = calibrated.parameters
+    low = creep_coefficients(p, default_operating_point(p, s0=0.005))
+    high = creep_coefficients(p, default_operating_point(p, s0=0.014))
+    assert low.b11 > 0 > high.b11  # positive slope, then negative damping on the falling branch
+
+
+def test_motor_pattern_only_on_id2_rotor_and_stator(model):
+    Bm = model.motor_pattern
+    touched = sorted({model.dofs.names[i] for i in np.flatnonzero(np.any(Bm != 0, axis=0))})
+    assert touched == ["ID2.rotor.ry", "ID2.stator.ry"]
+    assert np.array_equal(Bm, Bm.T)
+    assert np.linalg.eigvalsh(Bm).min() > -1e-14
+    # relative form: a rotation of rotor and stator together does not change the motor torque
+    together = np.zeros(model.n)
+    together[[model.dofs.index("ID2.rotor.ry"), model.dofs.index("ID2.stator.ry")]] = 1.0
+    assert not np.any(Bm @ together)
+
+
+def test_short_circuit_force_is_internal_and_drives_drivetrain_1(model):
+    """M_C acts on ID1's rotor and, as reaction, on ID1's stator: the net torque on the bogie is
+    zero (rotating rotor and stator together, i.e. the whole motor as one body, absorbs no work),
+    while on the drivetrain's rigid spin — rotor at −p, stator at rest — it does the work p per
+    radian of the wheel: a positive driving torque M_C spins the wheels forward (+ry).  Drive 2's
+    spin is untouched."""
+    f = model.short_circuit_force
+    p = model.parameters["gear_ratio"]
+    touched = sorted(model.dofs.names[i] for i in np.flatnonzero(f))
+    assert touched == ["ID1.rotor.ry", "ID1.stator.ry"]
+    motor_as_one_body = np.zeros(model.n)
+    for name in touched:
+        motor_as_one_body[model.dofs.index(name)] = 1.0
+    assert f @ motor_as_one_body == 0.0
+    r1, r2 = model.rigid_body_modes.T
+    assert f @ r1 == pytest.approx(p, rel=1e-14)
+    assert f @ r2 == 0.0
+
+
+def test_static_traction_load_is_self_equilibrated(model):
+    """Eq. 7: the motor torque M = 2 μ N0 r0 / p balances the creep moment 2 μ N0 r0 on each
+    drivetrain's rigid spin, so K q0 = f0 is solvable (f0 ⟂ null space of K)."""
+    for s0 in (0.005, 0.014):
+        op = default_operating_point(model.parameters, s0=s0, v_kmh=120.0)
+        f0 = static_load(model, op)
+        for r in model.rigid_body_modes.T:
+            assert abs(f0 @ r) <= 1e-12 * np.linalg.norm(f0) * np.linalg.norm(r)
+
+
+def test_eigen_analysis_identifies_the_two_rigid_spins(calibrated):
+    op = default_operating_point(calibrated.parameters)
+    result = eigen_analysis(calibrated, op, vectors=False)
+    assert result.n_rigid == 2
+    assert result.eigenvalues.size == 2 * calibrated.n - 2
+
+
+# ------------------------------------------------------------------------------------------------
+# energy
+
+
+def _energy(model, x):
+    n = model.n
+    q, v = x[:n], x[n:]
+    return 0.5 * v @ model.M @ v + 0.5 * q @ model.K @ q
+
+
+def _trajectory(model, B, dt=1e-3, steps=20, seed=0):
+    """Exact free response x(k dt) = expm(A dt)^k x0 of M q̈ + B q̇ + K q = 0 from a random state."""
+    A = state_space(model).state_matrix(B)
+    step = sla.expm(A * dt)
+    x = np.random.default_rng(seed).normal(size=2 * model.n)
+    energies = [_energy(model, x)]
+    for _ in range(steps):
+        x = step @ x
+        energies.append(_energy(model, x))
+    return np.array(energies)
+
+
+def test_undamped_free_vibration_conserves_energy(calibrated):
+    """B = 0, no creep, no motor: E = ½ q̇ᵀMq̇ + ½ qᵀKq is constant.  expm is accurate to about
+    eps ||A dt||; the measured drift is ~3e-13, we allow 1e-10."""
+    energies = _trajectory(calibrated, np.zeros_like(calibrated.M))
+    assert np.allclose(energies, energies[0], rtol=1e-10, atol=0)
+
+
+def test_structural_damping_dissipates_monotonically(calibrated):
+    """dE/dt = −q̇ᵀBq̇ ≤ 0 for B symmetric PSD: energy never grows and here falls a lot."""
+    energies = _trajectory(calibrated, calibrated.B)
+    assert np.all(np.diff(energies) <= 1e-12 * energies[0])
+    assert energies[-1] < 0.5 * energies[0]
