@@ -381,6 +381,7 @@ class ResponseResult:
     peaks: dict[str, float]  # name -> signed total of largest magnitude [units]
     peak_times: dict[str, float]  # name -> its time [s]
     perturbation_peaks: dict[str, float]  # name -> signed Δy of largest magnitude [units]
+    perturbation_peak_times: dict[str, float]  # name -> its time [s]
     dominant_frequencies: dict[str, tuple[float, ...]]  # name -> spectral peaks of Δy [Hz]
     limit_crossings: list[LimitCrossing]  # totals beyond physical limits, by time
     limits: dict[str, float]  # "M_ad" [N m], "M_ad/p" [N m], "mu_max N0" [N]
@@ -413,9 +414,11 @@ def dominant_frequencies(y: np.ndarray, fs: float, count: int = 4,
     """Strongest peaks of the amplitude spectrum of each column of ``y`` (sampled at ``fs`` [Hz]),
     strongest first [Hz].
 
-    Linear trend removed, Hann window, zero padding to ≥ 2× the length (power of 2) and a
-    parabolic fit of the log amplitude at each peak; peaks below ``relative`` × the strongest are
-    dropped.  A 1-D ``y`` gives a list with one tuple.
+    The mean is removed and only the second half is tapered (half cosine): the response starts
+    from rest, and a full window would hide the early, decaying content (the 90 Hz excitation).
+    Zero padding to ≥ 2× the length (power of 2) and a parabolic fit of the log amplitude at
+    each peak; peaks below ``relative`` × the strongest are dropped.  A 1-D ``y`` gives a list
+    with one tuple.
     """
     y = np.asarray(y, dtype=float)
     if y.ndim == 1:
@@ -423,10 +426,12 @@ def dominant_frequencies(y: np.ndarray, fs: float, count: int = 4,
     N = y.shape[0]
     if N < 8:
         return [() for _ in range(y.shape[1])]
-    k = np.arange(N) - (N - 1) / 2
-    y = y - y.mean(axis=0) - np.outer(k, (k @ y) / (k @ k))
+    y = y - y.mean(axis=0)
+    taper = np.ones(N)
+    m = max(2, N // 2)
+    taper[N - m:] = 0.5 * (1 + np.cos(np.pi * np.arange(1, m + 1) / m))
     n_fft = 1 << math.ceil(math.log2(2 * N))
-    spectrum = np.abs(np.fft.rfft(y * np.hanning(N)[:, None], n=n_fft, axis=0))
+    spectrum = np.abs(np.fft.rfft(y * taper[:, None], n=n_fft, axis=0))
     df = fs / n_fft
     result = []
     for s in spectrum.T:
@@ -435,9 +440,16 @@ def dominant_frequencies(y: np.ndarray, fs: float, count: int = 4,
             result.append(())
             continue
         peaks = peaks[s[peaks] >= relative * s[peaks].max()]
-        peaks = peaks[np.argsort(-s[peaks])][:count]
-        found = []
+        peaks = peaks[np.argsort(-s[peaks])]
+        # side lobes: drop peaks closer than 4/T to a stronger one
+        chosen: list[int] = []
         for i in peaks:
+            if all(abs(i - j) * df > 4.0 * fs / N for j in chosen):
+                chosen.append(int(i))
+            if len(chosen) == count:
+                break
+        found = []
+        for i in chosen:
             l0, l1, l2 = np.log(s[i - 1: i + 2] + 1e-300)
             den = l0 - 2 * l1 + l2
             shift = 0.5 * (l0 - l2) / den if den < 0 else 0.0
@@ -506,13 +518,13 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
     valid = y.shape[0]
     t = np.arange(valid) * dt
     totals = {name: y[:, j] + steady[name] for j, name in enumerate(names)}
-    peaks, peak_times, pert_peaks = {}, {}, {}
+    peaks, peak_times, pert_peaks, pert_times = {}, {}, {}, {}
     freqs = dict(zip(names, dominant_frequencies(y, fs), strict=True))
     for j, name in enumerate(names):
         k = int(np.argmax(np.abs(totals[name])))
         peaks[name], peak_times[name] = float(totals[name][k]), float(t[k])
         kp = int(np.argmax(np.abs(y[:, j])))
-        pert_peaks[name] = float(y[kp, j])
+        pert_peaks[name], pert_times[name] = float(y[kp, j]), float(t[kp])
     M_ad = adhesion_moment(model.parameters, op.v, op.N0)
     _, mu_max = creep_law(model.parameters, op.N0).maximum(op.v)
     limits = {"M_ad": M_ad, "M_ad/p": M_ad / model.parameters["gear_ratio"],
@@ -530,6 +542,7 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
     return ResponseResult(
         t=t, outputs=totals, units=units, steady=steady, M_C=excitation.torque(t, step),
         peaks=peaks, peak_times=peak_times, perturbation_peaks=pert_peaks,
+        perturbation_peak_times=pert_times,
         dominant_frequencies=freqs, limit_crossings=crossings, limits=limits,
         operating_point=op, excitation=excitation, phase_shift=excitation.shift(step),
         motor_torque=step, method=used, error_estimate=estimate,
