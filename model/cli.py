@@ -180,6 +180,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 EXTRA_COMMANDS: list[Callable] = []  # register(subparsers) functions of other command modules
 
+from .response_cli import register as _register_response  # noqa: E402
+
+EXTRA_COMMANDS.append(_register_response)
+
 
 def main(argv: list[str] | None = None) -> int:
     from .operating_point import OperatingPointError
