@@ -12,7 +12,14 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from model import build_model, default_operating_point, eigen_analysis, load_parameters
+from model import (
+    build_model,
+    default_operating_point,
+    eigen_analysis,
+    load_parameters,
+    motor_torque,
+    output_matrices,
+)
 from model.assembly import DRIVES, dof_names
 from model.dofs import AXES6
 from model.eigen import state_space
@@ -321,3 +328,24 @@ def test_structural_damping_dissipates_monotonically(calibrated):
     energies = _trajectory(calibrated, calibrated.B)
     assert np.all(np.diff(energies) <= 1e-12 * energies[0])
     assert energies[-1] < 0.5 * energies[0]
+
+
+def test_static_traction_torque_chain(calibrated):
+    """Steady traction (eq. 7) through the drivetrain: the driving shaft carries the motor torque
+    M, the disc and claw clutches p·M = the wheelset's adhesion moment 2 μ N0 r0, and the gear mesh
+    the tooth force M / (r_pinion cos α) along the line of action.  (The sign of ID2's gear mesh
+    force is opposite to ID1's: its line of action is drive 1's turned by 180°.)"""
+    p = calibrated.parameters
+    ratio, alpha = p["gear_ratio"], p["pressure_angle"]
+    r_pinion = p["gear_radius"] / ratio
+    for s0 in (0.005, 0.014):
+        op = default_operating_point(p, s0=s0, v_kmh=120.0)
+        torque = motor_torque(p, op)
+        outputs = output_matrices(calibrated, op)
+        steady = dict(zip(outputs.names, outputs.steady, strict=True))
+        for drive in DRIVES:
+            assert steady[f"{drive}.driving_shaft.torque"] == pytest.approx(torque, rel=1e-9)
+            for name in ("disc_clutch.torque", "claw_clutch.torque", "wheelset.adhesion_moment"):
+                assert steady[f"{drive}.{name}"] == pytest.approx(ratio * torque, rel=1e-9), name
+            assert abs(steady[f"{drive}.gear_mesh.force"]) == pytest.approx(
+                torque / (r_pinion * np.cos(alpha)), rel=1e-9)
