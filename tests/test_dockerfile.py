@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import re
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -127,15 +128,18 @@ def test_serve_origins_from_the_environment(monkeypatch):
     pn = pytest.importorskip("panel")
     from app.serve import serve
 
-    calls = []
+    calls, handlers = [], {}
     monkeypatch.setattr(pn, "serve", lambda *args, **kwargs: calls.append(kwargs))
+    monkeypatch.setattr(signal, "signal", handlers.__setitem__)  # leave pytest's handlers alone
 
     monkeypatch.delenv("BOGIE_ALLOWED_ORIGINS", raising=False)
-    serve(port=5123, address="0.0.0.0")
+    serve(port=5123.0, address="0.0.0.0")  # the command line gives a float
     assert calls[-1]["websocket_origin"] == ["localhost:5123", "127.0.0.1:5123"]
     assert calls[-1]["liveness"] is True
     assert calls[-1]["address"] == "0.0.0.0"
     assert calls[-1]["port"] == 5123
+    assert isinstance(calls[-1]["port"], int)
+    assert handlers == {signal.SIGTERM: signal.default_int_handler}  # docker stop ends it cleanly
 
     monkeypatch.setenv("BOGIE_ALLOWED_ORIGINS", " bogie.example.org , localhost:8080,")
     serve(port=5006)
