@@ -243,9 +243,10 @@ def _grid_exponentials(lam: np.ndarray, n_points: int, dt: float, block: int):
 
 
 def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu: complex,
-                   n_points: int, dt: float) -> tuple[np.ndarray, float, int]:
+                   n_points: int, dt: float) -> tuple[np.ndarray, float, int, float]:
     """Perturbation outputs y (n_points x p) by the modal closed form; (y, error estimate relative
-    to the largest |y|, number of valid points)."""
+    to the largest |y|, number of valid points, highest frequency [Hz] of a mode contributing
+    more than 1 % of some output's peak)."""
     Q1, Q2 = system.deflation
     lam, Y, lu, cond = system.modal
     alpha, beta = system.step_particular(u0)
@@ -295,7 +296,10 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
         + np.abs(const_h)
     scale = np.abs(y).max(axis=0)
     estimate = float(np.max(EPS * cond * terms / np.maximum(scale, 1e-300))) if p else 0.0
-    return y, estimate, valid
+    share = (np.abs(coef_k) / np.maximum(scale, 1e-300)[:, None]).max(axis=0)
+    significant = lam_k.imag[share > 0.01]
+    excited = float(significant.max() / (2 * np.pi)) if len(significant) else 0.0
+    return y, estimate, valid, excited
 
 
 def _expm_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu: complex,
@@ -333,18 +337,23 @@ def _expm_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu
 
 
 def solve_linear(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu: complex,
-                 n_points: int, dt: float, method: str = "auto") -> tuple[np.ndarray, str, float]:
+                 n_points: int, dt: float, method: str = "auto",
+                 info: dict | None = None) -> tuple[np.ndarray, str, float]:
     """Perturbation outputs ``C [q; q̇]`` (n_points x p) of ``M q̈ + B q̇ + K q = f u(t)``,
     ``u = u0 + Re(a e^(μt))`` for t ≥ 0, at rest at t = 0, on the grid t_k = k dt.
 
     Returns (y, method used, error estimate relative to max|y| per output; NaN for "expm").
     The number of rows is smaller than n_points if the response had to be truncated (growth).
+    ``info``, if given, receives ``"mode_hz"``: the highest frequency [Hz] of a mode that
+    contributes more than 1 % of some output's peak (when the modal form was evaluated).
     """
     if method not in ("auto", "modal", "expm"):
         raise ResponseError(f"method '{method}' is not allowed: auto, modal or expm")
     if method in ("auto", "modal"):
         try:
-            y, estimate, _ = _modal_outputs(system, C, u0, a, mu, n_points, dt)
+            y, estimate, _, excited = _modal_outputs(system, C, u0, a, mu, n_points, dt)
+            if info is not None:
+                info["mode_hz"] = excited
         except np.linalg.LinAlgError:
             y, estimate = None, math.inf
         ok = y is not None and np.all(np.isfinite(y)) and estimate <= AUTO_TOLERANCE
@@ -392,6 +401,14 @@ class ResponseResult:
     method: str  # "modal" or "expm"
     error_estimate: float  # rounding-error estimate of the modal form (relative), NaN for expm
     truncated_at: float | None  # [s] if the grid was cut to avoid overflow (growth)
+    highest_excited_hz: float | None  # max(f, highest mode with > 1 % of an output) [Hz]
+
+    @property
+    def nyquist_ok(self) -> bool:
+        """fs/2 above the highest excited frequency (None: not known, method "expm")."""
+        if self.highest_excited_hz is None or len(self.t) < 2:
+            return True
+        return 0.5 / (self.t[1] - self.t[0]) > self.highest_excited_hz
 
     def perturbation(self, name: str) -> np.ndarray:
         """Δy(t) = total − pre-fault value [unit of the output]."""
@@ -514,7 +531,8 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
     u0, a, mu = excitation.terms(step)
     dt = 1.0 / fs
     system = _response_system(model, op)
-    y, used, estimate = solve_linear(system, C, u0, a, mu, n_points, dt, method)
+    info: dict = {}
+    y, used, estimate = solve_linear(system, C, u0, a, mu, n_points, dt, method, info)
     valid = y.shape[0]
     t = np.arange(valid) * dt
     totals = {name: y[:, j] + steady[name] for j, name in enumerate(names)}
@@ -546,4 +564,6 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
         dominant_frequencies=freqs, limit_crossings=crossings, limits=limits,
         operating_point=op, excitation=excitation, phase_shift=excitation.shift(step),
         motor_torque=step, method=used, error_estimate=estimate,
-        truncated_at=None if valid == n_points else float(t[-1]))
+        truncated_at=None if valid == n_points else float(t[-1]),
+        highest_excited_hz=(max(excitation.f if excitation.M0 > 0 else 0.0, info["mode_hz"])
+                            if "mode_hz" in info else None))

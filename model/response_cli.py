@@ -87,6 +87,10 @@ def cmd_response(args: argparse.Namespace) -> None:
     model, op, _ = load_model(args)
     result = short_circuit_response(model, op, excitation, args.t_end, args.fs, names,
                                     method=args.method)
+    if result.highest_excited_hz and args.fs < MIN_SAMPLES_PER_PERIOD * result.highest_excited_hz:
+        raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the highest excited "
+                         f"frequency {result.highest_excited_hz:.4g} Hz: must be at least "
+                         f"{MIN_SAMPLES_PER_PERIOD * result.highest_excited_hz:.4g} Hz")
     if out is not None:
         write_result(result, out)
     summary = summary_data(result)
@@ -104,6 +108,7 @@ def summary_data(result) -> dict:
         "motor_torque": result.motor_torque, "method": result.method,
         "error_estimate": None if math.isnan(result.error_estimate) else result.error_estimate,
         "truncated_at": result.truncated_at, "limits": result.limits,
+        "highest_excited_hz": result.highest_excited_hz,
         "outputs": {name: {"unit": result.units[name], "steady": result.steady[name],
                            "peak": result.peaks[name], "peak_time": result.peak_times[name],
                            "perturbation_peak": result.perturbation_peaks[name],
