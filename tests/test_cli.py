@@ -8,11 +8,13 @@ subprocess (``sys.executable -m model``) so that the process-level contract is c
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
 import numpy as np
 import pytest
+from threadpoolctl import threadpool_limits
 
 from model import build_model, eigen_analysis, load_parameters, motor_torque
 from model.cli import main
@@ -23,6 +25,15 @@ from model.parameters import ESTIMATE_FILE, dumps_parameters
 
 EIGEN_KEYS = {"operating_point", "stable", "complex", "real", "rigid_body"}
 EXPORT_ARRAYS = {"M", "B", "K", "dofs", "f_mc", "motor_torque", "C_q", "C_v", "outputs"}
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _one_blas_thread():
+    """Dense 386 x 386 eigenproblems run fastest on one BLAS thread, and OpenBLAS threads that
+    busy-wait against another process on the same cores slow an eigen-analysis from ~0.1 s to
+    ~9 s (measured on the 2-core machine); pin BLAS to one thread for this module."""
+    with threadpool_limits(1):
+        yield
 
 
 def run(argv: list[str], capsys) -> tuple[int, str, str]:
@@ -37,8 +48,9 @@ def run(argv: list[str], capsys) -> tuple[int, str, str]:
 
 
 def run_process(argv: list[str], timeout: float = 300) -> subprocess.CompletedProcess:
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}  # see _one_blas_thread
     return subprocess.run([sys.executable, "-m", "model", *argv], capture_output=True, text=True,
-                          timeout=timeout, check=False)
+                          timeout=timeout, check=False, env=env)
 
 
 def assert_one_line_error(code, out, err):
