@@ -22,7 +22,7 @@ from model import (
     output_matrices,
 )
 from model.assembly import DRIVES, dof_names
-from model.dofs import AXES6
+from model.dofs import AXES6, DofMap
 from model.eigen import state_space
 from model.operating_point import creep_coefficients, creep_damping
 from model.outputs import static_load
@@ -359,3 +359,14 @@ def test_static_traction_torque_chain(calibrated):
                 assert steady[f"{drive}.{name}"] == pytest.approx(ratio * torque, rel=1e-9), name
             assert abs(steady[f"{drive}.gear_mesh.force"]) == pytest.approx(
                 torque / (r_pinion * np.cos(alpha)), rel=1e-9)
+
+
+def test_dof_map_lookup_errors():
+    with pytest.raises(ValueError, match="duplicate"):
+        DofMap(("a.x", "a.x"))
+    dofs = DofMap(("BF.x", "ID1.rim12.ry"))
+    with pytest.raises(KeyError, match=r"unknown DOF 'BF\.q'"):
+        dofs.index("BF.q")
+    assert dofs.unit("ID1.rim12.ry") == "rad"
+    assert dofs.part("ID1.rim12.ry") == "ID1.rim12"
+    assert dofs.subsystem("ID1.rim12.ry") == "ID1"

@@ -19,6 +19,7 @@ from model.contact import (
     creep_block,
     hertz_contact,
     kalker_coefficients,
+    kalker_creep_coefficients,
 )
 from model.dofs import AXES6, PAPER_RIM_ORDER
 
@@ -165,3 +166,20 @@ def test_creep_block_from_contact_point_kinematics():
     moment = b23 * P[1] - b33 * e_rz  # M_z = moment @ q̇
     generalized = P.T @ force + np.outer(e_rz, moment)
     assert np.allclose(creep_block(b11, b22, b23, b33, r0), -generalized, rtol=1e-14, atol=1e-9)
+
+
+def test_kalker_creep_coefficients_scale_with_the_contact_size():
+    """f11 = G c² C11, f22 = G c² C22, f23 = G c³ C23, f33 = G c⁴ C33 with c = √(ab) (spec §2.2)."""
+    N, r_wheel, r_rail, E, nu = 1e5, 0.625, 0.3, 2.1e11, 0.28
+    k = kalker_creep_coefficients(N, r_wheel, r_rail, E, nu)
+    contact = hertz_contact(N, r_wheel, r_rail, E, nu)
+    c = np.sqrt(contact.a * contact.b)
+    G = E / (2 * (1 + nu))
+    C11, C22, C23, C33 = kalker_coefficients(contact.a / contact.b)
+    assert k.f11 == pytest.approx(G * c**2 * C11, rel=1e-12)
+    assert k.f22 == pytest.approx(G * c**2 * C22, rel=1e-12)
+    assert k.f23 == pytest.approx(G * c**3 * C23, rel=1e-12)
+    assert k.f33 == pytest.approx(G * c**4 * C33, rel=1e-12)
+    # c ∝ N^(1/3): f22 ∝ N^(2/3) at a fixed ellipse shape
+    k8 = kalker_creep_coefficients(8 * N, r_wheel, r_rail, E, nu)
+    assert k8.f22 / k.f22 == pytest.approx(4.0, rel=1e-10)
