@@ -53,6 +53,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.fft
 import scipy.linalg as sla
 from scipy.linalg.lapack import zgecon
 
@@ -280,16 +281,17 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
         valid = max(2, int(t_cut / dt))
     block = max(16, int(math.sqrt(valid)))
     E_block, E_outer = _grid_exponentials(lam_k, valid, dt, block)
-    # y_h[a·block + b] = Re Σ_j E_block[b, j] E_outer[a, j] coef[:, j]
-    stacked = (E_outer[:, :, None] * coef_k.T[None, :, :])  # n_blocks x m x p
-    stacked = stacked.transpose(1, 0, 2).reshape(len(lam_k), -1)
-    Yh = (E_block @ stacked).real  # block x (n_blocks·p)
+    # y_h[:, a·block + b] = Re Σ_j coef[:, j] E_outer[a, j] E_block[b, j]: one real GEMM pair
     p = C.shape[0]
-    Yh = Yh.reshape(block, -1, p).transpose(1, 0, 2).reshape(-1, p)[:valid]
+    G = (coef_k[:, None, :] * E_outer[None, :, :]).reshape(p * E_outer.shape[0], -1)
+    Yh = G.real @ np.ascontiguousarray(E_block.real.T)
+    Yh -= G.imag @ np.ascontiguousarray(E_block.imag.T)
+    Yh = Yh.reshape(p, -1)[:, :valid]  # p x valid
     t = np.arange(valid) * dt
-    y = Yh + const_h.real
-    y += (C @ alpha)[None, :] + np.outer(t, C @ beta)
-    y += (np.exp(mu * t)[:, None] * (C @ x_mu)[None, :]).real
+    Yh += (const_h.real + C @ alpha)[:, None]
+    Yh += np.outer(C @ beta, t)
+    Yh += ((C @ x_mu)[:, None] * np.exp(mu * t)[None, :]).real
+    y = Yh.T  # valid x p (a view: each output's column is contiguous)
     # rounding-error estimate: size of the cancelling terms × eigenvector condition
     terms = (np.abs(coef_k) @ np.exp(np.outer(lam_k.real, [0.0, t[-1]]))).max(axis=1)
     terms = terms + np.abs(C @ alpha) + np.abs(C @ beta) * t[-1] + np.abs(C @ x_mu) \
@@ -433,9 +435,9 @@ def dominant_frequencies(y: np.ndarray, fs: float, count: int = 4,
 
     The mean is removed and only the second half is tapered (half cosine): the response starts
     from rest, and a full window would hide the early, decaying content (the 90 Hz excitation).
-    Zero padding to ≥ 2× the length (power of 2) and a parabolic fit of the log amplitude at
-    each peak; peaks below ``relative`` × the strongest are dropped.  A 1-D ``y`` gives a list
-    with one tuple.
+    No zero padding (resolution fs/N = 1/T); a parabolic fit of the log amplitude locates each
+    peak between the bins; peaks below ``relative`` × the strongest are dropped.  A 1-D ``y``
+    gives a list with one tuple.
     """
     y = np.asarray(y, dtype=float)
     if y.ndim == 1:
@@ -447,8 +449,8 @@ def dominant_frequencies(y: np.ndarray, fs: float, count: int = 4,
     taper = np.ones(N)
     m = max(2, N // 2)
     taper[N - m:] = 0.5 * (1 + np.cos(np.pi * np.arange(1, m + 1) / m))
-    n_fft = 1 << math.ceil(math.log2(2 * N))
-    spectrum = np.abs(np.fft.rfft(y * taper[:, None], n=n_fft, axis=0))
+    n_fft = scipy.fft.next_fast_len(N, real=True)
+    spectrum = np.abs(scipy.fft.rfft(y * taper[:, None], n=n_fft, axis=0))
     df = fs / n_fft
     result = []
     for s in spectrum.T:
@@ -535,14 +537,15 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
     y, used, estimate = solve_linear(system, C, u0, a, mu, n_points, dt, method, info)
     valid = y.shape[0]
     t = np.arange(valid) * dt
-    totals = {name: y[:, j] + steady[name] for j, name in enumerate(names)}
+    yT = np.ascontiguousarray(y.T)  # p x valid
+    totals = {name: yT[j] + steady[name] for j, name in enumerate(names)}
     peaks, peak_times, pert_peaks, pert_times = {}, {}, {}, {}
     freqs = dict(zip(names, dominant_frequencies(y, fs), strict=True))
     for j, name in enumerate(names):
         k = int(np.argmax(np.abs(totals[name])))
         peaks[name], peak_times[name] = float(totals[name][k]), float(t[k])
-        kp = int(np.argmax(np.abs(y[:, j])))
-        pert_peaks[name], pert_times[name] = float(y[kp, j]), float(t[kp])
+        kp = int(np.argmax(np.abs(yT[j])))
+        pert_peaks[name], pert_times[name] = float(yT[j, kp]), float(t[kp])
     M_ad = adhesion_moment(model.parameters, op.v, op.N0)
     _, mu_max = creep_law(model.parameters, op.N0).maximum(op.v)
     limits = {"M_ad": M_ad, "M_ad/p": M_ad / model.parameters["gear_ratio"],

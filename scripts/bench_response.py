@@ -1,0 +1,144 @@
+"""Benchmark of the short-circuit response: closed form vs scipy.signal.lsim vs solve_ivp (Radau).
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/bench_response.py [--t-end 2] [--fs 10000]
+
+One run, one system (calibrated set, s0 = 0.005, 120 km/h; all 20 outputs), default excitation.
+Accuracy of every method against an exact reference: the exported system (M, B, K, f_mc, C_q,
+C_v) with the state augmented by the generator of M_C, stepped sample by sample with
+Φ = expm(F/fs); the figure is max over outputs of max|y − y_ref| / max|y_ref|.
+
+* closed form, cold: a fresh operating point (eigendecomposition included) + all the
+  post-processing of :func:`short_circuit_response` (peaks, spectra, limit checks);
+* closed form, warm: the same call with the per-operating-point decomposition cached (changing
+  the excitation, the horizon or the sampling, as the dashboard does);
+* closed form, solve only: the warm time history alone (:func:`model.response.solve_linear`);
+* lsim: ``scipy.signal.lsim`` on the same state space and the sampled M_C (first-order hold);
+* Radau: ``solve_ivp(method="Radau", rtol=1e-8)`` with the exact Jacobian, t_eval on the grid.
+
+Times are the best of several repeats (lsim and Radau: one run), wall clock, on this machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import time
+
+import numpy as np
+import scipy
+import scipy.linalg as sla
+import scipy.signal
+from scipy.integrate import solve_ivp
+
+from model import build_model, default_operating_point, load_parameters
+from model.outputs import output_matrices
+from model.response import ShortCircuit, _response_system, short_circuit_response, solve_linear
+
+
+def exact_reference(A, b, C, u0, M0, w, sigma, shift, steps, dt):
+    n2 = A.shape[0]
+    F = np.zeros((n2 + 3, n2 + 3))
+    F[:n2, :n2] = A
+    F[:n2, n2] = u0 * b
+    F[:n2, n2 + 1] = -M0 * b
+    F[n2 + 1:, n2 + 1:] = [[-sigma, w], [-w, -sigma]]
+    z = np.zeros(n2 + 3)
+    z[n2:] = [1.0, np.sin(-w * shift), np.cos(-w * shift)]
+    Phi = sla.expm(F * dt)
+    Z = np.empty((steps, n2 + 3))
+    for k in range(steps):
+        Z[k] = z
+        z = Phi @ z
+    return Z[:, :n2] @ C.T
+
+
+def error(y, reference) -> float:
+    return float(np.max(np.abs(y - reference).max(axis=0) / np.abs(reference).max(axis=0)))
+
+
+def best_of(function, repeats):
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        value = function()
+        times.append(time.perf_counter() - start)
+    return min(times), value
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--t-end", type=float, default=2.0)
+    parser.add_argument("--fs", type=float, default=10_000.0)
+    parser.add_argument("--skip-radau", action="store_true")
+    args = parser.parse_args()
+    parameters = load_parameters()
+    model = build_model(parameters)
+    op = default_operating_point(parameters, 0.005, 120.0)
+    excitation = ShortCircuit()
+    steps = round(args.t_end * args.fs) + 1
+    dt = 1.0 / args.fs
+    t = np.arange(steps) * dt
+
+    def cold():
+        model.__dict__.pop("_response_systems", None)
+        return short_circuit_response(model, op, excitation, args.t_end, args.fs)
+
+    t_cold, result = best_of(cold, 3)
+    t_warm, result = best_of(
+        lambda: short_circuit_response(model, op, excitation, args.t_end, args.fs), 5)
+    system = _response_system(model, op)
+    outputs = output_matrices(model, op)
+    C = np.hstack([outputs.C_q, outputs.C_v])
+    u0, a, mu = excitation.terms(result.motor_torque)
+    t_solve, (y_solve, method, estimate) = best_of(
+        lambda: solve_linear(system, C, u0, a, mu, steps, dt), 5)
+    y_ours = np.column_stack([result.perturbation(name) for name in outputs.names])
+
+    A, b = system.A, system.b
+    start = time.perf_counter()
+    reference = exact_reference(A, b, C, u0, excitation.M0, excitation.omega,
+                                excitation.D * excitation.omega, result.phase_shift, steps, dt)
+    t_reference = time.perf_counter() - start
+
+    u = result.M_C
+    start = time.perf_counter()
+    _, y_lsim, _ = scipy.signal.lsim((A, b[:, None], C, np.zeros((C.shape[0], 1))), u, t)
+    t_lsim = time.perf_counter() - start
+
+    rows = {
+        "closed form, cold (eig + all post-processing)": (t_cold, error(y_ours, reference)),
+        "closed form, warm (cached decomposition, all post-processing)":
+            (t_warm, error(y_ours, reference)),
+        "closed form, solve only (warm)": (t_solve, error(y_solve, reference)),
+        "scipy.signal.lsim": (t_lsim, error(y_lsim, reference)),
+    }
+    if not args.skip_radau:
+        x_scale = np.abs(np.linalg.lstsq(A, -b * u0, rcond=None)[0]).max()
+        start = time.perf_counter()
+        sol = solve_ivp(lambda tt, x: A @ x + b * (u0 + (a * np.exp(mu * tt)).real),
+                        (0.0, t[-1]), np.zeros(len(b)), method="Radau", t_eval=t, rtol=1e-8,
+                        atol=1e-8 * 1e-3 * x_scale, jac=A)
+        t_radau = time.perf_counter() - start
+        rows["scipy.integrate.solve_ivp Radau rtol 1e-8"] = (t_radau, error((C @ sol.y).T,
+                                                                            reference))
+    print(f"system: {model.n} DOF, state {2 * model.n}, {len(outputs.names)} outputs, "
+          f"{steps} points ({args.t_end:g} s at {args.fs:g} Hz); method {method}, "
+          f"error estimate {estimate:.1e}; reference (exact stepping) took {t_reference:.2f} s")
+    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+          f"load average {os.getloadavg()[0]:.2f}; numpy {np.__version__}, scipy "
+          f"{scipy.__version__}; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}")
+    print()
+    print("| method | time [ms] | speed-up vs lsim | speed-up vs Radau | max error / peak |")
+    print("|---|---:|---:|---:|---:|")
+    radau = rows.get("scipy.integrate.solve_ivp Radau rtol 1e-8", (np.nan,))[0]
+    for name, (seconds, err) in rows.items():
+        print(f"| {name} | {1e3 * seconds:.1f} | {t_lsim / seconds:.1f} | "
+              f"{radau / seconds:.1f} | {err:.1e} |")
+    print()
+    print(json.dumps({name: {"seconds": s, "error": e} for name, (s, e) in rows.items()}))
+
+
+if __name__ == "__main__":
+    main()
