@@ -20,11 +20,12 @@ DOF layout (193 coordinates; the study had 189 without stating its breakdown):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from itertools import pairwise
 
 import numpy as np
 
 from .beam import TubeSection, beam_global_matrices
-from .bodies import Body, carried_body, free_body, ground, rigid_mass_matrix
+from .bodies import Body, carried_body, free_body, rigid_mass_matrix
 from .connections import Spring, SpringDamper, axis_springs
 from .dofs import AXES6, DofMap
 from .parameters import Parameters
@@ -178,11 +179,11 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
     axle_y = {11: -j, 12: -c, 10: y_claw, 13: 0.0, 16: y_gear, 14: c, 15: j}
     ax = {k: free_body(f"{prefix}.ax{k}", pos(axle_x, y, 0.0), dofs) for k, y in axle_y.items()}
     hollow = TubeSection(p["hollow_shaft_outer_radius"], p["hollow_shaft_inner_radius"])
-    for k1, k2 in zip(HOLLOW_SHAFT_NODES[:-1], HOLLOW_SHAFT_NODES[1:], strict=True):
+    for k1, k2 in pairwise(HOLLOW_SHAFT_NODES):
         asm.add_beam(f"{prefix}.hollow_shaft", f"{prefix}.hollow_shaft", hs[k1], hs[k2], hollow, p)
     axle_order = sorted(axle_y, key=axle_y.get)
     solid = TubeSection(p["axle_radius"])
-    for k1, k2 in zip(axle_order[:-1], axle_order[1:], strict=True):
+    for k1, k2 in pairwise(axle_order):
         asm.add_beam(f"{prefix}.axle", f"{prefix}.wheelset", ax[k1], ax[k2], solid, p)
     for k in RIM_NODES:  # wheel discs
         Jd = p["wheel_disc_diametral_inertia"]

@@ -37,11 +37,11 @@ def beam_local_matrices(length: float, section: TubeSection, young: float, poiss
     """Local 12 x 12 stiffness [N/m, N, N m] and consistent mass [kg, kg m, kg m^2] matrices."""
     L = length
     E, G = young, young / (2 * (1 + poisson))
-    A, I, J = section.area, section.second_moment, section.polar_moment
+    A, Iyz, J = section.area, section.second_moment, section.polar_moment
     K = np.zeros((12, 12))
     K[np.ix_([0, 6], [0, 6])] = E * A / L * np.array([[1, -1], [-1, 1]])
     K[np.ix_([3, 9], [3, 9])] = G * J / L * np.array([[1, -1], [-1, 1]])
-    bend = E * I / L**3 * np.array([[12, 6 * L, -12, 6 * L], [6 * L, 4 * L * L, -6 * L, 2 * L * L],
+    bend = E * Iyz / L**3 * np.array([[12, 6 * L, -12, 6 * L], [6 * L, 4 * L * L, -6 * L, 2 * L * L],
                                     [-12, -6 * L, 12, -6 * L], [6 * L, 2 * L * L, -6 * L, 4 * L * L]])
     flip = np.diag([1, -1, 1, -1])  # the x-z plane: w with θy = −dw/dx
     K[np.ix_([1, 5, 7, 11], [1, 5, 7, 11])] = bend

@@ -47,17 +47,30 @@ def number(label: str, low: float = -math.inf, high: float = math.inf, low_open:
     return parse
 
 
+def positive_int(label: str) -> Callable[[str], int]:
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{label} must be a whole number, got '{text}'") from None
+        if value < 1:
+            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: must be >= 1")
+        return value
+
+    return parse
+
+
 def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.005) -> None:
     parser.add_argument("--s0", type=number("--s0 (creepage)", 0, 1, allowed="must be in (0, 1)"),
                         default=s0, help="longitudinal creepage s0 [-] (default %(default)s)")
-    parser.add_argument("--v", type=number("--v (speed, km/h)", 0, 1000,
-                                           allowed="must be in (0, 1000) km/h"),
+    parser.add_argument("--v", type=number("--v (speed, km/h)", 1, 500, False, False,
+                                           allowed="must be in [1, 500] km/h"),
                         default=120.0, help="speed [km/h] (default %(default)s)")
-    parser.add_argument("--n0", type=number("--n0 (wheel force, N)", 0, 1e7,
-                                            allowed="must be in (0, 1e7) N"),
+    parser.add_argument("--n0", type=number("--n0 (wheel force, N)", 1e3, 1e6, False, False,
+                                            allowed="must be in [1e3, 1e6] N"),
                         default=None, help="static wheel force N0 [N] (default: parameter set)")
-    parser.add_argument("--bm", type=number("--bm (motor slope, N m s/rad)", 0, 1e9, low_open=False,
-                                            allowed="must be in [0, 1e9) N m s/rad"),
+    parser.add_argument("--bm", type=number("--bm (motor slope, N m s/rad)", 0, 1e9, False, False,
+                                            allowed="must be in [0, 1e9] N m s/rad"),
                         default=None, help="motor slope b_M [N m s/rad] (default: parameter set)")
     parser.add_argument("--params", default=None, metavar="FILE",
                         help="parameter file (TOML; default: the calibrated set)")
@@ -152,7 +165,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("eigen", help="eigenvalues and stability at an operating point")
     add_operating_point(p)
-    p.add_argument("--count", type=int, default=10, help="complex pairs / real values to list")
+    p.add_argument("--count", type=positive_int("--count"), default=10,
+                   help="complex pairs / real values to list (default %(default)s)")
     p.set_defaults(func=cmd_eigen)
 
     p = sub.add_parser("limit", help="stability limit s0*(v) at a speed")
@@ -186,12 +200,15 @@ EXTRA_COMMANDS.append(_register_response)
 
 
 def main(argv: list[str] | None = None) -> int:
+    from threadpoolctl import threadpool_limits
+
     from .operating_point import OperatingPointError
 
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        args.func(args)
+        with threadpool_limits(1):  # dense 200-400 sized problems: one BLAS thread is fastest
+            args.func(args)
     except (UsageError, ParameterError, OperatingPointError, KeyError, ValueError) as error:
         message = error.args[0] if error.args else str(error)
         print(f"bogie {args.command}: error: {message}", file=sys.stderr)

@@ -16,21 +16,22 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
-# Kalker's creepage and spin coefficients C11, C22, C23, C33 for Poisson's ratio 0.25,
-# J. J. Kalker, "On the rolling contact of two elastic bodies in the presence of dry friction",
-# thesis, Delft 1967, Table; as reproduced in V. K. Garg, R. V. Dukkipati, "Dynamics of Railway
-# Vehicle Systems", Academic Press 1984, Table 5.1 (C33 included there).
-# Rows: (g, C11, C22, C23, C33) with g = a/b for a <= b (first half) and b/a for a >= b (second);
-# we store them against the ratio a/b (a: longitudinal, b: lateral semi-axis).
+# Kalker's creepage and spin coefficients for Poisson's ratio 0.25: J. J. Kalker, "On the
+# rolling contact of two elastic bodies in the presence of dry friction", thesis, Delft 1967,
+# as tabulated in V. K. Garg, R. V. Dukkipati, "Dynamics of Railway Vehicle Systems", Academic
+# Press 1984, Table 5.1.  Columns C11, C22, C23 are the ν = 0.25 values.  The C33 column holds the
+# ν = 0 values of the same table (C33 depends only weakly on ν, a few per cent); its ν = 0.25
+# column could not be checked against the primary source from this workplace.
+# Rows: (g, C11, C22, C23, C33); g = a/b for a <= b (first block), b/a for a >= b (second).
 _KALKER_A_OVER_B_SMALL = np.array([  # a/b = g <= 1
-    (0.1, 2.51, 2.31, 0.334, 6.42), (0.2, 2.59, 2.41, 0.483, 3.46), (0.3, 2.68, 2.52, 0.607, 2.49),
-    (0.4, 2.78, 2.63, 0.720, 2.02), (0.5, 2.88, 2.75, 0.827, 1.74), (0.6, 2.98, 2.87, 0.930, 1.56),
-    (0.7, 3.09, 2.98, 1.03, 1.43), (0.8, 3.19, 3.11, 1.13, 1.34), (0.9, 3.29, 3.24, 1.23, 1.27),
-    (1.0, 3.40, 3.37, 1.33, 1.21)])
+    (0.1, 3.31, 2.52, 0.473, 6.42), (0.2, 3.37, 2.63, 0.603, 3.46), (0.3, 3.44, 2.75, 0.715, 2.49),
+    (0.4, 3.53, 2.88, 0.823, 2.02), (0.5, 3.62, 3.01, 0.929, 1.74), (0.6, 3.72, 3.14, 1.03, 1.56),
+    (0.7, 3.81, 3.28, 1.14, 1.43), (0.8, 3.91, 3.41, 1.25, 1.34), (0.9, 4.01, 3.54, 1.36, 1.27),
+    (1.0, 4.12, 3.67, 1.47, 1.21)])
 _KALKER_B_OVER_A_SMALL = np.array([  # b/a = g <= 1 (a/b = 1/g >= 1)
-    (0.9, 3.51, 3.50, 1.44, 1.16), (0.8, 3.65, 3.67, 1.58, 1.10), (0.7, 3.82, 3.89, 1.76, 1.05),
-    (0.6, 4.06, 4.18, 2.01, 1.01), (0.5, 4.37, 4.57, 2.35, 0.958), (0.4, 4.84, 5.20, 2.88, 0.912),
-    (0.3, 5.57, 6.34, 3.79, 0.868), (0.2, 6.96, 8.73, 5.72, 0.828), (0.1, 10.7, 17.0, 12.2, 0.795)])
+    (0.9, 4.22, 3.81, 1.59, 1.16), (0.8, 4.36, 3.99, 1.75, 1.10), (0.7, 4.54, 4.21, 1.95, 1.05),
+    (0.6, 4.78, 4.50, 2.23, 1.01), (0.5, 5.10, 4.90, 2.62, 0.958), (0.4, 5.57, 5.48, 3.24, 0.912),
+    (0.3, 6.34, 6.40, 4.32, 0.868), (0.2, 7.78, 8.14, 6.63, 0.828), (0.1, 11.7, 12.8, 14.6, 0.795)])
 
 
 def kalker_coefficients(a_over_b: float) -> tuple[float, float, float, float]:
@@ -65,7 +66,9 @@ def hertz_contact(normal_force: float, wheel_radius: float, rail_head_radius: fl
         K, E = ellipk(e2), ellipe(e2)
         return ((E / (1 - e2) - K) / (K - E)) - large / small
 
-    e2 = 0.0 if large == small else brentq(ratio_error, 1e-12, 1 - 1e-12)
+    ratio = large / small
+    # nearly equal curvatures: circular contact (the ellipse equation has a spurious root at e² → 0)
+    e2 = 0.0 if ratio - 1 < 1e-6 else brentq(ratio_error, 0.1 * min(ratio - 1, 1), 1 - 1e-12)
     if e2 == 0.0:
         major = (3 * normal_force / (4 * e_star * 2 * small)) ** (1 / 3)
         minor = major
@@ -162,7 +165,7 @@ def creep_block(b11: float, b22: float, b23: float, b33: float, r0: float) -> np
 
     b11 [N s/m] = N0 μ'(s0)/v, b22 [N s/m] = f22/v, b23 [N s] = f23/v, b33 [N s m] = f33/v.
     """
-    X, Y, Z, RX, RY, RZ = range(6)
+    X, Y, _, RX, RY, RZ = range(6)  # the vertical z has no creep term
     B = np.zeros((6, 6))
     # longitudinal: slip velocity r0 ω_y − ẋ,  F_x = b11 (r0 ṙy − ẋ), M_y = −r0 F_x
     B[X, X], B[X, RY], B[RY, X], B[RY, RY] = b11, -r0 * b11, -r0 * b11, r0 * r0 * b11

@@ -37,7 +37,6 @@ class StateSpace:
     @cached_property
     def deflation(self) -> tuple[np.ndarray, np.ndarray]:
         """Orthonormal bases (Q1 of the rigid-body subspace [r; 0], Q2 of its complement)."""
-        n = self.model.n
         rigid = np.vstack([self.model.rigid_body_modes, np.zeros_like(self.model.rigid_body_modes)])
         Q, _ = np.linalg.qr(rigid, mode="complete")
         r = rigid.shape[1]

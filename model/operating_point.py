@@ -15,6 +15,7 @@ from .contact import KalkerCoefficients, PolachLaw, creep_block, kalker_creep_co
 from .parameters import Parameters
 
 KMH = 1 / 3.6  # m/s per km/h
+V_MIN, V_MAX = 1 * KMH, 500 * KMH  # speed range of the linearized model [m/s]
 
 
 class OperatingPointError(ValueError):
@@ -31,15 +32,17 @@ class OperatingPoint:
     b_M: float  # falling slope of the healthy motor's characteristic [N m s/rad]
 
     def __post_init__(self) -> None:
-        checks = (("creepage s0", self.s0, 0.0, 1.0, "between 0 and 1 (exclusive)"),
-                  ("speed v", self.v, 0.0, math.inf, "positive"),
-                  ("wheel force N0", self.N0, 0.0, math.inf, "positive"),
-                  ("motor slope b_M", self.b_M, -1e-300, math.inf, "zero or positive"))
-        for label, value, low, high, allowed in checks:
+        # the linearization (creep damping ∝ 1/v, Hertz contact ∝ N0) needs v and N0 well above 0
+        checks = (("creepage s0", self.s0, 0.0, 1.0, False, "between 0 and 1 (exclusive)"),
+                  ("speed v", self.v, V_MIN, V_MAX, True, "1 to 500 km/h"),
+                  ("wheel force N0", self.N0, 1e3, 1e6, True, "1e3 to 1e6 N"),
+                  ("motor slope b_M", self.b_M, 0.0, 1e9, True, "0 to 1e9 N m s/rad"))
+        for label, value, low, high, closed, allowed in checks:
             if isinstance(value, bool) or not isinstance(value, int | float):
                 raise OperatingPointError(f"{label} must be a number, got {value!r}")
-            if not math.isfinite(value) or not low < value < high:
-                raise OperatingPointError(f"{label} = {value} is not allowed: must be {allowed}")
+            inside = low <= value <= high if closed else low < value < high
+            if not math.isfinite(value) or not inside:
+                raise OperatingPointError(f"{label} = {value:g} is not allowed: must be {allowed}")
 
     @property
     def v_kmh(self) -> float:

@@ -73,8 +73,8 @@ def test_kalker_coefficients_bounds_and_trends():
     """Bounds a/b ∈ [0.1, 10] (table g = 0.1 for both a/b and b/a); outside: ValueError.
     C11, C22, C23 grow with a/b and C33 falls (Kalker's table): a guard against a row
     stored against the wrong ratio (b/a instead of a/b)."""
-    assert kalker_coefficients(0.1)[0] == pytest.approx(2.51)
-    assert kalker_coefficients(10.0)[0] == pytest.approx(10.7)
+    assert kalker_coefficients(0.1)[0] == pytest.approx(3.31)  # Kalker, ν = 0.25
+    assert kalker_coefficients(10.0)[0] == pytest.approx(11.7)
     for bad in (0.0999, 10.01, 0.0, -1.0):
         with pytest.raises(ValueError, match="outside"):
             kalker_coefficients(bad)

@@ -1,0 +1,200 @@
+"""Root locus over creepage s0 or speed v, with branches tracked by eigenvector similarity (MAC).
+
+Method — a reduced model whose error is estimated at every point and bounded by dense checks:
+
+1. Along a sweep only ``B_ad`` changes, a combination of four fixed patterns,
+   ``B_ad = b11 P11 + b22 P22 + b23 P23 + b33 P33`` (:func:`creep_patterns`).
+2. The displacement space is reduced to ``Φ`` = orthonormal basis of the rigid-body modes and the
+   real and imaginary parts of the exact eigenvectors (displacement part) of all eigenvalues with
+   |λ| < 2π f_max at the first and the last point of the sweep.  The second-order structure is
+   kept: ``Φᵀ M Φ``, ``Φᵀ K Φ``, ``Φᵀ (B + b_M B_M) Φ`` and ``Φᵀ P_k Φ`` are formed once, so a point
+   costs one small eigenproblem (Galerkin projection of eq. 20).
+3. At every point each tracked Ritz pair's residual in the *full* model,
+   ``r = (λ² M + λ B_total + K) Φ x``, gives an error estimate
+   ``|δλ| ≈ ‖r‖ / ‖(2λ M + B_total) Φ x‖``; where it exceeds ``rtol·|λ|`` the point is solved densely
+   (exact there) and the basis is enriched with the tracked eigenvectors of that point.
+4. Branches are continued from point to point by an optimal assignment on ``1 − MAC`` plus the
+   normalized eigenvalue distance, so branches do not swap at near-crossings.
+
+The naive reference (:func:`dense_generalized_eigenvalues`) solves the generalized eigenproblem
+(21)–(22) densely at a point; ``scripts/bench_locus.py`` compares both.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import linear_sum_assignment
+
+from .assembly import BogieModel
+from .contact import creep_block
+from .eigen import eigen_analysis
+from .operating_point import OperatingPoint, creep_coefficients, damping_matrix
+
+
+@dataclass(frozen=True)
+class RootLocus:
+    """Tracked eigenvalues along a parameter sweep."""
+
+    parameter: str  # "s0" [-] or "v" [m/s]
+    values: np.ndarray  # (n_points,) parameter values, SI
+    eigenvalues: np.ndarray  # (n_points, n_branches) complex [1/s]; column = one tracked branch
+    error_estimate: np.ndarray  # (n_points, n_branches) estimated relative error (0: exact)
+    dense_points: np.ndarray  # (n_points,) bool: solved densely (exact) at that point
+    operating_point: OperatingPoint  # the fixed quantities of the sweep
+    basis_size: int  # columns of the reduction basis Φ at the end
+
+    @property
+    def max_real_part(self) -> np.ndarray:
+        """Largest real part of the tracked branches at each point [1/s]."""
+        return self.eigenvalues.real.max(axis=1)
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Tracked branches all in the closed left half-plane, per point."""
+        return self.max_real_part <= 0.0
+
+    @property
+    def upper_branches(self) -> np.ndarray:
+        """Indices of branches with Im ≥ 0 at the first point (one of each conjugate pair)."""
+        return np.flatnonzero(self.eigenvalues[0].imag >= 0)
+
+
+def creep_patterns(model: BogieModel) -> list[np.ndarray]:
+    """The four n x n patterns P11, P22, P23, P33 of B_ad (coefficient 1 each)."""
+    r0 = model.parameters["wheel_radius"]
+    patterns = []
+    for unit in np.eye(4):
+        block = creep_block(*unit, r0=r0)
+        P = np.zeros((model.n, model.n))
+        for index in model.rims.values():
+            P[np.ix_(index, index)] += block
+        patterns.append(P)
+    return patterns
+
+
+def _coefficients(model: BogieModel, op: OperatingPoint) -> np.ndarray:
+    cc = creep_coefficients(model.parameters, op)
+    return np.array([cc.b11, cc.b22, cc.b23, cc.b33])
+
+
+class _Reduced:
+    """Projected matrices of the sweep on a basis Φ."""
+
+    def __init__(self, model: BogieModel, op: OperatingPoint, patterns, vectors: list[np.ndarray]):
+        U, s, _ = np.linalg.svd(np.hstack(vectors), full_matrices=False)
+        Phi = U[:, s > 1e-12 * s[0]]
+        self.Phi = Phi
+        self.M_Phi = model.M @ Phi
+        self.K_Phi = model.K @ Phi
+        self.C0_Phi = (model.B + op.b_M * model.motor_pattern) @ Phi
+        self.P_Phi = [P @ Phi for P in patterns]
+        # mass-normalize the reduced coordinates: Φᵀ M Φ = L Lᵀ
+        L = np.linalg.cholesky(Phi.T @ self.M_Phi)
+        self.Linv = sla.solve_triangular(L, np.eye(len(L)), lower=True)
+        project = lambda X: self.Linv @ (Phi.T @ X) @ self.Linv.T  # noqa: E731
+        self.K_r = project(self.K_Phi)
+        self.C0_r = project(self.C0_Phi)
+        self.P_r = [project(P) for P in self.P_Phi]
+
+    @property
+    def size(self) -> int:
+        return self.Phi.shape[1]
+
+    def solve(self, c: np.ndarray):
+        """Ritz values and displacement vectors (in Φ coordinates, unit norm) at coefficients c."""
+        r = self.size
+        C = self.C0_r + sum(ck * Pk for ck, Pk in zip(c, self.P_r, strict=True))
+        A = np.zeros((2 * r, 2 * r))
+        A[:r, r:] = np.eye(r)
+        A[r:, :r] = -self.K_r
+        A[r:, r:] = -C
+        lam, V = sla.eig(A, overwrite_a=True, check_finite=False)
+        X = self.Linv.T @ V[:r]  # back from mass-normalized to Φ coordinates
+        X /= np.linalg.norm(X, axis=0)
+        return lam, X
+
+    def error_estimate(self, c: np.ndarray, lam: np.ndarray, X: np.ndarray) -> np.ndarray:
+        """First-order relative eigenvalue error from the full-model residual."""
+        CX = self.C0_Phi @ X + sum(ck * (P @ X) for ck, P in zip(c, self.P_Phi, strict=True))
+        MX = self.M_Phi @ X
+        residual = lam**2 * MX + lam * CX + self.K_Phi @ X
+        derivative = 2 * lam * MX + CX
+        return (np.linalg.norm(residual, axis=0) / np.linalg.norm(derivative, axis=0)
+                / np.maximum(np.abs(lam), 1e-300))
+
+
+def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
+               max_frequency_hz: float = 20.0, rtol: float = 1e-6) -> RootLocus:
+    """Track the non-rigid eigenvalues with |λ| < 2π·max_frequency_hz (at the first value) while
+    ``parameter`` ("s0" [-] or "v" [m/s]) runs through ``values``; the other quantities of the
+    operating point ``op`` stay fixed."""
+    if parameter not in ("s0", "v"):
+        raise ValueError(f"parameter must be 's0' or 'v', got '{parameter}'")
+    values = np.asarray(values, dtype=float)
+    if values.ndim != 1 or len(values) < 2 or not np.all(np.isfinite(values)):
+        raise ValueError("need at least two finite parameter values")
+    points = [replace(op, **{parameter: float(x)}) for x in values]  # validates each point
+    coefficients = np.array([_coefficients(model, p) for p in points])
+    patterns = creep_patterns(model)
+    radius = 2 * np.pi * max_frequency_hz
+    n, n_points = model.n, len(values)
+
+    def exact(i: int):
+        result = eigen_analysis(model, points[i])
+        q = result.vectors[:n]
+        return result.eigenvalues, q / np.linalg.norm(q, axis=0)
+
+    def modes(lam, Q, factor=2.5):
+        chosen = Q[:, np.abs(lam) < factor * radius]
+        return [chosen.real, chosen.imag]
+
+    first, last = exact(0), exact(n_points - 1)
+    basis = [model.rigid_body_modes, *modes(*first), *modes(*last)]
+    reduced = _Reduced(model, op, patterns, basis)
+    tracked = np.flatnonzero(np.abs(first[0]) < radius)
+    eigenvalues = np.zeros((n_points, len(tracked)), dtype=complex)
+    errors = np.zeros((n_points, len(tracked)))
+    dense = np.zeros(n_points, dtype=bool)
+    eigenvalues[0], dense[0] = first[0][tracked], True
+    previous_values, previous_vectors = first[0][tracked], first[1][:, tracked]
+
+    for i in range(1, n_points):
+        lam, X = reduced.solve(coefficients[i])
+        X_full = reduced.Phi @ X
+        chosen, ok = _assign(previous_vectors, previous_values, X_full, lam)
+        estimate = reduced.error_estimate(coefficients[i], lam[chosen], X[:, chosen])
+        if ok and np.all(estimate <= rtol) and i != n_points - 1:
+            eigenvalues[i], errors[i] = lam[chosen], estimate
+            previous_values, previous_vectors = lam[chosen], X_full[:, chosen]
+            continue
+        lam, Q = last if i == n_points - 1 else exact(i)
+        chosen, _ = _assign(previous_vectors, previous_values, Q, lam)
+        if i != n_points - 1:  # enrich with every tracked branch's exact eigenvector here
+            basis += [Q[:, chosen].real, Q[:, chosen].imag]
+            reduced = _Reduced(model, op, patterns, basis)
+        eigenvalues[i], dense[i] = lam[chosen], True
+        previous_values, previous_vectors = lam[chosen], Q[:, chosen]
+    return RootLocus(parameter, values, eigenvalues, errors, dense, op, reduced.size)
+
+
+def _assign(previous_vectors, previous_values, vectors, values):
+    """Columns of ``vectors`` continuing each previous branch (MAC + eigenvalue distance)."""
+    mac = np.abs(previous_vectors.conj().T @ vectors) ** 2  # unit vectors: MAC in [0, 1]
+    scale = np.maximum(np.abs(previous_values), 1.0)[:, None]
+    distance = np.abs(previous_values[:, None] - values[None, :]) / scale
+    rows, columns = linear_sum_assignment((1 - mac) + distance)
+    chosen = np.empty(len(previous_values), dtype=int)
+    chosen[rows] = columns
+    return chosen, bool(np.all(mac[rows, columns] > 0.5))
+
+
+def dense_generalized_eigenvalues(model: BogieModel, op: OperatingPoint) -> np.ndarray:
+    """All 2n eigenvalues of ``[λ N + P] u = 0`` (eqs. 21–22), dense QZ — the naive reference."""
+    n = model.n
+    Z = np.zeros((n, n))
+    N = np.block([[Z, model.M], [model.M, damping_matrix(model, op)]])
+    P = np.block([[-model.M, Z], [Z, model.K]])
+    return sla.eig(-P, N, right=False, check_finite=False)
