@@ -126,7 +126,10 @@ def test_dockerignore_keeps_the_venv_git_and_caches_out():
 def test_serve_origins_from_the_environment(monkeypatch):
     """app.serve.serve(): BOGIE_ALLOWED_ORIGINS (default localhost only), liveness on."""
     pn = pytest.importorskip("panel")
+    import app.serve
     from app.serve import serve
+
+    monkeypatch.setattr(app.serve, "limit_blas_threads", lambda: None, raising=False)
 
     calls, handlers = [], {}
     monkeypatch.setattr(pn, "serve", lambda *args, **kwargs: calls.append(kwargs))
