@@ -1,0 +1,298 @@
+"""What the dashboard computes, as plain data, cached across sessions.
+
+Every function here takes primitives only (so :func:`panel.cache` keys them by value, not by
+object identity) and returns read-only plain data: results are shared between sessions and
+never mutated.  The physics is in :mod:`model`; this module only calls it and reshapes the
+results for plotting.  Units: SI, except where a name says otherwise (``v_kmh`` [km/h],
+``N0_kN`` [kN], ``M0_kNm`` [kN m], ``dt_ms`` [ms], ``im_hz`` [Hz]).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import panel as pn
+
+from model import (
+    KMH,
+    NoStabilityLimit,
+    adhesion_moment,
+    build_model,
+    creep_law,
+    eigen_analysis,
+    load_parameters,
+    mode_character,
+)
+from model.contact import CREEP_PRESETS
+from model.operating_point import OperatingPoint
+
+RAIL_CONDITIONS = ("calibrated", "dry", "wet")  # "calibrated": the creep law of the parameter set
+N_COMPLEX_TABLE = 10  # complex pairs in the eigenvalue / mode tables (Table 1 and 2 layout)
+N_REAL_TABLE = 10  # real eigenvalues in the eigenvalue table
+LOCUS_MAX_HZ = 20.0  # branches tracked up to this frequency [Hz]
+LOCUS_POINTS = 12  # points of a root-locus sweep
+LOCUS_S0 = (0.001, 0.02)  # s0 range of the creepage sweep [-]
+LOCUS_V_KMH = (40.0, 200.0)  # speed range of the speed sweep [km/h]
+GROWTH_CUT = 4.0  # plotted histories end when a torque exceeds this multiple of M_ad
+PLOT_BUCKETS = 1500  # min/max decimation of time histories for the browser (CSV keeps all)
+
+TORQUES = ("driving_shaft.torque", "disc_clutch.torque")
+FORCES = ("disc_clutch.force_x", "disc_clutch.force_y", "disc_clutch.force_z")
+RESPONSE_OUTPUTS = tuple(f"{d}.{q}" for d in ("ID1", "ID2") for q in TORQUES + FORCES)
+
+
+class ModelRejected(ValueError):
+    """A parameter combination the model rejects (message shown to the user)."""
+
+
+# --- model -----------------------------------------------------------------------------------
+
+@pn.cache(max_items=4)
+def parameters(params_path: str, rail: str):
+    """The parameter set in use: the file (``""``: calibrated default) with the rail's creep
+    law (``"calibrated"`` keeps the file's, ``"dry"``/``"wet"``: Polach's presets)."""
+    p = load_parameters(params_path or None)
+    if rail == "calibrated":
+        return p
+    if rail not in CREEP_PRESETS:
+        raise ModelRejected(f"unknown rail condition '{rail}'; allowed: {', '.join(RAIL_CONDITIONS)}")
+    return p.replace(**CREEP_PRESETS[rail])
+
+
+@pn.cache(max_items=4)
+def model(params_path: str, rail: str):
+    """The assembled model (shared read-only between sessions)."""
+    return build_model(parameters(params_path, rail))
+
+
+def operating_point(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                    b_M: float) -> OperatingPoint:
+    return OperatingPoint.from_kmh(float(s0), float(v_kmh), float(N0_kN) * 1e3, float(b_M))
+
+
+# --- eigenvalues, modes, creep characteristic at the current point ---------------------------
+
+@dataclass(frozen=True)
+class Mode:
+    """One complex mode (upper eigenvalue of a pair)."""
+
+    number: int  # ν, by ascending frequency
+    eigenvalue: complex  # [1/s]
+    im_hz: float  # Im λ / 2π [Hz]
+    damping_ratio: float  # −Re λ / |λ| [-]
+    description: str  # generated from energy shares (model.modes)
+    displacement: dict[str, np.ndarray]  # drawn point -> real translation (x, y, z), unit max
+
+
+@dataclass(frozen=True)
+class PointResult:
+    """Eigen-analysis of one operating point, reshaped for the views."""
+
+    key: tuple  # (params_path, rail, s0, v_kmh, N0_kN, b_M)
+    eigenvalues: np.ndarray  # all non-rigid eigenvalues [1/s]
+    stable: bool
+    max_real_part: float  # [1/s]
+    flutter: int  # unstable complex pairs
+    divergence: int  # positive real eigenvalues
+    n_rigid: int  # identified rigid-body zero eigenvalues
+    modes: list[Mode]  # first N_COMPLEX_TABLE complex pairs
+    real: np.ndarray  # real eigenvalues, largest first (first N_REAL_TABLE) [1/s]
+    creep_s: np.ndarray  # creepage grid [-]
+    creep_mu: np.ndarray  # μ(s, v) on it [-]
+    mu0: float  # μ(s0, v) [-]
+    s_max: float  # creepage of the creep maximum [-]
+    mu_max: float  # μ_max(v) [-]
+    M_ad: float  # maximal adhesion moment 2 N0 r0 μ_max [N m]
+
+
+def drawing_owner(model_, point: str) -> tuple[str, bool]:
+    """(body whose coordinates move ``point``, whether the point has its own translations)."""
+    names = set(model_.dofs.names)
+    if f"{point}.x" in names:
+        return point, True
+    if point.startswith("secondary."):
+        return "BF", False
+    drive = point.split(".")[0]
+    return f"{drive}.stator", False
+
+
+def point_displacements(model_, q: np.ndarray) -> dict[str, np.ndarray]:
+    """Real translation (x, y, z) [m per unit mode amplitude] of every drawn point of
+    ``model.positions`` for the displacement vector Δq (rigid-body kinematics for points carried
+    by a body: u + θ × r)."""
+    index = {name: i for i, name in enumerate(model_.dofs.names)}
+    out: dict[str, np.ndarray] = {}
+    for point, position in model_.positions.items():
+        if point == "CB":
+            out[point] = np.array([0.0, 0.0, q[index["CB.z"]].real])
+            continue
+        owner, own = drawing_owner(model_, point)
+        u = np.array([q[index[f"{owner}.{a}"]].real for a in ("x", "y", "z")])
+        theta = np.array([q[index[f"{owner}.{a}"]].real for a in ("rx", "ry", "rz")])
+        if not own:
+            u = u + np.cross(theta, np.asarray(position) - model_.positions[owner])
+        out[point] = u
+    return out
+
+
+@pn.cache(max_items=256)
+def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                 b_M: float) -> PointResult:
+    """Eigenvalues, stability, mode descriptions and creep characteristic at one point."""
+    m = model(params_path, rail)
+    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
+    result = eigen_analysis(m, op)
+    modes = []
+    for number, i in enumerate(result.complex_index[:N_COMPLEX_TABLE], start=1):
+        character = mode_character(m, result, int(i))
+        lam = complex(result.eigenvalues[i])
+        modes.append(Mode(number, lam, lam.imag / (2 * math.pi), character.damping_ratio,
+                          character.description,
+                          point_displacements(m, result.mode_shape(int(i)))))
+    law = creep_law(m.parameters, op.N0)
+    s_max, mu_max = law.maximum(op.v)
+    s_grid = np.linspace(0.0, max(0.03, 1.5 * op.s0), 301)
+    return PointResult(
+        key=(params_path, rail, s0, v_kmh, N0_kN, b_M), eigenvalues=result.eigenvalues,
+        stable=result.stable, max_real_part=result.max_real_part, flutter=result.flutter,
+        divergence=result.divergence, n_rigid=result.n_rigid, modes=modes,
+        real=result.real[:N_REAL_TABLE], creep_s=s_grid, creep_mu=np.asarray(law.mu(s_grid, op.v)),
+        mu0=float(law.mu(op.s0, op.v)), s_max=s_max, mu_max=mu_max,
+        M_ad=adhesion_moment(m.parameters, op.v, op.N0))
+
+
+# --- stability limit ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class LimitResult:
+    s0_limit: float | None  # s0*(v) [-], None if there is none in the searched range
+    message: str  # why there is none ("" otherwise)
+
+
+@pn.cache(max_items=128)
+def limit_result(params_path: str, rail: str, v_kmh: float, N0_kN: float,
+                 b_M: float) -> LimitResult:
+    """The stability limit s0*(v) at the current speed (model.stability)."""
+    from model.stability import stability_limit
+
+    m = model(params_path, rail)
+    try:
+        limit = stability_limit(m, v_kmh * KMH, N0_kN * 1e3, b_M)
+    except NoStabilityLimit as error:
+        return LimitResult(None, str(error))
+    return LimitResult(limit.s0_limit, "")
+
+
+# --- root locus --------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class LocusResult:
+    parameter: str  # "s0" [-] or "v" (values in km/h here)
+    values: np.ndarray  # (n_points,) in display units ([-] or [km/h])
+    eigenvalues: np.ndarray  # (n_points, n_branches) upper branches [1/s]
+    stable: np.ndarray  # (n_points,) bool
+
+
+@pn.cache(max_items=64)
+def locus_result(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
+                 b_M: float) -> LocusResult:
+    """Tracked branches over s0 (at speed ``fixed`` [km/h]) or over v (at creepage ``fixed``)."""
+    from model.locus import root_locus
+
+    m = model(params_path, rail)
+    if parameter == "s0":
+        op = operating_point(params_path, rail, LOCUS_S0[0], fixed, N0_kN, b_M)
+        values = np.linspace(*LOCUS_S0, LOCUS_POINTS)
+        locus = root_locus(m, op, "s0", values, max_frequency_hz=LOCUS_MAX_HZ)
+        shown = values
+    elif parameter == "v":
+        op = operating_point(params_path, rail, fixed, LOCUS_V_KMH[0], N0_kN, b_M)
+        shown = np.linspace(*LOCUS_V_KMH, LOCUS_POINTS)
+        locus = root_locus(m, op, "v", shown * KMH, max_frequency_hz=LOCUS_MAX_HZ)
+    else:
+        raise ModelRejected(f"root locus parameter must be 's0' or 'v', got '{parameter}'")
+    upper = np.flatnonzero(locus.eigenvalues[0].imag >= 0)
+    return LocusResult(parameter, shown, locus.eigenvalues[:, upper], np.asarray(locus.stable))
+
+
+# --- short-circuit response --------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class ResponseView:
+    """Time histories of both drives, full resolution (CSV) and decimated (plots)."""
+
+    t: np.ndarray  # [s]
+    outputs: dict[str, np.ndarray]  # RESPONSE_OUTPUTS -> total value [N m or N]
+    M_C: np.ndarray  # short-circuit torque [N m]
+    peaks: dict[str, float]  # signed total of largest magnitude
+    peak_times: dict[str, float]  # [s]
+    units: dict[str, str]
+    M_ad: float  # [N m]
+    truncated_at: float | None  # [s]
+    crossings: list[tuple[str, str, float, float]]  # (output, limit name, time [s], value)
+    plot_cut: float | None = None  # plots end here [s]: a torque exceeded GROWTH_CUT x M_ad
+    plot_t: np.ndarray = field(repr=False, default=None)
+    plot_outputs: dict[str, np.ndarray] = field(repr=False, default=None)
+    plot_M_C: np.ndarray = field(repr=False, default=None)
+
+
+def decimate(t: np.ndarray, ys: list[np.ndarray], buckets: int = PLOT_BUCKETS):
+    """Min/max decimation for plotting: keeps every extreme (peaks stay visible)."""
+    n = len(t)
+    if n <= 2 * buckets:
+        return t, ys
+    edges = np.linspace(0, n, buckets + 1).astype(int)
+    picks = []
+    for a, b in itertools.pairwise(edges):
+        picks.append(a)
+        for y in ys:
+            picks.append(a + int(np.argmax(y[a:b])))
+            picks.append(a + int(np.argmin(y[a:b])))
+    picks.append(n - 1)
+    index = np.unique(np.array(picks))
+    return t[index], [y[index] for y in ys]
+
+
+@pn.cache(max_items=64)
+def response_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                    b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
+                    t_end: float) -> ResponseView:
+    """Short-circuit response of both drives (model.response)."""
+    from model.response import ShortCircuit, short_circuit_response
+
+    m = model(params_path, rail)
+    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
+    excitation = ShortCircuit(M0=float(M0_kNm) * 1e3, f=float(f), D=float(D),
+                              dt=None if dt_ms is None else float(dt_ms) * 1e-3)
+    fs = max(2000.0, 10.0 * float(f))
+    r = short_circuit_response(m, op, excitation, t_end=float(t_end), fs=fs,
+                               outputs=list(RESPONSE_OUTPUTS))
+    outputs = {name: np.asarray(r.outputs[name]) for name in RESPONSE_OUTPUTS}
+    M_ad = float(r.limits["M_ad"])
+    # plots stop where a torque grows beyond GROWTH_CUT x M_ad (unstable: exponential growth
+    # would flatten everything before it); the CSV keeps the whole history
+    torques = np.array([np.abs(outputs[n]) for n in RESPONSE_OUTPUTS if n.endswith("torque")])
+    beyond = np.flatnonzero(torques.max(axis=0) > GROWTH_CUT * M_ad)
+    stop = int(beyond[0]) + 1 if len(beyond) else len(r.t)
+    plot_t, plot_ys = decimate(r.t[:stop], [y[:stop] for y in [*outputs.values(), r.M_C]])
+    return ResponseView(
+        t=r.t, outputs=outputs, M_C=np.asarray(r.M_C),
+        peaks={k: float(r.peaks[k]) for k in RESPONSE_OUTPUTS},
+        peak_times={k: float(r.peak_times[k]) for k in RESPONSE_OUTPUTS},
+        units={k: r.units[k] for k in RESPONSE_OUTPUTS}, M_ad=M_ad,
+        plot_cut=float(r.t[stop - 1]) if stop < len(r.t) else None,
+        truncated_at=r.truncated_at,
+        crossings=[(c.output, c.limit_name, c.time, c.value) for c in r.limit_crossings
+                   if c.output in outputs],
+        plot_t=plot_t, plot_outputs=dict(zip(RESPONSE_OUTPUTS, plot_ys[:-1], strict=True)),
+        plot_M_C=plot_ys[-1])
+
+
+def response_available() -> bool:
+    """Whether model/response.py exists (it was written in parallel with the dashboard)."""
+    import importlib.util
+
+    return importlib.util.find_spec("model.response") is not None

@@ -1,0 +1,500 @@
+"""The dashboard: a :class:`panel.viewable.Viewer` with ``param`` parameters, one per session.
+
+Controls are built per instance (never shared class attributes) and write into the parameters
+on ``value_throttled`` (slider release / keyboard step), so a drag triggers one computation.
+Heavy work runs in :mod:`app.compute` (cached, shared read-only across sessions).  In a served
+session it runs on a worker thread without the document lock, so several reviewers on one
+server do not queue behind each other; the results are applied on the next tick with the lock.
+Without a server (tests) everything runs synchronously.
+
+Two stages per change: *fast* (eigenvalues, status, creep, tables, mode shape, time histories)
+and *slow* (stability limit s0*(v), root locus), which only depend on part of the parameters and
+are usually cached.  A rejected parameter combination shows a notice and keeps the last valid
+results on screen.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import html
+import io
+import json
+import logging
+import math
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+import panel as pn
+import param
+from bokeh.document import without_document_lock
+
+from model import NoStabilityLimit, OperatingPointError, ParameterError
+from model.parameters import dumps_parameters
+
+from . import compute
+from .plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
+
+log = logging.getLogger(__name__)
+ASSETS = Path(__file__).resolve().parent.parent / "assets"
+MODEL_ERRORS = (OperatingPointError, ParameterError, NoStabilityLimit, ValueError,
+                np.linalg.LinAlgError)
+# worker threads shared by all sessions: computations release the GIL in LAPACK
+EXECUTOR = ThreadPoolExecutor(max_workers=2, thread_name_prefix="bogie-compute")
+PUBLISHED_CASES = {"stable": 0.005, "unstable": 0.014}  # s0 at 120 km/h (the study's two cases)
+
+CSS = """
+.status-box {font-size: 30px; font-weight: 700; padding: 6px 14px; border-radius: 6px;
+             color: white; text-align: center; letter-spacing: 0.05em}
+.status-box.ok {background: STABLE_COLOR} .status-box.bad {background: UNSTABLE_COLOR}
+table.bogie {border-collapse: collapse; font-size: 12px; width: 100%}
+table.bogie th, table.bogie td {border-bottom: 1px solid #ddd; padding: 2px 6px; text-align: right}
+table.bogie td.text, table.bogie th.text {text-align: left}
+table.bogie td.bad {color: UNSTABLE_COLOR; font-weight: 700}
+""".replace("UNSTABLE_COLOR", UNSTABLE).replace("STABLE_COLOR", STABLE)
+
+
+@dataclass(frozen=True)
+class State:
+    """The primitives a computation depends on (a snapshot of the parameters)."""
+
+    params_path: str
+    rail: str
+    s0: float
+    v: float
+    N0: float
+    b_M: float
+    M0: float
+    f: float
+    D: float
+    dt: float | None
+    t_end: float
+    locus: str
+
+    @property
+    def point(self) -> tuple:
+        return (self.params_path, self.rail, self.s0, self.v, self.N0, self.b_M)
+
+
+class BogieDashboard(pn.viewable.Viewer):
+    """Stability and short-circuit load of the bogie at one operating point."""
+
+    s0 = param.Number(0.005, bounds=(0.0005, 0.03), doc="longitudinal creepage s0 [-]")
+    v = param.Number(120.0, bounds=(10.0, 250.0), doc="speed v [km/h]")
+    N0 = param.Number(100.0, bounds=(40.0, 160.0), doc="static wheel force N0 [kN]")
+    b_M = param.Number(3000.0, bounds=(0.0, 20000.0), doc="motor slope b_M [N m s/rad]")
+    M0 = param.Number(50.0, bounds=(0.0, 200.0), doc="short-circuit amplitude M0 [kN m]")
+    f = param.Number(90.0, bounds=(10.0, 300.0), doc="short-circuit frequency f [Hz]")
+    D = param.Number(0.04, bounds=(0.0, 0.3), doc="short-circuit decay D [-]")
+    dt_auto = param.Boolean(True, doc="Δt such that the motor torque is continuous at t = 0")
+    dt = param.Number(0.0, bounds=(-10.0, 10.0), doc="short-circuit time shift Δt [ms]")
+    t_end = param.Number(2.0, bounds=(0.2, 5.0), doc="simulated time [s]")
+    rail = param.Selector(default="calibrated", objects=list(compute.RAIL_CONDITIONS),
+                          doc="rail condition (creep law)")
+    locus = param.Selector(default="s0", objects=["s0", "v"], doc="root locus over s0 or v")
+    zoom = param.Selector(default="all", objects=["all", "low"], doc="root locus view")
+    mode = param.Integer(1, bounds=(1, compute.N_COMPLEX_TABLE), doc="mode shown (ν)")
+
+    def __init__(self, params_path: str | None = None, **params):
+        super().__init__(**params)
+        self._params_path = str(params_path or "")
+        base = compute.parameters(self._params_path, "calibrated")
+        with param.parameterized.discard_events(self):
+            if "N0" not in params:
+                self.N0 = base["wheel_force"] / 1e3
+            if "b_M" not in params:
+                self.b_M = base["motor_slope"]
+        self.point: compute.PointResult | None = None  # last valid results
+        self.limit: compute.LimitResult | None = None
+        self.locus_result: compute.LocusResult | None = None
+        self.response: compute.ResponseView | None = None
+        self.error = ""  # last rejection message ("" if the current parameters are valid)
+        self._dirty = False
+        self._busy = False
+        self._build()
+        self.param.watch(self._on_change, ["s0", "v", "N0", "b_M", "M0", "f", "D", "dt_auto",
+                                           "dt", "t_end", "rail", "locus"])
+        self.param.watch(self._on_mode, ["mode"])
+        self.param.watch(lambda e: self.locus_plot.zoom(e.new == "low"), ["zoom"])
+        doc = pn.state.curdoc
+        if doc is not None and doc.session_context is not None:
+            # served: show the fast results at once, the root locus and s0* when they are ready
+            self.refresh(slow=False)
+            self._request(doc, loading=False)
+        else:
+            self.refresh()
+
+    # --- controls ------------------------------------------------------------------------------
+
+    def _slider(self, name: str, label: str, step: float, fmt: str = "0[.]000"):
+        p = self.param[name]
+        widget = pn.widgets.FloatSlider(label=label, start=p.bounds[0], end=p.bounds[1],
+                                        step=step, value=getattr(self, name), format=fmt,
+                                        css_classes=[f"ctl-{name}"], sizing_mode="stretch_width")
+        widget.param.watch(lambda event: setattr(self, name, event.new), "value_throttled")
+        self.param.watch(lambda event: setattr(widget, "value", event.new), name)
+        return widget
+
+    def _controls(self):
+        sliders = {
+            "s0": self._slider("s0", "creepage s0 [-]", 0.0005, "0.0000"),
+            "v": self._slider("v", "speed v [km/h]", 5.0, "0"),
+            "N0": self._slider("N0", "wheel force N0 [kN]", 1.0, "0"),
+            "b_M": self._slider("b_M", "motor slope b_M [N m s/rad]", 100.0, "0"),
+            "M0": self._slider("M0", "short circuit M0 [kN m]", 1.0, "0"),
+            "f": self._slider("f", "frequency f [Hz]", 1.0, "0"),
+            "D": self._slider("D", "decay D [-]", 0.005, "0.000"),
+            "dt": self._slider("dt", "time shift Δt [ms]", 0.05, "0.00"),
+            "t_end": self._slider("t_end", "simulated time [s]", 0.1, "0.0"),
+        }
+        sliders["dt"].disabled = self.dt_auto
+        self.param.watch(lambda e: setattr(sliders["dt"], "disabled", e.new), "dt_auto")
+        dt_auto = pn.widgets.Checkbox.from_param(self.param.dt_auto,
+                                                 label="Δt automatic (continuous torque)",
+                                                 css_classes=["ctl-dt_auto"])
+        rail = pn.widgets.Select.from_param(self.param.rail, label="rail condition (creep law)",
+                                            css_classes=["ctl-rail"], sizing_mode="stretch_width")
+        cases = []
+        for key, s0 in PUBLISHED_CASES.items():
+            button = pn.widgets.Button(label=f"Published case s0 = {s0} ({key})",
+                                       color="success" if key == "stable" else "danger",
+                                       css_classes=[f"case-{key}"], sizing_mode="stretch_width")
+            button.on_click(partial(self._published_case, s0))
+            cases.append(button)
+        self.sliders = sliders
+        downloads = [
+            pn.widgets.FileDownload(callback=self._csv, filename="time_histories.csv",
+                                    label="time histories (CSV)", css_classes=["dl-csv"],
+                                    sizing_mode="stretch_width"),
+            pn.widgets.FileDownload(callback=self._json, filename="eigenvalues.json",
+                                    label="eigenvalues (JSON)", css_classes=["dl-json"],
+                                    sizing_mode="stretch_width"),
+            pn.widgets.FileDownload(callback=self._toml, filename="parameters.toml",
+                                    label="parameter set (TOML)", css_classes=["dl-toml"],
+                                    sizing_mode="stretch_width"),
+        ]
+        return pn.Column(
+            "### Published cases (120 km/h)", *cases,
+            "### Operating point", sliders["s0"], sliders["v"], sliders["N0"], sliders["b_M"],
+            rail,
+            "### Short circuit M_C(t)", sliders["M0"], sliders["f"], sliders["D"], dt_auto,
+            sliders["dt"], sliders["t_end"],
+            "### Downloads", *downloads, width=300)
+
+    def _published_case(self, s0: float, _event=None) -> None:
+        self.param.update(s0=s0, v=120.0)
+
+    # --- layout --------------------------------------------------------------------------------
+
+    def _build(self) -> None:
+        m = compute.model(self._params_path, "calibrated")
+        self.locus_plot = RootLocusPlot()
+        self.creep_plot = CreepPlot()
+        self.response_plots = ResponsePlots()
+        self.mode_plot = ModeShapePlot(m.positions, m.parameters["wheel_radius"])
+        html_pane = partial(pn.pane.HTML, sizing_mode="stretch_width", stylesheets=[CSS])
+        self.status = html_pane("", css_classes=["stability-status"])
+        self.details = html_pane("")
+        self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
+                                    css_classes=["model-notice"], sizing_mode="stretch_width")
+        self.peaks = html_pane("")
+        self.eigen_table = html_pane("")
+        self.mode_table = html_pane("")
+        self.mode_select = pn.widgets.Select(label="mode ν", options={}, width=420,
+                                             css_classes=["ctl-mode"])
+        self.mode_select.link(self, value="mode")
+        locus_choice = pn.widgets.RadioButtonGroup.from_param(
+            self.param.locus, options={"locus over s0": "s0", "locus over speed v": "v"},
+            css_classes=["ctl-locus"])
+        zoom = pn.widgets.RadioButtonGroup.from_param(
+            self.param.zoom, options={"all modes ≤ 20 Hz": "all", "low modes": "low"},
+            css_classes=["ctl-zoom"])
+        bokeh_pane = partial(pn.pane.Bokeh, sizing_mode="stretch_width")
+        schematic = ASSETS / "schematic.svg"
+        self.main = pn.Column(
+            self.notice,
+            pn.Row(pn.Column(self.status, self.details, width=330),
+                   pn.Column(pn.Row(locus_choice, zoom), bokeh_pane(self.locus_plot.figure),
+                             sizing_mode="stretch_width"),
+                   sizing_mode="stretch_width"),
+            "### Short-circuit response",
+            pn.Row(bokeh_pane(self.creep_plot.figure), pn.Column(self.peaks, width=520),
+                   sizing_mode="stretch_width"),
+            pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[:2]),
+                   sizing_mode="stretch_width"),
+            pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[2:]),
+                   sizing_mode="stretch_width"),
+            "### Eigenvalues (layout of Table 1) and modes (layout of Table 2)",
+            pn.Row(self.eigen_table, self.mode_table, sizing_mode="stretch_width"),
+            "### Mode shape",
+            self.mode_select,
+            pn.Row(*(bokeh_pane(f) for f in self.mode_plot.figures), sizing_mode="stretch_width"),
+            "### Schematic of the bogie (names used in the tables)",
+            pn.pane.SVG(schematic, sizing_mode="stretch_width", max_width=1100)
+            if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*"),
+            sizing_mode="stretch_width")
+        self.layout = pn.Row(
+            self._controls(), self.main, sizing_mode="stretch_width",
+            stylesheets=[CSS])
+
+    def __panel__(self):
+        return self.layout
+
+    # --- state and computations --------------------------------------------------------------
+
+    def state(self) -> State:
+        rnd = lambda x, n=6: float(round(x, n))  # noqa: E731 - cache keys without float noise
+        return State(self._params_path, self.rail, rnd(self.s0, 7), rnd(self.v, 3),
+                     rnd(self.N0, 3), rnd(self.b_M, 3), rnd(self.M0, 3), rnd(self.f, 3),
+                     rnd(self.D, 5), None if self.dt_auto else rnd(self.dt, 4), rnd(self.t_end, 3),
+                     self.locus)
+
+    @staticmethod
+    def compute_fast(state: State):
+        """(point result, response result) for a state (raises a MODEL_ERRORS on rejection)."""
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(1):
+            point = compute.point_result(*state.point)
+            response = compute.response_result(*state.point, state.M0, state.f, state.D,
+                                               state.dt, state.t_end)
+        return point, response
+
+    @staticmethod
+    def compute_slow(state: State):
+        """(stability limit, root locus) for a state."""
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(1):
+            limit = compute.limit_result(state.params_path, state.rail, state.v, state.N0,
+                                         state.b_M)
+            fixed = state.v if state.locus == "s0" else state.s0
+            locus = compute.locus_result(state.params_path, state.rail, state.locus, fixed,
+                                         state.N0, state.b_M)
+        return limit, locus
+
+    def refresh(self, slow: bool = True) -> None:
+        """Compute and show everything synchronously (initial view, tests); ``slow=False``
+        skips the stability limit and the root locus."""
+        state = self.state()
+        try:
+            fast = self.compute_fast(state)
+        except MODEL_ERRORS as error:
+            self._reject(error)
+            return
+        self._apply_fast(state, fast)
+        if not slow:
+            return
+        try:
+            slow = self.compute_slow(state)
+        except MODEL_ERRORS as error:
+            self._reject(error)
+            return
+        self._apply_slow(state, slow)
+
+    def _on_change(self, *_events) -> None:
+        doc = pn.state.curdoc
+        if doc is None or doc.session_context is None:
+            self.refresh()
+            return
+        self._request(doc)
+
+    def _request(self, doc, loading: bool = True) -> None:
+        self._dirty = True
+        if self._busy:
+            return  # the running worker picks up the newest parameters when it is done
+        self._busy = True
+        if loading:
+            self.main.loading = True
+        doc.add_next_tick_callback(without_document_lock(partial(self._worker, doc)))
+
+    async def _worker(self, doc) -> None:
+        loop = asyncio.get_running_loop()
+        try:
+            while self._dirty:
+                self._dirty = False
+                state = self.state()
+                try:
+                    fast = await loop.run_in_executor(EXECUTOR, self.compute_fast, state)
+                except MODEL_ERRORS as error:
+                    doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+                    continue
+                doc.add_next_tick_callback(partial(self._locked, doc, self._apply_fast, state,
+                                                   fast))
+                if self._dirty:
+                    continue
+                try:
+                    slow = await loop.run_in_executor(EXECUTOR, self.compute_slow, state)
+                except MODEL_ERRORS as error:
+                    doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+                    continue
+                if not self._dirty:
+                    doc.add_next_tick_callback(partial(self._locked, doc, self._apply_slow,
+                                                       state, slow))
+        except Exception as error:  # keep the server and the session alive, say what happened
+            log.exception("dashboard computation failed")
+            doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+        finally:
+            self._busy = False
+            doc.add_next_tick_callback(partial(self._locked, doc, self._done))
+
+    @staticmethod
+    def _locked(doc, function, *args) -> None:
+        from panel.io.state import set_curdoc
+
+        with set_curdoc(doc):
+            function(*args)
+
+    def _done(self) -> None:
+        if not self._busy:
+            self.main.loading = False
+
+    def _reject(self, error: Exception) -> None:
+        message = error.args[0] if error.args else str(error)
+        self.error = str(message)
+        self.notice.object = (f"**The model rejects this combination:** {html.escape(str(message))}"
+                              " — showing the last valid result.")
+        self.notice.visible = True
+
+    def _on_mode(self, *_events) -> None:
+        if self.point is not None and 1 <= self.mode <= len(self.point.modes):
+            self.mode_plot.update(self.point.modes[self.mode - 1].displacement)
+
+    # --- showing results -----------------------------------------------------------------------
+
+    def _apply_fast(self, state: State, fast) -> None:
+        point, response = fast
+        self.point, self.response, self.error = point, response, ""
+        self.notice.visible = False
+        self.locus_plot.update_point(point)
+        self.creep_plot.update_point(point)
+        self.response_plots.update(response)
+        self._show_status()
+        self.eigen_table.object = eigen_table_html(point)
+        self.mode_table.object = mode_table_html(point)
+        self.peaks.object = peaks_html(response)
+        self.mode_select.options = {f"ν = {m.number}: {m.im_hz:.3f} Hz — {m.description}"[:90]:
+                                    m.number for m in point.modes}
+        self.mode_select.value = min(self.mode, len(point.modes))
+        self._on_mode()
+        self.locus_plot.zoom(self.zoom == "low")
+
+    def _apply_slow(self, state: State, slow) -> None:
+        self.limit, self.locus_result = slow
+        self.creep_plot.update_limit(self.limit)
+        self.locus_plot.update_locus(self.locus_result)
+        self.locus_plot.zoom(self.zoom == "low")
+        self._show_status()
+
+    def _show_status(self) -> None:
+        point = self.point
+        word = "STABLE" if point.stable else "UNSTABLE"
+        self.status.object = (f'<div class="status-box {"ok" if point.stable else "bad"}">'
+                              f"{word}</div>")
+        s0, v_kmh = point.key[2], point.key[3]
+        if self.limit is None:
+            limit = "s0*(v): computing…"
+        elif self.limit.s0_limit is None:
+            limit = f"s0*(v): none ({html.escape(self.limit.message)})"
+        else:
+            margin = self.limit.s0_limit - s0
+            limit = (f"s0*({v_kmh:g} km/h) = <b>{self.limit.s0_limit:.5f}</b><br>"
+                     f"margin s0* − s0 = <b>{margin:+.5f}</b> ({margin / self.limit.s0_limit:+.0%})")
+        self.details.object = (
+            f"<div style='font-size:13px;line-height:1.5'>"
+            f"largest Re λ = <b>{point.max_real_part:+.4f}</b> 1/s<br>"
+            f"flutter pairs (Re &gt; 0): <b>{point.flutter}</b><br>"
+            f"divergent real eigenvalues: <b>{point.divergence}</b><br>{limit}<br>"
+            f"μ(s0) = {point.mu0:.4f}, μ_max = {point.mu_max:.4f} at s = {point.s_max:.4f}<br>"
+            f"M_ad = 2 N0 r0 μ_max = {point.M_ad:,.0f} N m</div>")
+
+    # --- downloads -----------------------------------------------------------------------------
+
+    def _csv(self):
+        r = self.response
+        names = list(r.outputs)
+        header = "t [s]," + ",".join(f"{n} [{r.units[n]}]" for n in names) + ",M_C [N m]"
+        data = np.column_stack([r.t, *r.outputs.values(), r.M_C])
+        buffer = io.StringIO()
+        np.savetxt(buffer, data, delimiter=",", header=header, comments="", fmt="%.8g")
+        buffer.seek(0)
+        return buffer
+
+    def _json(self):
+        p = self.point
+        lam = p.eigenvalues
+        order = np.lexsort((lam.real, lam.imag))
+        data = {"operating_point": {"s0": p.key[2], "v_kmh": p.key[3], "N0": p.key[4] * 1e3,
+                                    "b_M": p.key[5], "rail": p.key[1]},
+                "stable": p.stable, "max_real_part": p.max_real_part, "flutter_pairs": p.flutter,
+                "divergent_real": p.divergence, "rigid_body": p.n_rigid,
+                "modes": [{"nu": m.number, "re": m.eigenvalue.real, "im_hz": m.im_hz,
+                           "damping_ratio": m.damping_ratio, "description": m.description}
+                          for m in p.modes],
+                "eigenvalues": [{"re": float(x.real), "im": float(x.imag)} for x in lam[order]]}
+        return io.StringIO(json.dumps(data, indent=1))
+
+    def _toml(self):
+        state = self.state()
+        p = compute.parameters(state.params_path, state.rail)
+        header = (f"parameter set in use by the dashboard (rail condition: {state.rail})\n"
+                  f"operating point: s0 = {state.s0}, v = {state.v} km/h, N0 = {state.N0} kN, "
+                  f"b_M = {state.b_M} N m s/rad")
+        return io.StringIO(dumps_parameters(p, header))
+
+
+# --- tables ------------------------------------------------------------------------------------
+
+def _complex(lam: complex) -> str:
+    return f"{lam.real:+.4f} ± i {abs(lam.imag) / (2 * math.pi):.3f}"
+
+
+def eigen_table_html(point: compute.PointResult) -> str:
+    """Table 1 layout: first complex pairs (Re [1/s] ± i Im [Hz]) and real eigenvalues [1/s]."""
+    rows = []
+    for i in range(max(len(point.modes), len(point.real))):
+        c = point.modes[i].eigenvalue if i < len(point.modes) else None
+        r = float(point.real[i]) if i < len(point.real) else None
+        c_cell = (f'<td class="{"bad" if c.real > 0 else ""}">{_complex(c)}</td>' if c is not None
+                  else "<td></td>")
+        r_cell = (f'<td class="{"bad" if r > 0 else ""}">{r:+.4g}</td>' if r is not None
+                  else "<td></td>")
+        rows.append(f"<tr><td>{i + 1}</td>{c_cell}{r_cell}</tr>")
+    s0, v = point.key[2], point.key[3]
+    return (f"<b>Eigenvalues at s0 = {s0:g}, v = {v:g} km/h</b> (Re [1/s] ± i Im [Hz]; "
+            f"{point.n_rigid} rigid-body zeros deflated)"
+            '<table class="bogie"><tr><th>#</th><th>complex</th><th>real (largest first)</th></tr>'
+            + "".join(rows) + "</table>")
+
+
+def mode_table_html(point: compute.PointResult) -> str:
+    """Table 2 layout: ν, Im λ [Hz], damping ratio and the generated description."""
+    rows = "".join(
+        f"<tr><td>{m.number}</td><td>{m.im_hz:.3f}</td><td>{m.damping_ratio:+.4f}</td>"
+        f'<td class="text">{html.escape(m.description)}</td></tr>' for m in point.modes)
+    return ('<b>Mode shapes</b> (dominant motion from kinetic/strain energy shares)'
+            '<table class="bogie"><tr><th>ν</th><th>Im λ [Hz]</th><th>ζ [-]</th>'
+            '<th class="text">dominant motion</th></tr>' + rows + "</table>")
+
+
+def peaks_html(response: compute.ResponseView) -> str:
+    """Peaks (signed total of largest magnitude) and their times, per output."""
+    rows = []
+    for name in response.outputs:
+        peak, unit = response.peaks[name], response.units[name]
+        over = unit == "N m" and "disc_clutch" in name and abs(peak) > response.M_ad
+        value = f"{peak:,.0f}" if abs(peak) < 1e7 else f"{peak:.3e}"
+        rows.append(f'<tr><td class="text">{name}</td><td class="{"bad" if over else ""}">'
+                    f"{value} {unit}</td><td>{response.peak_times[name]:.4f} s</td></tr>")
+    note = ""
+    if response.truncated_at is not None:
+        note = f" — growth: the time grid was cut at {response.truncated_at:.3f} s"
+    elif response.plot_cut is not None:
+        note = f" — unstable growth (plots end at {response.plot_cut:.3f} s; CSV has all)"
+    crossings = "; ".join(f"{o} exceeds {n} at {t:.3f} s" for o, n, t, _ in response.crossings[:4])
+    return (f"<b>Peaks</b> (M_ad = {response.M_ad:,.0f} N m){note}"
+            '<table class="bogie"><tr><th class="text">output</th><th>peak</th><th>at</th></tr>'
+            + "".join(rows) + "</table>"
+            + (f"<div style='font-size:12px'>{html.escape(crossings)}</div>" if crossings else ""))
