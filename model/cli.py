@@ -131,13 +131,94 @@ def cmd_eigen(args: argparse.Namespace) -> None:
 
 def cmd_limit(args: argparse.Namespace) -> None:
     from .operating_point import KMH
-    from .stability import stability_limit
+    from .stability import NoStabilityLimit, stability_limit
 
     model, _, (n0, bm) = load_model(args)
-    limit = stability_limit(model, args.v * KMH, n0, bm)
+    try:
+        limit = stability_limit(model, args.v * KMH, n0, bm)
+    except NoStabilityLimit as reason:
+        emit(args, {"v_kmh": args.v, "s0_limit": None, "N0": n0, "b_M": bm, "reason": str(reason)},
+             f"no stability limit at {args.v:g} km/h: {reason}")
+        return
     emit(args, {"v_kmh": args.v, "s0_limit": limit.s0_limit, "N0": n0, "b_M": bm},
          f"stability limit at {args.v:g} km/h: s0* = {limit.s0_limit:.6f} "
          f"({limit.evaluations} eigen-analyses)")
+
+
+def cmd_modes(args: argparse.Namespace) -> None:
+    from .eigen import eigen_analysis
+    from .modes import mode_character
+
+    model, op, _ = load_model(args)
+    result = eigen_analysis(model, op)
+    rows = []
+    for nu, index in enumerate(result.complex_index[: args.count], start=1):
+        c = mode_character(model, result, index)
+        top = sorted(c.kinetic.items(), key=lambda item: -item[1])[:3]
+        rows.append({"nu": nu, "re": float(c.eigenvalue.real), "im_hz": c.frequency_hz,
+                     "damping_ratio": c.damping_ratio, "description": c.description,
+                     "kinetic_energy_shares": {k: round(v, 4) for k, v in top}})
+    lines = [f"modes at s0 = {op.s0:g}, v = {op.v_kmh:g} km/h (Table 2 layout)", "",
+             f"{'ν':>3} {'Im λ [Hz]':>10} {'ζ [-]':>7}  dominant motion"]
+    lines += [f"{r['nu']:>3} {r['im_hz']:>10.3f} {r['damping_ratio']:>7.4f}  {r['description']}"
+              for r in rows]
+    emit(args, {"operating_point": op.as_dict(), "modes": rows}, "\n".join(lines))
+
+
+def parse_range(text: str, label: str, scale: float = 1.0) -> np.ndarray:
+    """'A:B:N' -> N values from A to B (times ``scale``)."""
+    parts = text.split(":")
+    try:
+        start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
+    except (ValueError, IndexError):
+        raise UsageError(f"{label} must be A:B:N (two numbers and a whole count), got '{text}'") from None
+    if len(parts) != 3 or count < 2 or count > 5000 or not (math.isfinite(start) and math.isfinite(stop)):
+        raise UsageError(f"{label} must be A:B:N with finite A, B and 2 <= N <= 5000, got '{text}'")
+    return np.linspace(start, stop, count) * scale
+
+
+def cmd_locus(args: argparse.Namespace) -> None:
+    from .locus import root_locus
+    from .operating_point import KMH
+
+    model, op, _ = load_model(args)
+    if (args.s0_range is None) == (args.v_range is None):
+        raise UsageError("give exactly one of --s0-range A:B:N or --v-range A:B:N (km/h)")
+    if args.s0_range is not None:
+        parameter, values = "s0", parse_range(args.s0_range, "--s0-range")
+    else:
+        parameter, values = "v", parse_range(args.v_range, "--v-range", KMH)
+    locus = root_locus(model, op, parameter, values, max_frequency_hz=args.max_frequency)
+    shown = values if parameter == "s0" else values / KMH
+    upper = locus.upper_branches
+    data = {"parameter": parameter, "unit": "-" if parameter == "s0" else "km/h",
+            "values": shown.tolist(), "operating_point": op.as_dict(),
+            "branches": [{"re": locus.eigenvalues[:, b].real.tolist(),
+                          "im_hz": (locus.eigenvalues[:, b].imag / (2 * np.pi)).tolist()}
+                         for b in upper],
+            "max_real_part": locus.max_real_part.tolist(),
+            "max_error_estimate": float(locus.error_estimate.max())}
+    lines = [f"root locus over {parameter} ({len(values)} points, {len(upper)} branches with "
+             f"Im >= 0 of {locus.eigenvalues.shape[1]} tracked, |λ| < 2π·{args.max_frequency:g} Hz)",
+             f"{'value':>10} {'max Re [1/s]':>13}  stable"]
+    step = max(1, len(values) // 20)
+    for value, growth in list(zip(shown, locus.max_real_part, strict=True))[::step]:
+        lines.append(f"{value:>10.5g} {growth:>13.4g}  {'yes' if growth <= 0 else 'NO'}")
+    emit(args, data, "\n".join(lines))
+
+
+def cmd_calibrate(args: argparse.Namespace) -> None:
+    from pathlib import Path
+
+    from .calibration import run
+    from .parameters import CALIBRATED_FILE, ESTIMATE_FILE
+
+    start = Path(args.start) if args.start else ESTIMATE_FILE
+    out = Path(args.out) if args.out else CALIBRATED_FILE
+    if not out.parent.is_dir():
+        raise UsageError(f"directory '{out.parent}' does not exist")
+    run(start, out, max_evaluations=args.max_evaluations,
+        progress=lambda text: print(text, file=sys.stderr if args.json else sys.stdout, flush=True))
 
 
 def cmd_export(args: argparse.Namespace) -> None:
@@ -172,6 +253,27 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("limit", help="stability limit s0*(v) at a speed")
     add_operating_point(p, s0=None)
     p.set_defaults(func=cmd_limit)
+
+    p = sub.add_parser("modes", help="mode table (Table 2 layout): energy shares and descriptions")
+    add_operating_point(p)
+    p.add_argument("--count", type=positive_int("--count"), default=10, help="modes to list")
+    p.set_defaults(func=cmd_modes)
+
+    p = sub.add_parser("locus", help="root locus over s0 or v, branches tracked by MAC")
+    add_operating_point(p)
+    p.add_argument("--s0-range", default=None, metavar="A:B:N", help="creepage sweep")
+    p.add_argument("--v-range", default=None, metavar="A:B:N", help="speed sweep [km/h]")
+    p.add_argument("--max-frequency", type=number("--max-frequency (Hz)", 0.5, 500, allowed="must be in (0.5, 500) Hz"),
+                   default=20.0, help="track eigenvalues with |λ| < 2π f [Hz] (default %(default)s)")
+    p.set_defaults(func=cmd_locus)
+
+    p = sub.add_parser("calibrate", help="fit the uncertain parameters to the published results")
+    p.add_argument("--start", default=None, metavar="FILE", help="starting set (default: estimate.toml)")
+    p.add_argument("--out", default=None, metavar="FILE", help="output (default: calibrated.toml)")
+    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=80,
+                   help="least-squares iterations of the structural stage (default %(default)s)")
+    p.add_argument("--json", action="store_true", help="progress to stderr")
+    p.set_defaults(func=cmd_calibrate)
 
     p = sub.add_parser("export", help="export M, B, K, outputs at an operating point (.npz)")
     add_operating_point(p)
