@@ -24,7 +24,7 @@ case "${1:-}" in
     test)
         shift
         ensure_venv "[test]"
-        if [ ! -x /usr/bin/chromium ] || ! command -v buildah >/dev/null || ! command -v debootstrap >/dev/null; then
+        if [ ! -x /usr/bin/chromium ] || ! command -v buildah >/dev/null || { [ ! -x /usr/sbin/debootstrap ] && ! command -v debootstrap >/dev/null; }; then
             echo "run.sh: installing Debian packages chromium, buildah, debootstrap for the browser and image tests" >&2
             SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
             $SUDO apt-get update -qq
