@@ -1,0 +1,80 @@
+"""Root locus: the reduced, error-controlled sweep against dense solutions, branch continuity,
+the speed sweep, bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from threadpoolctl import threadpool_limits
+
+from model import OperatingPointError, build_model, default_operating_point, load_parameters
+from model.locus import dense_generalized_eigenvalues, root_locus
+
+CONTROLLED = 1.5 * 2 * np.pi * 20.0  # |λ| inside which the tolerance is enforced [1/s]
+
+
+@pytest.fixture(scope="module")
+def setup():
+    with threadpool_limits(1):
+        parameters = load_parameters()
+        model = build_model(parameters)
+        op = default_operating_point(parameters)
+        s0 = np.linspace(0.002, 0.016, 30)
+        yield model, op, s0, root_locus(model, op, "s0", s0)
+
+
+def test_tracked_eigenvalues_equal_dense_solution(setup):
+    """Every tracked eigenvalue inside the controlled disc lies within 1e-6 (relative) of an
+    eigenvalue of the dense QZ solution of eqs. (21)–(22) at the same point."""
+    model, op, s0, locus = setup
+    for i in range(0, len(s0), 3):
+        reference = dense_generalized_eigenvalues(model, op.__class__(s0[i], op.v, op.N0, op.b_M))
+        reference = reference[np.isfinite(reference)]
+        for value in locus.eigenvalues[i]:
+            if abs(value) < CONTROLLED:
+                assert np.min(np.abs(reference - value)) <= 1e-6 * abs(value)
+
+
+def test_branches_are_continuous_and_conjugate_closed(setup):
+    _, _, _, locus = setup
+    steps = np.abs(np.diff(locus.eigenvalues, axis=0))
+    scale = np.maximum(np.abs(locus.eigenvalues[:-1]), 1.0)
+    # lightly damped branches (the low modes of the table) move little between neighbouring
+    # points; a swap would show as a jump to the neighbouring branch.  (Heavily damped,
+    # creep-dominated branches do move fast at small s0, where the creep slope is steep.)
+    E = locus.eigenvalues[:-1]
+    light = (np.abs(E) < CONTROLLED) & (np.abs(E.imag) > 3 * np.abs(E.real))  # ζ < 0.32
+    assert np.all((steps / scale)[light] < 0.1)
+    for row in locus.eigenvalues:
+        assert np.allclose(np.sort_complex(row), np.sort_complex(row.conj()), rtol=1e-8, atol=1e-8)
+
+
+def test_locus_crosses_into_instability_at_the_limit(setup):
+    _, _, s0, locus = setup
+    unstable = s0[~locus.stable]
+    assert locus.stable[0]
+    assert not locus.stable[-1]
+    assert 0.0075 < unstable.min() < 0.0095  # the crossing near s0* = 0.0082 (test_literature)
+
+
+def test_speed_sweep(setup):
+    model, op, _, _ = setup
+    v = np.linspace(60, 200, 8) / 3.6
+    locus = root_locus(model, op, "v", v)
+    assert locus.eigenvalues.shape[0] == 8
+    reference = dense_generalized_eigenvalues(model, op.__class__(op.s0, v[-1], op.N0, op.b_M))
+    value = locus.eigenvalues[-1][np.argmax(locus.eigenvalues[-1].real)]
+    assert np.min(np.abs(reference[np.isfinite(reference)] - value)) <= 1e-6 * abs(value)
+
+
+@pytest.mark.parametrize(("parameter", "values", "error"), [
+    ("N0", [1e5, 2e5], ValueError),
+    ("s0", [0.005], ValueError),
+    ("s0", [0.005, np.nan], ValueError),
+    ("s0", [0.005, 1.5], OperatingPointError),
+    ("v", [10.0, -1.0], OperatingPointError),
+])
+def test_bad_input(setup, parameter, values, error):
+    model, op, _, _ = setup
+    with pytest.raises(error):
+        root_locus(model, op, parameter, values)
