@@ -71,8 +71,12 @@ debian_mirror() {
 }
 
 make_base() {
+    # one maker at a time (two test runs at once would race on the cache)
+    exec 9>"$BOGIE_ROOTFS_CACHE.lock"
+    flock 9
     if buildah inspect --type image "$STANDIN_BASE" >/dev/null 2>&1; then
         say "stand-in base $STANDIN_BASE exists (remove with 'buildah rmi $STANDIN_BASE' to remake)"
+        exec 9>&-
         return
     fi
     local t0 rootfs="$BOGIE_ROOTFS_CACHE/$SUITE"
@@ -108,6 +112,7 @@ make_base() {
         "$ctr"
     buildah commit --rm -q "$ctr" "$STANDIN_BASE" >/dev/null
     say "stand-in base $STANDIN_BASE made in $(elapsed "$t0") s"
+    exec 9>&-
 }
 
 build() {
