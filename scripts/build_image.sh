@@ -164,7 +164,9 @@ serve() {
     # --isolation chroot shares this machine's network: the port is reachable directly.
     # shellcheck disable=SC2064
     trap "buildah rm '$name' >/dev/null 2>&1 || true" EXIT
-    buildah run --isolation chroot --env "BOGIE_PORT=$port" "$name" -- "${cmd[@]}"
+    local env=(--env "BOGIE_PORT=$port")
+    [ -n "${BOGIE_ALLOWED_ORIGINS:-}" ] && env+=(--env "BOGIE_ALLOWED_ORIGINS=$BOGIE_ALLOWED_ORIGINS")
+    buildah run --isolation chroot "${env[@]}" "$name" -- "${cmd[@]}"
 }
 
 free_port() { python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }

@@ -69,9 +69,10 @@ def served(image, tmp_path_factory):
     """The image's CMD running with ``buildah run`` on a free port of this machine."""
     port = free_port()
     log_path = tmp_path_factory.mktemp("serve") / "serve.log"
+    env = {key: value for key, value in os.environ.items() if key != "BOGIE_ALLOWED_ORIGINS"}
     with log_path.open("w") as log:  # a file, not a pipe: a full pipe would block the server
         process = subprocess.Popen(["bash", str(SCRIPT), "serve", str(port)],
-                                   env={**os.environ, "IMAGE": image}, stdout=log,
+                                   env={**env, "IMAGE": image}, stdout=log,
                                    stderr=subprocess.STDOUT, start_new_session=True)
     base = f"http://127.0.0.1:{port}"
     start = time.monotonic()
@@ -101,12 +102,40 @@ def test_liveness_endpoint_answers_200(served):
 
 
 def test_app_page_holds_the_bokeh_document(served):
+    """/app is Bokeh's server page (its document follows over the websocket): pull it."""
+    import panel  # noqa: F401 - registers Panel's model types for deserialization
+    from bokeh.client import pull_session
+
     base, _, _ = served
     status, page = get(f"{base}/app", timeout=60)
     assert status == 200
-    assert "docs_json" in page  # the serialized Bokeh document
-    assert "Bokeh" in page
-    assert "root_ids" in page
+    assert "Bokeh.embed.embed_items(docs_json, render_items)" in page
+    assert '"token"' in page  # the session the page's websocket opens
+    with pull_session(url=f"{base}/app") as session:
+        document = session.document
+        assert document.roots
+        assert len(list(document.models)) > 10
+        assert document.title == "Bogie drive dynamics"
+
+
+def websocket_handshake(port: int, origin: str) -> int:
+    """HTTP status of a websocket upgrade request to /app/ws from the given Origin."""
+    request = (f"GET /app/ws HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: {origin}\r\n"
+               "Connection: Upgrade\r\nUpgrade: websocket\r\nSec-WebSocket-Version: 13\r\n"
+               "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Protocol: bokeh\r\n"
+               "\r\n")
+    with socket.create_connection(("127.0.0.1", port), timeout=30) as sock:
+        sock.sendall(request.encode())
+        status_line = sock.makefile("rb").readline().decode()
+    return int(status_line.split()[1])
+
+
+def test_websocket_origins_default_to_localhost_only(served):
+    _, port, status = served
+    assert status == 200
+    assert websocket_handshake(port, f"http://127.0.0.1:{port}") == 101
+    assert websocket_handshake(port, f"http://localhost:{port}") == 101
+    assert websocket_handshake(port, "http://elsewhere.example.org") == 403
 
 
 def test_healthcheck_command_passes_inside_the_container(served):
