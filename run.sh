@@ -11,8 +11,14 @@ ensure_venv() {
     if [ ! -x "$VENV/bin/python" ]; then
         "$PY" -m venv "$VENV"
     fi
+    # editable install: only a changed pyproject.toml needs pip again (stamp = its last copy)
+    local stamp="$VENV/.installed-pyproject$1.toml"
+    if [ -f "$stamp" ] && cmp -s pyproject.toml "$stamp"; then
+        return
+    fi
     "$VENV/bin/python" -m pip install -q --upgrade pip
     "$VENV/bin/python" -m pip install -q -e ".$1"
+    cp pyproject.toml "$stamp"
 }
 
 case "${1:-}" in
