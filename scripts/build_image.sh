@@ -24,6 +24,7 @@
 #   DEBIAN_MIRROR       Debian mirror for debootstrap    (default: this machine's apt source)
 #   PIP_INDEX_URL       forwarded to the build when it is an http(s) URL (default: this machine's
 #                       pip configuration, read with `pip config get global.index-url`)
+#   BOGIE_ALLOWED_ORIGINS  passed on to the served container (serve, check)
 #
 # Needs root (buildah, debootstrap; re-runs itself with sudo when not root) and Debian's packages
 # buildah and debootstrap (`bash run.sh test` installs them with apt-get).
