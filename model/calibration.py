@@ -59,23 +59,29 @@ def _share(character, component: str, axes: tuple[str, ...]) -> float:
     return kinetic * sum(directions.get(axis, 0.0) for axis in axes)
 
 
-# Table 2 characters as scores in [0, 1] (kinetic/strain energy shares)
+def _in_phase(character, a: str, b: str, axis: str) -> float:
+    return 0.5 * (1 + character.phase_cosine(a, b, axis))
+
+
+_TMS = ("ID1.stator", "ID2.stator")
+
+# Table 2 characters as scores in [0, 1] (kinetic/strain energy shares, phase factors)
 MODE_SIGNATURES: tuple[tuple[str, Callable], ...] = (
     ("vertical of CB in phase with BF and TMs", lambda c: _share(c, "CB", ("z",))),
     ("torsion of ID1 rotor with gears, DC twisting",
      lambda c: c.kinetic.get("ID1.rotor", 0) + c.strain.get("ID1.disc_clutch", 0)),
     ("torsion of both gears and BF pitch, gearing",
-     lambda c: _share(c, "BF", ("ry",)) + _share(c, "ID1.stator", ("ry",))
-     + _share(c, "ID2.stator", ("ry",))),
+     lambda c: _share(c, "BF", ("ry",)) + sum(_share(c, tm, ("ry",)) for tm in _TMS)
+     + c.strain.get("ID1.gear_mesh", 0) + c.strain.get("ID2.gear_mesh", 0)),
     ("vertical of BF with both TMs in phase",
-     lambda c: _share(c, "BF", ("z",)) + _share(c, "ID1.stator", ("z",))
-     + _share(c, "ID2.stator", ("z",))),
+     lambda c: (_share(c, "BF", ("z",)) + sum(_share(c, tm, ("z",)) for tm in _TMS))
+     * _in_phase(c, "BF", "ID1.stator", "z") * _in_phase(c, "BF", "ID2.stator", "z")),
     ("lateral and roll of BF with both TMs",
-     lambda c: _share(c, "BF", ("y", "rx")) + 0.5 * (_share(c, "ID1.stator", ("y", "rx"))
-                                                    + _share(c, "ID2.stator", ("y", "rx")))),
+     lambda c: (_share(c, "BF", ("y", "rx")) + sum(_share(c, tm, ("y", "rx")) for tm in _TMS))
+     * _in_phase(c, "BF", "ID1.stator", "y") * _in_phase(c, "BF", "ID2.stator", "y")),
     ("lateral of both TMs in opposite phase",
-     lambda c: _share(c, "ID1.stator", ("y", "rz")) + _share(c, "ID2.stator", ("y", "rz"))
-     - _share(c, "BF", ("y",))),
+     lambda c: sum(_share(c, tm, ("y", "rz")) for tm in _TMS)
+     * (1 - _in_phase(c, "ID1.stator", "ID2.stator", "y"))),
     ("longitudinal-pitch of WS2", lambda c: _share(c, "ID2.wheelset", ("x",))),
     ("longitudinal-pitch of WS1", lambda c: _share(c, "ID1.wheelset", ("x",))),
     ("longitudinal-yaw of WS2",

@@ -9,7 +9,7 @@ For a mode shape Δq (complex), the kinetic-energy share of a component is
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -57,6 +57,17 @@ class ModeCharacter:
     strain: dict[str, float]  # element group -> strain-energy share [-]
     directions: dict[str, dict[str, float]]  # component -> axis -> share of its kinetic energy
     description: str
+    amplitudes: dict[str, dict[str, complex]] = field(default_factory=dict)  # component -> axis ->
+    # largest complex amplitude of that axis among the component's coordinates (for phases)
+
+    def phase_cosine(self, a: str, b: str, axis: str) -> float:
+        """cos of the phase angle between components a and b along ``axis`` (1: in phase,
+        −1: opposite phase, 0 if either does not move that way)."""
+        za = self.amplitudes.get(a, {}).get(axis, 0j)
+        zb = self.amplitudes.get(b, {}).get(axis, 0j)
+        if za == 0 or zb == 0:
+            return 0.0
+        return float(np.real(za * np.conj(zb)) / (abs(za) * abs(zb)))
 
     @property
     def frequency_hz(self) -> float:
@@ -96,7 +107,18 @@ def characterize(model: BogieModel, eigenvalue: complex, q: np.ndarray) -> ModeC
     strain = {g: value / total for g, value in strain_raw.items()}
     directions = {c: _axis_shares(model, groups[c], q) for c in groups}
     text = _describe(model, q, kinetic, strain, directions)
-    return ModeCharacter(complex(eigenvalue), kinetic, strain, directions, text)
+    amplitudes = {c: _amplitudes(model, groups[c], q) for c in groups}
+    return ModeCharacter(complex(eigenvalue), kinetic, strain, directions, text, amplitudes)
+
+
+def _amplitudes(model: BogieModel, parts: list[str], q: np.ndarray) -> dict[str, complex]:
+    best: dict[str, complex] = {}
+    for name in parts:
+        for index in model.mass_parts[name].index:
+            axis = model.dofs.names[index].rsplit(".", 1)[1]
+            if abs(q[index]) > abs(best.get(axis, 0j)):
+                best[axis] = complex(q[index])
+    return best
 
 
 def _direction_words(component: str, shares: dict[str, float]) -> str:
