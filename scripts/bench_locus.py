@@ -6,8 +6,8 @@ the same run, on the calibrated default parameters.
 
 Reports wall-clock times (best of ``--repeat`` for the fast methods; the naive loop once), the
 speed-up ratios, and the accuracy of the tracked eigenvalues: for every point and every tracked
-eigenvalue inside the accuracy-controlled disc (|λ| < 1.5·2π·20 Hz), the relative distance to the
-nearest eigenvalue of the dense QZ solution.  One BLAS thread (as the CLI and the app use).
+eigenvalue inside the accuracy-controlled disc (|λ| < 1.5·2π·f_max), the relative distance to the
+nearest eigenvalue of the dense solutions (deflated, and the naive QZ).  One BLAS thread (as the CLI and the app use).
 """
 
 from __future__ import annotations
@@ -36,6 +36,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--points", type=int, default=200)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--max-frequency", type=float, default=13.0,
+                        help="track |λ| < 2π f [Hz]; 13 Hz covers the published Table 1 band")
     args = parser.parse_args()
 
     parameters = load_parameters()
@@ -47,18 +49,25 @@ def main() -> None:
     t_eigen_values, _ = best_of(args.repeat, lambda: eigen_analysis(model, op, vectors=False))
     t_naive_one, _ = best_of(args.repeat, lambda: dense_generalized_eigenvalues(model, op))
 
-    t_locus, locus = best_of(args.repeat, lambda: root_locus(model, op, "s0", s0))
+    t_locus, locus = best_of(args.repeat, lambda: root_locus(model, op, "s0", s0,
+                                                             max_frequency_hz=args.max_frequency))
     start = time.perf_counter()
     naive = [dense_generalized_eigenvalues(model, op.__class__(x, op.v, op.N0, op.b_M)) for x in s0]
     t_naive = time.perf_counter() - start
 
-    controlled = 1.5 * 2 * np.pi * 20.0
-    worst = 0.0
+    controlled = 1.5 * 2 * np.pi * args.max_frequency
+    worst, worst_deflated, worst_absolute = 0.0, 0.0, 0.0
     for i, reference in enumerate(naive):
         reference = reference[np.isfinite(reference)]
+        deflated = eigen_analysis(model, op.__class__(s0[i], op.v, op.N0, op.b_M),
+                                  vectors=False).eigenvalues
         for value in locus.eigenvalues[i]:
             if abs(value) < controlled:
-                worst = max(worst, float(np.min(np.abs(reference - value)) / abs(value)))
+                gap = float(np.min(np.abs(reference - value)))
+                worst = max(worst, gap / abs(value))
+                worst_absolute = max(worst_absolute, gap)
+                worst_deflated = max(worst_deflated,
+                                     float(np.min(np.abs(deflated - value)) / abs(value)))
 
     print(f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()},"
           f" numpy {np.__version__}, one BLAS thread")
@@ -80,8 +89,12 @@ def main() -> None:
     print(f"root locus: {int(locus.dense_points.sum())} points solved densely, "
           f"{locus.newton_refinements} branch-points refined by Newton, basis {locus.basis_size}; "
           f"largest error estimate {locus.error_estimate.max():.2e}")
-    print(f"accuracy: largest relative deviation of a tracked eigenvalue (|λ| < {controlled:.0f} 1/s) "
-          f"from the dense QZ solution: {worst:.2e}")
+    print(f"accuracy (tracked eigenvalues with |λ| < {controlled:.0f} 1/s, all {args.points} points):")
+    print(f"  against the dense deflated solution (`eigen_analysis`): largest relative deviation "
+          f"{worst_deflated:.2e}")
+    print(f"  against the naive dense QZ: largest relative deviation {worst:.2e}, largest absolute "
+          f"{worst_absolute:.2e} 1/s (QZ does not deflate the rigid-body zeros; near the stability "
+          "limit the drivetrain-spin eigenvalue meets them and QZ loses digits there)")
 
 
 if __name__ == "__main__":
