@@ -203,17 +203,21 @@ class LinearSystem:
         return self._get("deflation", build)
 
     @property
-    def modal(self) -> tuple[np.ndarray, np.ndarray, tuple, float]:
-        """Eigenvalues λ and unit eigenvectors Y of A22 = Q2ᵀ A Q2, the LU factors of Y and its
-        condition number (1-norm, LAPACK estimate)."""
+    def modal(self) -> tuple[np.ndarray, np.ndarray, tuple, float, np.ndarray]:
+        """Eigen-decomposition of A22 = Q2ᵀ A Q2 = T Yb Λ Yb⁻¹ T⁻¹ with the diagonal balancing
+        T = diag(scale) (powers of 2, exact): λ, unit eigenvectors Yb of the balanced matrix, the
+        LU factors of Yb, its condition number (1-norm, LAPACK estimate) and the scale.
+        Balancing puts displacements and velocities on one footing (|λ| spans 0.3…3·10⁵ 1/s)
+        and lowers cond(Yb) by two orders of magnitude against the unbalanced eigenvectors."""
         def build():
             _, Q2 = self.deflation
             A22 = Q2.T @ self.A @ Q2
-            lam, Y = np.linalg.eig(A22)
+            balanced, (scale, _) = sla.matrix_balance(A22, permute=False, separate=True)
+            lam, Y = np.linalg.eig(balanced)
             Y = Y / np.linalg.norm(Y, axis=0)
             lu = sla.lu_factor(Y, check_finite=False)
             rcond, _ = zgecon(lu[0], np.abs(Y).sum(axis=0).max(), norm="1")
-            return lam, Y, lu, (1.0 / rcond if rcond > 0 else math.inf)
+            return lam, Y, lu, (1.0 / rcond if rcond > 0 else math.inf), scale
         return self._get("modal", build)
 
     def step_particular(self, u0: float) -> tuple[np.ndarray, np.ndarray]:
@@ -249,19 +253,19 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
     to the largest |y|, number of valid points, highest frequency [Hz] of a mode contributing
     more than 1 % of some output's peak)."""
     Q1, Q2 = system.deflation
-    lam, Y, lu, cond = system.modal
+    lam, Y, lu, cond, scale = system.modal  # A22 = (T Y) Λ (T Y)⁻¹, T = diag(scale)
     alpha, beta = system.step_particular(u0)
     x_mu = system.exponential_particular(a, mu)
     xh0 = -(alpha + x_mu.real)
     c0 = Q2.T @ xh0
     a0 = Q1.T @ xh0
-    d = sla.lu_solve(lu, c0.astype(complex), check_finite=False)
-    W = (C @ Q2) @ Y  # p x m
+    d = sla.lu_solve(lu, (c0 / scale).astype(complex), check_finite=False)
+    W = ((C @ Q2) * scale) @ Y  # p x m
     CQ1 = C @ Q1
     if CQ1.size and np.abs(CQ1).max() > 0.0:
         # rigid coordinates: ȧ = A12 c  ->  a(t) = a0 + A12 Y diag((e^(λt) − 1)/λ) d
         A12 = Q1.T @ system.A @ Q2
-        G = CQ1 @ (A12 @ Y)
+        G = CQ1 @ ((A12 * scale) @ Y)
         W = W + G / lam
         const_h = CQ1 @ a0 - (G / lam) @ d
     else:

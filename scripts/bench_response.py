@@ -72,6 +72,9 @@ def main() -> None:
     parser.add_argument("--t-end", type=float, default=2.0)
     parser.add_argument("--fs", type=float, default=10_000.0)
     parser.add_argument("--skip-radau", action="store_true")
+    parser.add_argument("--radau-t-end", type=float, default=None,
+                        help="horizon of the Radau run [s] (default: --t-end); a shorter one is "
+                             "reported as such, its error against the reference's first part")
     args = parser.parse_args()
     parameters = load_parameters()
     model = build_model(parameters)
@@ -115,14 +118,17 @@ def main() -> None:
         "scipy.signal.lsim": (t_lsim, error(y_lsim, reference)),
     }
     if not args.skip_radau:
+        t_radau_end = args.t_end if args.radau_t_end is None else min(args.radau_t_end, args.t_end)
+        k = round(t_radau_end * args.fs) + 1
         x_scale = np.abs(np.linalg.lstsq(A, -b * u0, rcond=None)[0]).max()
         start = time.perf_counter()
         sol = solve_ivp(lambda tt, x: A @ x + b * (u0 + (a * np.exp(mu * tt)).real),
-                        (0.0, t[-1]), np.zeros(len(b)), method="Radau", t_eval=t, rtol=1e-8,
-                        atol=1e-8 * 1e-3 * x_scale, jac=A)
+                        (0.0, t[k - 1]), np.zeros(len(b)), method="Radau", t_eval=t[:k],
+                        rtol=1e-8, atol=1e-8 * 1e-3 * x_scale, jac=A)
         t_radau = time.perf_counter() - start
-        rows["scipy.integrate.solve_ivp Radau rtol 1e-8"] = (t_radau, error((C @ sol.y).T,
-                                                                            reference))
+        rows[f"scipy.integrate.solve_ivp Radau rtol 1e-8 (0…{t_radau_end:g} s only)"
+             if k < steps else "scipy.integrate.solve_ivp Radau rtol 1e-8"] = (
+            t_radau, error((C @ sol.y).T, reference[:k]))
     print(f"system: {model.n} DOF, state {2 * model.n}, {len(outputs.names)} outputs, "
           f"{steps} points ({args.t_end:g} s at {args.fs:g} Hz); method {method}, "
           f"error estimate {estimate:.1e}; reference (exact stepping) took {t_reference:.2f} s")
@@ -132,7 +138,7 @@ def main() -> None:
     print()
     print("| method | time [ms] | speed-up vs lsim | speed-up vs Radau | max error / peak |")
     print("|---|---:|---:|---:|---:|")
-    radau = rows.get("scipy.integrate.solve_ivp Radau rtol 1e-8", (np.nan,))[0]
+    radau = next((v[0] for name, v in rows.items() if "Radau" in name), np.nan)
     for name, (seconds, err) in rows.items():
         print(f"| {name} | {1e3 * seconds:.1f} | {t_lsim / seconds:.1f} | "
               f"{radau / seconds:.1f} | {err:.1e} |")

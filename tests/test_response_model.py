@@ -139,20 +139,26 @@ def test_unstable_case_grows_without_nan_for_5_s_and_reports_limits(bogie):
 
 
 def test_dofs_by_name_include_the_rigid_spin_drift(bogie):
-    """ID1's rotor angle: the rigid spin of the drivetrain drifts (ramp) after the fault, while
-    the torques settle; the DOF is reported as static deflection + Δq."""
+    """ID1's rotor angle: the rigid spin of the drivetrain drifts after the fault (K r = 0: the
+    angle keeps growing while the torques stay bounded).  The DOF path goes through the rigid
+    coordinates of the deflated modal form; it must agree with the expm form, and the DOF is
+    reported as static deflection + Δq."""
     parameters, model = bogie
     op = default_operating_point(parameters, 0.005)
-    r = short_circuit_response(model, op, ShortCircuit(), 20.0, 200.0,
-                               outputs=["ID1.rotor.ry", "ID1.disc_clutch.torque"])
+    names = ["ID1.rotor.ry", "ID1.rim12.ry", "ID1.disc_clutch.torque"]
+    r = short_circuit_response(model, op, ShortCircuit(), 5.0, 500.0, outputs=names,
+                               method="modal")
+    e = short_circuit_response(model, op, ShortCircuit(), 5.0, 500.0, outputs=names,
+                               method="expm")
     assert r.units["ID1.rotor.ry"] == "rad"
-    angle = r.perturbation("ID1.rotor.ry")
-    slope_late = np.polyfit(r.t[-400:], angle[-400:], 1)[0]
-    slope_mid = np.polyfit(r.t[-2000:-1600], angle[-2000:-1600], 1)[0]
-    assert slope_late != 0.0
-    assert slope_late == pytest.approx(slope_mid, rel=1e-3)  # constant spin velocity: a ramp
-    torque = r.perturbation("ID1.disc_clutch.torque")
-    assert np.ptp(torque[-400:]) < 1e-3 * np.abs(torque).max()  # the loads have settled
+    for name in names:
+        scale = np.abs(e.perturbation(name)).max()
+        assert np.abs(r.perturbation(name) - e.perturbation(name)).max() < TOLERANCE * scale
+    angle = np.abs(r.perturbation("ID1.rotor.ry"))
+    assert angle[-1] > 1.5 * angle[len(angle) // 2]  # drifts
+    torque = np.abs(r.perturbation("ID1.disc_clutch.torque"))
+    assert torque[-50:].max() < torque.max()  # bounded
+    assert r.outputs["ID1.rotor.ry"][0] == pytest.approx(r.steady["ID1.rotor.ry"])
 
 
 def test_bad_arguments_raise_one_line_errors(bogie):
@@ -169,8 +175,9 @@ def test_bad_arguments_raise_one_line_errors(bogie):
 @pytest.mark.slow
 @pytest.mark.parametrize("s0", [0.005, 0.014])
 def test_closed_form_matches_radau(bogie, s0):
-    """Independent integrator: Radau at rtol 1e-10 on the first 0.1 s (the stiff, lightly damped
-    high-frequency modes make longer horizons minutes long)."""
+    """Independent integrator: Radau at rtol 1e-10 (atol 1e-13 of the static step deflection) on
+    the first 0.1 s (the stiff, lightly damped high-frequency modes make longer horizons minutes
+    long)."""
     parameters, model = bogie
     op = default_operating_point(parameters, s0)
     result = short_circuit_response(model, op, ShortCircuit(), 0.1, 10_000.0, method="modal")
@@ -183,9 +190,10 @@ def test_closed_form_matches_radau(bogie, s0):
     outputs = output_matrices(model, op)
     C = np.hstack([outputs.C_q, outputs.C_v])
     A, b = system.A, system.b
+    x_scale = np.abs(np.linalg.lstsq(A, -b * u0, rcond=None)[0]).max()  # static step size
     sol = solve_ivp(lambda t, x: A @ x + b * (u0 + (a * np.exp(mu * t)).real), (0, 0.1),
-                    np.zeros(len(b)), method="Radau", t_eval=result.t, rtol=1e-10, atol=1e-16,
-                    jac=A)
+                    np.zeros(len(b)), method="Radau", t_eval=result.t, rtol=1e-10,
+                    atol=1e-13 * x_scale, jac=A)
     assert sol.success
     Y = (C @ sol.y).T
     for j, name in enumerate(outputs.names):
