@@ -56,7 +56,7 @@ class RootLocusPlot:
         self.lines = ColumnDataSource({"xs": [], "ys": []})
         self.points = ColumnDataSource({"x": [], "y": [], "value": [], "zeta": []})
         self.current = ColumnDataSource({"x": [], "y": [], "mode": [], "zeta": [],
-                                         "description": []})
+                                         "description": []}, name="locus_current")
         fig.multi_line("xs", "ys", source=self.lines, line_color="#999999", line_alpha=0.6)
         sweep = fig.scatter("x", "y", source=self.points, size=6,
                             color={"field": "value", "transform": self.mapper}, line_alpha=0.0)
@@ -153,7 +153,7 @@ class ResponsePlots:
     """Torques of both drives with ±M_ad, disc clutch forces, and M_C(t)."""
 
     def __init__(self):
-        self.source = ColumnDataSource({"t": []})
+        self.source = ColumnDataSource({"t": []}, name="response_source")
         self.torque = {}
         self.ad_spans = []
         shared_x = None

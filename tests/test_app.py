@@ -1,0 +1,237 @@
+"""Dashboard tests without a browser: the Viewer object, an in-process render of the whole
+layout into a Bokeh document, and the served app's liveness endpoint.
+
+Expectations come from the model (the dashboard must show what model/ computes), never from
+numbers typed in here.  Building a dashboard computes the stability limit and a root locus
+(seconds), so the tests that build one are marked slow.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import tomllib
+import urllib.request
+
+import numpy as np
+import pytest
+
+from app import compute
+from model import eigen_analysis
+from model.parameters import parse_parameters
+
+CONTROLS = ("s0", "v", "N0", "b_M", "M0", "f", "D", "dt", "t_end")
+
+
+# --- cheap pieces --------------------------------------------------------------------------------
+
+def test_decimation_keeps_every_extreme():
+    t = np.linspace(0.0, 1.0, 100_001)
+    y = np.sin(2 * np.pi * 97 * t) * np.exp(-t)
+    y[54_321] = 7.5  # a one-sample spike must survive
+    td, (yd,) = compute.decimate(t, [y], buckets=500)
+    assert len(td) < 2_100
+    assert yd.max() == y.max()
+    assert yd.min() == y.min()
+    assert np.all(np.diff(td) > 0)
+
+
+def test_mode_drawing_moves_carried_points_rigidly():
+    """A unit roll of the bogie frame moves the secondary spring seats by θ × r."""
+    m = compute.model("", "calibrated")
+    q = np.zeros(m.n)
+    q[m.dofs.index("BF.rx")] = 1.0
+    shift = compute.point_displacements(m, q)
+    r = m.positions["secondary.P1"] - m.positions["BF"]
+    np.testing.assert_allclose(shift["secondary.P1"], np.cross([1.0, 0.0, 0.0], r))
+    assert not np.any(shift["ID1.rim12"])  # the wheelset does not move
+
+
+# --- the dashboard object --------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def dash():
+    from app.dashboard import BogieDashboard
+
+    return BogieDashboard()
+
+
+def _verdict(dashboard) -> bool:
+    m = compute.model("", dashboard.rail)
+    op = compute.operating_point("", dashboard.rail, dashboard.s0, dashboard.v, dashboard.N0,
+                                 dashboard.b_M)
+    return eigen_analysis(m, op, vectors=False).stable
+
+
+@pytest.mark.slow
+def test_status_follows_the_model_and_the_published_cases_flip(dash):
+    for s0 in (0.005, 0.014, 0.005):
+        dash._published_case(s0)
+        expected = "STABLE" if _verdict(dash) else "UNSTABLE"
+        assert dash.s0 == s0
+        assert dash.v == 120.0
+        assert f">{expected}<" in dash.status.object
+    dash._published_case(0.005)
+    stable_text = dash.status.object
+    dash._published_case(0.014)
+    assert dash.status.object != stable_text, "the two published cases must differ in verdict"
+
+
+@pytest.mark.slow
+def test_views_show_the_current_point(dash):
+    dash.param.update(s0=0.0065, v=100.0)
+    m = compute.model("", "calibrated")
+    op = compute.operating_point("", "calibrated", 0.0065, 100.0, dash.N0, dash.b_M)
+    result = eigen_analysis(m, op)
+    # highlighted eigenvalues on the root locus = the model's lowest complex pairs
+    shown = np.array(dash.locus_plot.current.data["x"]) + 1j * np.array(
+        dash.locus_plot.current.data["y"]) * 2 * np.pi
+    np.testing.assert_allclose(shown, result.complex_pairs[: len(shown)], rtol=1e-9)
+    # status details: largest real part, flutter and divergence counts
+    assert f"{result.max_real_part:+.4f}" in dash.details.object
+    assert f"flutter pairs (Re &gt; 0): <b>{result.flutter}</b>" in dash.details.object
+    # the stability limit and the margin to it
+    from model.stability import stability_limit
+
+    limit = stability_limit(m, op.v, op.N0, op.b_M).s0_limit
+    assert f"{limit:.5f}" in dash.details.object
+    assert f"{limit - 0.0065:+.5f}" in dash.details.object
+    # creep characteristic: operating point on the curve, s0* marked
+    assert dash.creep_plot.point.data["s"] == [0.0065]
+    assert dash.creep_plot.limit.visible
+    assert dash.creep_plot.limit.location == pytest.approx(limit)
+    # root locus over s0 at the current speed: colour = s0, branches tracked in columns
+    values = np.array(dash.locus_plot.points.data["value"])
+    assert values.min() == pytest.approx(compute.LOCUS_S0[0])
+    assert len(dash.locus_plot.lines.data["xs"]) == dash.locus_result.eigenvalues.shape[1]
+    # tables: one row per complex pair / real eigenvalue, in Table 1 / Table 2 layout
+    for mode in dash.point.modes:
+        assert mode.description in dash.mode_table.object
+    assert f"{result.real[0]:+.4g}" in dash.eigen_table.object
+
+
+@pytest.mark.slow
+def test_time_histories_change_with_the_excitation(dash):
+    dash.param.update(s0=0.005, v=120.0, M0=50.0)
+    before = dict(dash.response.peaks)
+    source = dash.response_plots.source
+    assert {"t", "M_C", "ID1.disc_clutch.torque", "ID2.driving_shaft.torque"} <= set(source.data)
+    dash.M0 = 80.0
+    after = dash.response.peaks
+    assert abs(after["ID1.driving_shaft.torque"]) != pytest.approx(
+        abs(before["ID1.driving_shaft.torque"]))
+    assert "ID1.driving_shaft.torque" in dash.peaks.object
+    # ±M_ad reference lines at the model's maximal adhesion moment
+    from model import adhesion_moment
+
+    m = compute.model("", "calibrated")
+    expected = adhesion_moment(m.parameters, 120.0 / 3.6, dash.N0 * 1e3)
+    for _, span in dash.response_plots.ad_spans:
+        assert abs(span.location) == pytest.approx(expected)
+    dash.M0 = 50.0
+
+
+@pytest.mark.slow
+def test_speed_locus_on_demand(dash):
+    dash.locus = "v"
+    assert dash.locus_result.parameter == "v"
+    assert dash.locus_plot.colorbar.title == "v [km/h]"
+    dash.locus = "s0"
+    assert dash.locus_plot.colorbar.title == "s0 [-]"
+
+
+@pytest.mark.slow
+def test_rail_condition_changes_the_creep_law(dash):
+    calibrated = list(dash.creep_plot.curve.data["mu"])
+    dash.rail = "wet"
+    assert dash.creep_plot.curve.data["mu"] != calibrated
+    toml = tomllib.loads(dash._toml().read())
+    from model.contact import CREEP_PRESETS
+
+    for name, value in CREEP_PRESETS["wet"].items():
+        assert toml[name]["value"] == value
+    dash.rail = "calibrated"
+    assert dash.creep_plot.curve.data["mu"] == calibrated
+
+
+@pytest.mark.slow
+def test_downloads(dash):
+    csv = dash._csv().read()
+    header, first = csv.splitlines()[:2]
+    assert header.startswith("t [s],ID1.driving_shaft.torque [N m]")
+    assert float(first.split(",")[0]) == 0.0
+    data = np.loadtxt(io.StringIO(csv), delimiter=",", skiprows=1)
+    assert data.shape == (len(dash.response.t), 2 + len(compute.RESPONSE_OUTPUTS))
+    eig = json.loads(dash._json().read())
+    assert eig["stable"] == dash.point.stable
+    assert len(eig["eigenvalues"]) == len(dash.point.eigenvalues)
+    toml = dash._toml().read()
+    parse_parameters(tomllib.loads(toml))  # a valid parameter file
+
+
+@pytest.mark.slow
+def test_rejected_combination_keeps_the_last_result(dash, monkeypatch):
+    from model import OperatingPointError
+
+    dash.s0 = 0.005
+    last = dash.point
+
+    def reject(*args):
+        raise OperatingPointError("creepage s0 = 0.0055 is not allowed: test")
+
+    monkeypatch.setattr(compute, "point_result", reject)
+    dash.s0 = 0.0055
+    assert dash.notice.visible
+    assert "not allowed" in dash.notice.object
+    assert dash.point is last
+    assert "STABLE" in dash.status.object
+    monkeypatch.undo()
+    dash.s0 = 0.005
+    assert not dash.notice.visible
+    assert dash.error == ""
+
+
+@pytest.mark.slow
+def test_sessions_do_not_share_state(dash):
+    from app.dashboard import BogieDashboard
+
+    other = BogieDashboard()
+    other.s0 = 0.014
+    assert dash.s0 != 0.014 or dash.point is not other.point
+    assert other.sliders["s0"] is not dash.sliders["s0"]
+    assert other.sliders["s0"].value == 0.014
+    assert dash.sliders["s0"].value == dash.s0
+
+
+# --- the whole layout rendered into a Bokeh document -------------------------------------------
+
+@pytest.mark.slow
+def test_render_whole_layout(dash):
+    from bokeh.document import Document
+    from bokeh.models import Plot
+
+    from app.serve import create_app
+
+    doc = Document()
+    doc.add_root(create_app().get_root(doc))
+    models = list(doc.models)
+    classes = {c for model in models for c in (getattr(model, "css_classes", None) or [])}
+    for name in CONTROLS:
+        assert f"ctl-{name}" in classes, name
+    assert "stability-status" in classes
+    plots = [model for model in models if isinstance(model, Plot)]
+    assert len(plots) == 8  # locus, creep, 2 torques, forces, M_C, side and top view
+    titled = {model.title for model in models if getattr(model, "css_classes", None)
+              and "ctl-s0" in model.css_classes}
+    assert titled == {"creepage s0 [-]"}
+
+
+# --- served --------------------------------------------------------------------------------------
+
+@pytest.mark.slow
+def test_liveness_endpoint_builds_the_app(app_server):
+    with urllib.request.urlopen(f"{app_server}/liveness?endpoint=/app", timeout=120) as r:
+        assert r.status == 200
+    with urllib.request.urlopen(f"{app_server}/app", timeout=120) as r:
+        assert r.status == 200
+        assert b"Bokeh" in r.read()
