@@ -30,6 +30,7 @@ import numpy as np
 import panel as pn
 import param
 from bokeh.document import without_document_lock
+from threadpoolctl import threadpool_limits
 
 from model import NoStabilityLimit, OperatingPointError, ParameterError
 from model.parameters import dumps_parameters
@@ -42,7 +43,7 @@ ASSETS = Path(__file__).resolve().parent.parent / "assets"
 MODEL_ERRORS = (OperatingPointError, ParameterError, NoStabilityLimit, ValueError,
                 np.linalg.LinAlgError)
 # worker threads shared by all sessions: computations release the GIL in LAPACK
-EXECUTOR = ThreadPoolExecutor(max_workers=2, thread_name_prefix="bogie-compute")
+EXECUTOR = ThreadPoolExecutor(max_workers=3, thread_name_prefix="bogie-compute")
 PUBLISHED_CASES = {"stable": 0.005, "unstable": 0.014}  # s0 at 120 km/h (the study's two cases)
 
 CSS = """
@@ -251,29 +252,44 @@ class BogieDashboard(pn.viewable.Viewer):
                      rnd(self.D, 5), None if self.dt_auto else rnd(self.dt, 4), rnd(self.t_end, 3),
                      self.locus)
 
+    # the four computations of a change; each independent of the others (run in parallel
+    # when served), each with one BLAS thread
     @staticmethod
-    def compute_fast(state: State):
+    def _point(state: State):
+        with threadpool_limits(1):
+            return compute.point_result(*state.point)
+
+    @staticmethod
+    def _response(state: State):
+        with threadpool_limits(1):
+            return compute.response_result(*state.point, state.M0, state.f, state.D, state.dt,
+                                           state.t_end)
+
+    @staticmethod
+    def _limit(state: State):
+        with threadpool_limits(1):
+            return compute.limit_result(state.params_path, state.rail, state.v, state.N0,
+                                        state.b_M)
+
+    @staticmethod
+    def _locus(state: State):
+        fixed = state.v if state.locus == "s0" else state.s0
+        with threadpool_limits(1):
+            return compute.locus_result(state.params_path, state.rail, state.locus, fixed,
+                                        state.N0, state.b_M)
+
+    def compute_fast(self, state: State):
         """(point result, response result) for a state (raises a MODEL_ERRORS on rejection)."""
-        from threadpoolctl import threadpool_limits
+        return self._point(state), self._response(state)
 
-        with threadpool_limits(1):
-            point = compute.point_result(*state.point)
-            response = compute.response_result(*state.point, state.M0, state.f, state.D,
-                                               state.dt, state.t_end)
-        return point, response
+    def compute_slow(self, state: State):
+        """(stability limit, root locus) for a state."""
+        return self._limit(state), self._locus(state)
 
     @staticmethod
-    def compute_slow(state: State):
-        """(stability limit, root locus) for a state."""
-        from threadpoolctl import threadpool_limits
-
-        with threadpool_limits(1):
-            limit = compute.limit_result(state.params_path, state.rail, state.v, state.N0,
-                                         state.b_M)
-            fixed = state.v if state.locus == "s0" else state.s0
-            locus = compute.locus_result(state.params_path, state.rail, state.locus, fixed,
-                                         state.N0, state.b_M)
-        return limit, locus
+    async def _parallel(loop, state: State, *functions):
+        futures = [loop.run_in_executor(EXECUTOR, f, state) for f in functions]
+        return tuple(await asyncio.gather(*futures))
 
     def refresh(self, slow: bool = True) -> None:
         """Compute and show everything synchronously (initial view, tests); ``slow=False``
@@ -326,7 +342,7 @@ class BogieDashboard(pn.viewable.Viewer):
                 if self._dirty:
                     continue
                 try:
-                    slow = await loop.run_in_executor(EXECUTOR, self.compute_slow, state)
+                    slow = await self._parallel(loop, state, self._limit, self._locus)
                 except MODEL_ERRORS as error:
                     doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
                     continue

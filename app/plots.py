@@ -54,7 +54,8 @@ class RootLocusPlot:
                              text_color=UNSTABLE, text_font_size="11px"))
         self.mapper = LinearColorMapper(palette=Viridis256, low=0.0, high=1.0)
         self.lines = ColumnDataSource({"xs": [], "ys": []})
-        self.points = ColumnDataSource({"x": [], "y": [], "value": [], "zeta": []})
+        self.points = ColumnDataSource({"x": [], "y": [], "value": [], "zeta": []},
+                                       name="locus_points")
         self.current = ColumnDataSource({"x": [], "y": [], "mode": [], "zeta": [],
                                          "description": []}, name="locus_current")
         fig.multi_line("xs", "ys", source=self.lines, line_color="#999999", line_alpha=0.6)
