@@ -175,9 +175,9 @@ def test_bad_arguments_raise_one_line_errors(bogie):
 @pytest.mark.slow
 @pytest.mark.parametrize("s0", [0.005, 0.014])
 def test_closed_form_matches_radau(bogie, s0):
-    """Independent integrator: Radau at rtol 1e-10 (atol 1e-13 of the static step deflection) on
-    the first 0.1 s (the stiff, lightly damped high-frequency modes make longer horizons minutes
-    long)."""
+    """Independent integrator: Radau at rtol 1e-9 (atol 1e-12 of the static step deflection) on
+    the first 0.1 s (the stiff, lightly damped high-frequency modes make longer horizons, or
+    rtol 1e-10, many minutes long)."""
     parameters, model = bogie
     op = default_operating_point(parameters, s0)
     result = short_circuit_response(model, op, ShortCircuit(), 0.1, 10_000.0, method="modal")
@@ -192,8 +192,8 @@ def test_closed_form_matches_radau(bogie, s0):
     A, b = system.A, system.b
     x_scale = np.abs(np.linalg.lstsq(A, -b * u0, rcond=None)[0]).max()  # static step size
     sol = solve_ivp(lambda t, x: A @ x + b * (u0 + (a * np.exp(mu * t)).real), (0, 0.1),
-                    np.zeros(len(b)), method="Radau", t_eval=result.t, rtol=1e-10,
-                    atol=1e-13 * x_scale, jac=A)
+                    np.zeros(len(b)), method="Radau", t_eval=result.t, rtol=1e-9,
+                    atol=1e-12 * x_scale, jac=A)
     assert sol.success
     Y = (C @ sol.y).T
     for j, name in enumerate(outputs.names):
