@@ -233,7 +233,7 @@ class BogieDashboard(pn.viewable.Viewer):
             self.mode_select,
             pn.Row(*(bokeh_pane(f) for f in self.mode_plot.figures), sizing_mode="stretch_width"),
             "### Schematic of the bogie (names used in the tables)",
-            pn.pane.SVG(schematic, sizing_mode="stretch_width", max_width=1100)
+            pn.pane.SVG(schematic, width=640)
             if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*"),
             sizing_mode="stretch_width")
         self.layout = pn.Row(

@@ -176,7 +176,7 @@ class ResponsePlots:
             fig.legend.click_policy = "hide"
             fig.legend.label_text_font_size = "10px"
             self.torque[drive] = fig
-        self.forces = _figure("Disc clutch forces (ID1 solid, ID2 dashed)", "t [s]",
+        self.forces = _figure("Disc clutch forces (ID1 —, ID2 - -)", "t [s]",
                               "force [N]", x_range=shared_x)
         for quantity, color in zip(FORCES, Category10_10[2:5], strict=True):
             axis = quantity[-1]
@@ -206,8 +206,8 @@ class ResponsePlots:
         self.ad_label.text = f"dashed: ±M_ad = ±{response.M_ad:,.0f} N m"
         for fig in self.figures[:3]:
             fig.title.text = fig.title.text.split(" — ")[0] + (
-                f" — UNSTABLE growth: shown until t = {response.plot_cut:.3f} s "
-                f"(|M| > 4 M_ad)" if response.plot_cut is not None else "")
+                f" — UNSTABLE: growth, shown to {response.plot_cut:.3f} s"
+                if response.plot_cut is not None else "")
 
 
 # --- mode shapes -------------------------------------------------------------------------------

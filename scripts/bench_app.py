@@ -98,6 +98,19 @@ async def settle_n0(page, presses: int) -> None:
         await step(page, "ctl-N0", "ArrowLeft", SLOW, timeout=300_000)
 
 
+async def screenshots(browser, url: str) -> None:
+    out = ROOT / "assets" / "screenshots"
+    out.mkdir(parents=True, exist_ok=True)
+    page = await open_page(browser, url)
+    for case in ("stable", "unstable"):
+        await page.locator(f".case-{case} button").click()
+        word = "UNSTABLE" if case == "unstable" else "STABLE"
+        await page.locator(".stability-status", has_text=word).wait_for()
+        await wait_idle(page)
+        await page.screenshot(path=str(out / f"{case}.png"), full_page=True)
+    await page.close()
+
+
 async def run(args) -> dict:
     from playwright.async_api import async_playwright
 
@@ -108,6 +121,9 @@ async def run(args) -> dict:
     try:
         async with async_playwright() as p:
             browser = await p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+            if args.only_screenshots:
+                await screenshots(browser, url)
+                return results
             # 1 + 2: one session
             page = await open_page(browser, url)
             await settle_n0(page, 1)  # own N0 = 99 kN: nothing cached from earlier runs
@@ -138,16 +154,7 @@ async def run(args) -> dict:
             for pg in pages:
                 await pg.close()
             if args.screenshots:
-                out = ROOT / "assets" / "screenshots"
-                out.mkdir(parents=True, exist_ok=True)
-                page = await open_page(browser, url)
-                for case in ("stable", "unstable"):
-                    await page.locator(f".case-{case} button").click()
-                    word = "UNSTABLE" if case == "unstable" else "STABLE"
-                    await page.locator(".stability-status", has_text=word).wait_for()
-                    await wait_idle(page)
-                    await page.screenshot(path=str(out / f"{case}.png"), full_page=True)
-                await page.close()
+                await screenshots(browser, url)
             await browser.close()
     finally:
         server.terminate()
@@ -162,9 +169,12 @@ def main() -> None:
     parser.add_argument("--sessions", type=int, default=10)
     parser.add_argument("--concurrent-presses", type=int, default=5)
     parser.add_argument("--screenshots", action="store_true")
+    parser.add_argument("--only-screenshots", action="store_true")
     parser.add_argument("--json", default=None, help="write the raw numbers here")
     args = parser.parse_args()
     results = asyncio.run(run(args))
+    if args.only_screenshots:
+        return
     single = statistics.median(results["single_fast_s"])
     concurrent = statistics.median(results["concurrent_fast_s"])
     locus = statistics.median(results["locus_refresh_s"])
