@@ -11,7 +11,6 @@ import re
 import numpy as np
 import pytest
 import scipy.linalg as sla
-from threadpoolctl import threadpool_limits
 
 from model import (
     build_model,
@@ -34,15 +33,6 @@ N_DOF = 193
 # sign of each coordinate under the central symmetry (180° about z): x, y → −x, −y; z → z; the
 # rotations are axial vectors of a proper rotation and transform alike: rx, ry → −; rz → +.
 SYMMETRY_SIGN = {"x": -1.0, "y": -1.0, "z": 1.0, "rx": -1.0, "ry": -1.0, "rz": 1.0}
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _one_blas_thread():
-    """Dense 386 x 386 eigenproblems run fastest on one BLAS thread, and OpenBLAS threads that
-    busy-wait against another process on the same cores slow an eigen-analysis from ~0.1 s to
-    ~9 s (measured on the 2-core machine); pin BLAS to one thread for this module."""
-    with threadpool_limits(1):
-        yield
 
 
 @pytest.fixture(scope="module", params=["calibrated", "estimate"])

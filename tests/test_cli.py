@@ -14,7 +14,6 @@ import sys
 
 import numpy as np
 import pytest
-from threadpoolctl import threadpool_limits
 
 from model import build_model, eigen_analysis, load_parameters, motor_torque
 from model.cli import main
@@ -25,15 +24,6 @@ from model.parameters import ESTIMATE_FILE, dumps_parameters
 
 EIGEN_KEYS = {"operating_point", "stable", "complex", "real", "rigid_body"}
 EXPORT_ARRAYS = {"M", "B", "K", "dofs", "f_mc", "motor_torque", "C_q", "C_v", "outputs"}
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _one_blas_thread():
-    """Dense 386 x 386 eigenproblems run fastest on one BLAS thread, and OpenBLAS threads that
-    busy-wait against another process on the same cores slow an eigen-analysis from ~0.1 s to
-    ~9 s (measured on the 2-core machine); pin BLAS to one thread for this module."""
-    with threadpool_limits(1):
-        yield
 
 
 def run(argv: list[str], capsys) -> tuple[int, str, str]:

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from threadpoolctl import threadpool_limits
 
 from model import OperatingPoint, build_model, eigen_analysis, load_parameters, mode_character
 from model.calibration import (
@@ -52,13 +51,12 @@ MISSED_MODES = {
 
 @pytest.fixture(scope="module")
 def calibrated():
-    with threadpool_limits(1):
-        parameters = load_parameters()
-        model = build_model(parameters)
-        op = OperatingPoint(0.005, V_REF, parameters["wheel_force"], parameters["motor_slope"])
-        result = eigen_analysis(model, op)
-        matched, _ = match_table1_modes(model, result)
-        yield parameters, model, result, matched
+    parameters = load_parameters()
+    model = build_model(parameters)
+    op = OperatingPoint(0.005, V_REF, parameters["wheel_force"], parameters["motor_slope"])
+    result = eigen_analysis(model, op)
+    matched, _ = match_table1_modes(model, result)
+    return parameters, model, result, matched
 
 
 def _mark(k: int):
@@ -131,8 +129,7 @@ def test_unstable_pattern_as_published(calibrated):
 
 def test_stability_limit_within_3_percent(calibrated):
     parameters, model, _, _ = calibrated
-    with threadpool_limits(1):
-        limit = stability_limit(model, V_REF, parameters["wheel_force"], parameters["motor_slope"])
+    limit = stability_limit(model, V_REF, parameters["wheel_force"], parameters["motor_slope"])
     assert limit.s0_limit == pytest.approx(STABILITY_LIMIT, rel=0.03)
 
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from threadpoolctl import threadpool_limits
 
 from model import OperatingPointError, build_model, default_operating_point, load_parameters
 from model.locus import dense_generalized_eigenvalues, root_locus
@@ -15,12 +14,11 @@ CONTROLLED = 1.5 * 2 * np.pi * 20.0  # |λ| inside which the tolerance is enforc
 
 @pytest.fixture(scope="module")
 def setup():
-    with threadpool_limits(1):
-        parameters = load_parameters()
-        model = build_model(parameters)
-        op = default_operating_point(parameters)
-        s0 = np.linspace(0.002, 0.016, 30)
-        yield model, op, s0, root_locus(model, op, "s0", s0)
+    parameters = load_parameters()
+    model = build_model(parameters)
+    op = default_operating_point(parameters)
+    s0 = np.linspace(0.002, 0.016, 30)
+    return model, op, s0, root_locus(model, op, "s0", s0)
 
 
 def test_tracked_eigenvalues_equal_dense_solution(setup):

@@ -20,7 +20,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
-from threadpoolctl import threadpool_limits
 
 from model import (
     build_model,
@@ -46,15 +45,6 @@ RTOL = 1e-8
 ATOL = 1e-7  # [1/s]
 # brentq stops within xtol = 1e-7 of the root; two runs may land anywhere in that bracket
 LIMIT_ATOL = 2e-7
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _one_blas_thread():
-    """Dense 386 x 386 eigenproblems run fastest on one BLAS thread, and OpenBLAS threads that
-    busy-wait against another process on the same cores slow an eigen-analysis from ~0.1 s to
-    ~9 s (measured on the 2-core machine); pin BLAS to one thread for this module."""
-    with threadpool_limits(1):
-        yield
 
 
 @pytest.fixture(scope="module")
