@@ -226,7 +226,9 @@ def _assign(previous_vectors, previous_values, vectors, values):
     rows, columns = linear_sum_assignment((1 - mac) + distance)
     chosen = np.empty(len(previous_values), dtype=int)
     chosen[rows] = columns
-    return chosen, bool(np.all(mac[rows, columns] > 0.5))
+    # unambiguous: similar mode shape, or (for near-repeated twins of ID1/ID2, whose eigenvectors
+    # mix freely) an eigenvalue that moved by less than 5 % of its size
+    return chosen, bool(np.all((mac[rows, columns] > 0.5) | (distance[rows, columns] < 0.05)))
 
 
 def dense_generalized_eigenvalues(model: BogieModel, op: OperatingPoint) -> np.ndarray:
