@@ -289,10 +289,3 @@ def response_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN:
                    if c.output in outputs],
         plot_t=plot_t, plot_outputs=dict(zip(RESPONSE_OUTPUTS, plot_ys[:-1], strict=True)),
         plot_M_C=plot_ys[-1])
-
-
-def response_available() -> bool:
-    """Whether model/response.py exists (it was written in parallel with the dashboard)."""
-    import importlib.util
-
-    return importlib.util.find_spec("model.response") is not None
