@@ -236,9 +236,6 @@ def cmd_serve(args: argparse.Namespace) -> None:
           params=args.params)
 
 
-COMMANDS: dict[str, tuple[Callable, str]] = {}
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="bogie", description="Locomotive bogie drive dynamics: eigenvalues, "
                      "stability and traction-motor short-circuit response.")

@@ -22,7 +22,6 @@ from .assembly import DRIVES, RIM_NODES, BogieModel
 from .operating_point import (
     OperatingPoint,
     creep_coefficients,
-    damping_matrix,
     longitudinal_creep_pattern,
     motor_torque,
 )
@@ -115,8 +114,3 @@ def static_deflection(model: BogieModel, op: OperatingPoint) -> np.ndarray:
     bordered = np.block([[model.K, R], [R.T, np.zeros((r, r))]])
     solution = np.linalg.solve(bordered, np.concatenate([f, np.zeros(r)]))
     return solution[:n]
-
-
-def total_damping(model: BogieModel, op: OperatingPoint) -> np.ndarray:
-    """Alias of :func:`model.operating_point.damping_matrix` for exports."""
-    return damping_matrix(model, op)
