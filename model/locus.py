@@ -16,8 +16,9 @@ Method — a reduced model whose error is estimated at every point and bounded b
    damped branch that leaves it is still tracked and its estimate recorded).  Where the estimate
    exceeds ``rtol·|λ|`` for a few branches, those are refined by Newton's method on the full
    model (quadratic convergence; the last step size is the recorded error); where it fails for
-   many, or the MAC tracking is ambiguous, the point is solved densely and the basis is enriched
-   with that point's tracked eigenvectors.
+   many, or the MAC tracking is ambiguous, the point is solved densely (exact there).
+   The reduced eigenproblems of the inner points are independent of each other and are solved
+   first, on ``workers`` threads; tracking and error control then run through them in order.
 4. Branches are continued from point to point by an optimal assignment on ``1 − MAC`` plus the
    normalized eigenvalue distance, so branches do not swap at near-crossings.
 
@@ -27,6 +28,7 @@ The naive reference (:func:`dense_generalized_eigenvalues`) solves the generaliz
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -49,7 +51,7 @@ class RootLocus:
     error_estimate: np.ndarray  # (n_points, n_branches) estimated relative error (0: exact)
     dense_points: np.ndarray  # (n_points,) bool: solved densely (exact) at that point
     operating_point: OperatingPoint  # the fixed quantities of the sweep
-    basis_size: int  # columns of the reduction basis Φ at the end
+    basis_size: int  # columns of the reduction basis Φ
     newton_refinements: int  # branch-points refined by Newton's method on the full model
 
     @property
@@ -118,14 +120,15 @@ class _Reduced:
         A[:r, r:] = np.eye(r)
         A[r:, :r] = -self.K_r
         A[r:, r:] = -C
-        lam, V = sla.eig(A, overwrite_a=True, check_finite=False)
+        lam, V = np.linalg.eig(A)  # numpy releases the GIL: the points run on several threads
         X = self.Linv.T @ V[:r]  # back from mass-normalized to Φ coordinates
         X /= np.linalg.norm(X, axis=0)
         return lam, X
 
     def error_estimate(self, c: np.ndarray, lam: np.ndarray, X: np.ndarray) -> np.ndarray:
         """First-order relative eigenvalue error from the full-model residual."""
-        CX = self.C0_Phi @ X + sum(ck * (P @ X) for ck, P in zip(c, self.P_Phi, strict=True))
+        C_Phi = self.C0_Phi + sum(ck * P for ck, P in zip(c, self.P_Phi, strict=True))
+        CX = C_Phi @ X
         MX = self.M_Phi @ X
         residual = lam**2 * MX + lam * CX + self.K_Phi @ X
         derivative = 2 * lam * MX + CX
@@ -134,10 +137,11 @@ class _Reduced:
 
 
 def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
-               max_frequency_hz: float = 20.0, rtol: float = 1e-6) -> RootLocus:
+               max_frequency_hz: float = 20.0, rtol: float = 1e-6, workers: int = 2) -> RootLocus:
     """Track the non-rigid eigenvalues with |λ| < 2π·max_frequency_hz (at the first value) while
     ``parameter`` ("s0" [-] or "v" [m/s]) runs through ``values``; the other quantities of the
-    operating point ``op`` stay fixed."""
+    operating point ``op`` stay fixed.  ``workers`` threads solve the reduced eigenproblems
+    (default 2, the cores of the target machine)."""
     if parameter not in ("s0", "v"):
         raise ValueError(f"parameter must be 's0' or 'v', got '{parameter}'")
     values = np.asarray(values, dtype=float)
@@ -160,8 +164,12 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
         return [chosen.real, chosen.imag]
 
     first, last = exact(0), exact(n_points - 1)
-    basis = [model.rigid_body_modes, *modes(*first), *modes(*last)]
-    reduced = _Reduced(model, op, patterns, basis)
+    reduced = _Reduced(model, op, patterns,
+                       [model.rigid_body_modes, *modes(*first), *modes(*last)])
+    # the reduced eigenproblems of the inner points do not depend on each other: solve them on
+    # ``workers`` threads (numpy's LAPACK calls release the GIL), then track and check in order
+    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
+        solutions = list(pool.map(reduced.solve, coefficients[1:-1]))
     tracked = np.flatnonzero(np.abs(first[0]) < radius)
     eigenvalues = np.zeros((n_points, len(tracked)), dtype=complex)
     errors = np.zeros((n_points, len(tracked)))
@@ -171,14 +179,14 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     refined = 0
 
     for i in range(1, n_points):
-        lam, X = reduced.solve(coefficients[i])
-        X_full = reduced.Phi @ X
-        chosen, ok = _assign(previous_vectors, previous_values, X_full, lam)
-        estimate = reduced.error_estimate(coefficients[i], lam[chosen], X[:, chosen])
-        if ok and i != n_points - 1:
+        if i != n_points - 1:
+            lam, X = solutions[i - 1]
+            X_full = reduced.Phi @ X
+            chosen, ok = _assign(previous_vectors, previous_values, X_full, lam)
+            estimate = reduced.error_estimate(coefficients[i], lam[chosen], X[:, chosen])
             values_i, vectors_i = lam[chosen], X_full[:, chosen]
             failing = np.flatnonzero((estimate > rtol) & (np.abs(values_i) < controlled))
-            if len(failing) <= max(2, len(chosen) // 4):
+            if ok and len(failing) <= max(2, len(chosen) // 4):
                 # refine the few inaccurate branches by Newton's method in the full model
                 C = damping_matrix(model, points[i])
                 for b in failing:
@@ -189,11 +197,8 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
                     eigenvalues[i], errors[i] = values_i, estimate
                     previous_values, previous_vectors = values_i, vectors_i
                     continue
-        lam, Q = last if i == n_points - 1 else exact(i)
+        lam, Q = last if i == n_points - 1 else exact(i)  # dense: exact at this point
         chosen, _ = _assign(previous_vectors, previous_values, Q, lam)
-        if i != n_points - 1:  # enrich with every tracked branch's exact eigenvector here
-            basis += [Q[:, chosen].real, Q[:, chosen].imag]
-            reduced = _Reduced(model, op, patterns, basis)
         eigenvalues[i], dense[i] = lam[chosen], True
         previous_values, previous_vectors = lam[chosen], Q[:, chosen]
     return RootLocus(parameter, values, eigenvalues, errors, dense, op, reduced.size, refined)
