@@ -175,9 +175,10 @@ def operating_rows(parameters: Parameters) -> list[TargetRow]:
     return rows
 
 
-def frequency_rows(parameters: Parameters) -> list[TargetRow]:
-    """Table 1 imaginary parts (matched by character) and the driving-shaft mode."""
-    model = build_model(parameters)
+def frequency_rows(parameters: Parameters, model=None) -> list[TargetRow]:
+    """Table 1 imaginary parts (matched by character) and the driving-shaft mode; ``model`` is
+    the model built from ``parameters`` if the caller has it already."""
+    model = build_model(parameters) if model is None else model
     stable = eigen_analysis(model, OperatingPoint(S0_STABLE, V_REF, parameters["wheel_force"],
                                                   parameters["motor_slope"]))
     matched, _ = match_table1_modes(model, stable)
@@ -195,7 +196,7 @@ def evaluate(parameters: Parameters) -> list[TargetRow]:
     model = build_model(parameters)
     unstable = eigen_analysis(model, OperatingPoint(S0_UNSTABLE, V_REF, parameters["wheel_force"],
                                                     parameters["motor_slope"]), vectors=False)
-    return [*frequency_rows(parameters), *operating_rows(parameters),
+    return [*frequency_rows(parameters, model), *operating_rows(parameters),
             TargetRow("largest real eigenvalue at s0=0.014 (not fitted)", DIVERGENCE_RATE,
                       float(unstable.real.max()), "1/s")]
 

@@ -98,8 +98,8 @@ class _Reduced:
         self.M_Phi = model.M @ Phi
         self.K_Phi = model.K @ Phi
         C0 = model.B + op.b_M * model.motor_pattern
-        self.C0_Phi, self.C0t_Phi = C0 @ Phi, C0.T @ Phi
-        self.P_Phi, self.Pt_Phi = [P @ Phi for P in patterns], [P.T @ Phi for P in patterns]
+        self.C0_Phi = C0 @ Phi
+        self.P_Phi = [P @ Phi for P in patterns]
         # mass-normalize the reduced coordinates: Φᵀ M Φ = L Lᵀ
         L = np.linalg.cholesky(Phi.T @ self.M_Phi)
         self.Linv = sla.solve_triangular(L, np.eye(len(L)), lower=True)
@@ -159,8 +159,8 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
         q = result.vectors[:n]
         return result.eigenvalues, q / np.linalg.norm(q, axis=0)
 
-    def modes(lam, Q, factor=1.0):
-        chosen = Q[:, np.abs(lam) < factor * radius]
+    def modes(lam, Q):
+        chosen = Q[:, np.abs(lam) < radius]
         return [chosen.real, chosen.imag]
 
     first, last = exact(0), exact(n_points - 1)
