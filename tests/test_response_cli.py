@@ -9,19 +9,10 @@ import sys
 
 import numpy as np
 import pytest
-
-from model.cli import main
+from test_cli import run  # the in-process CLI runner (tests/ is on sys.path under pytest)
 
 BASE = ["response", "--t-end", "0.2", "--fs", "1000"]
 
-
-def run(argv, capsys):
-    try:
-        code = main(argv)
-    except SystemExit as exit_:
-        code = exit_.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_summary_table_lists_every_output_with_peaks_and_frequencies(capsys):
