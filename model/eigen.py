@@ -4,7 +4,8 @@ State ``u = [Δq; Δq̇]``, ``u̇ = A u`` with ``A = [[0, I], [−M⁻¹K, −M�
 zero eigenvalues are *identified*, not guessed: every vector ``r`` with ``K r = 0`` (the rigid spin
 of each whole drivetrain, known from the kinematics and checked against K) gives the exact
 eigenpair ``(0, [r; 0])`` whatever the damping, and the invariant subspace they span is deflated
-before the eigenvalues of the rest are computed.
+before the eigenvalues of the rest are computed (:mod:`model.linear_system`).  The decomposition
+with vectors is shared with the short-circuit response through :func:`bogie_system`.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .assembly import BogieModel
+from .linear_system import LinearSystem, SystemCache
 from .operating_point import OperatingPoint, damping_matrix
 
 
@@ -33,14 +35,6 @@ class StateSpace:
     @cached_property
     def minus_Minv_K(self) -> np.ndarray:
         return -self.inverse_mass @ self.model.K
-
-    @cached_property
-    def deflation(self) -> tuple[np.ndarray, np.ndarray]:
-        """Orthonormal bases (Q1 of the rigid-body subspace [r; 0], Q2 of its complement)."""
-        rigid = np.vstack([self.model.rigid_body_modes, np.zeros_like(self.model.rigid_body_modes)])
-        Q, _ = np.linalg.qr(rigid, mode="complete")
-        r = rigid.shape[1]
-        return Q[:, :r], Q[:, r:]
 
     def state_matrix(self, B_total: np.ndarray) -> np.ndarray:
         n = self.model.n
@@ -123,18 +117,32 @@ class EigenResult:
         return q / q[np.argmax(np.abs(q))]
 
 
+def bogie_system(model: BogieModel, op: OperatingPoint, cached: bool = True) -> LinearSystem:
+    """The bogie at ``op`` as a :class:`LinearSystem` (input: the short-circuit torque M_C on
+    ID1's rotor and stator).  ``cached``: kept with the last few operating points of the model, so
+    that the eigen-analysis and the response at one point share one eigendecomposition."""
+    def build() -> LinearSystem:
+        return LinearSystem(model.M, damping_matrix(model, op), model.K,
+                            model.short_circuit_force, model.rigid_body_modes,
+                            state_space(model).inverse_mass)
+    if not cached:
+        return build()
+    cache = model.__dict__.setdefault("_systems", SystemCache())
+    return cache.get(op, build)
+
+
 def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) -> EigenResult:
-    """All eigenvalues (and eigenvectors) at ``op`` with the rigid-body ones deflated."""
-    ss = state_space(model)
-    A = ss.state_matrix(damping_matrix(model, op))
-    Q1, Q2 = ss.deflation
-    A22 = Q2.T @ A @ Q2
+    """All eigenvalues (and eigenvectors) at ``op`` with the rigid-body ones deflated.
+
+    With ``vectors`` the decomposition is cached for the operating point (the response reuses
+    it); without, a point already decomposed is not decomposed again, and a new one is not kept
+    (root finding and sweeps would only evict the points the user is looking at)."""
+    n_rigid = model.rigid_body_modes.shape[1]
     if not vectors:
-        return EigenResult(op, sla.eigvals(A22, overwrite_a=True, check_finite=False), None,
-                           Q1.shape[1])
-    lam, Y = sla.eig(A22, overwrite_a=False, check_finite=False)
-    # back to the full state: A [Q1 Q2] = [Q1 Q2] [[0, A12], [0, A22]]  =>  x = Q2 y + Q1 A12 y / λ
-    A12 = Q1.T @ A @ Q2
-    X = Q2 @ Y + Q1 @ ((A12 @ Y) / lam)
-    X /= np.linalg.norm(X, axis=0)
-    return EigenResult(op, lam, X, Q1.shape[1])
+        cache = model.__dict__.get("_systems")
+        system = cache.peek(op) if cache is not None else None
+        if system is None:
+            system = bogie_system(model, op, cached=False)
+        return EigenResult(op, system.eigenvalues(), None, n_rigid)
+    system = bogie_system(model, op)
+    return EigenResult(op, system.eigen[0], system.state_vectors(), n_rigid)

@@ -50,19 +50,19 @@ exceed 1e250 the time grid is cut there and ``truncated_at`` says when.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft
 import scipy.linalg as sla
-from scipy.linalg.lapack import zgecon
 
 from .assembly import BogieModel
+from .eigen import bogie_system
+from .linear_system import LinearSystem
 from .operating_point import (
     OperatingPoint,
     adhesion_moment,
     creep_law,
-    damping_matrix,
     motor_torque,
 )
 from .outputs import output_matrices, static_deflection
@@ -148,98 +148,6 @@ class ShortCircuit:
 
 # --- exact LTI core ------------------------------------------------------------------------------
 
-@dataclass
-class LinearSystem:
-    """``M q̈ + B q̇ + K q = f u(t)`` with outputs ``y = C_q q + C_v q̇``, rigid modes ``K R = 0``.
-
-    The pieces of the exact solution that depend only on the system (not on u) are cached here.
-    """
-
-    M: np.ndarray  # n x n, symmetric positive definite
-    B: np.ndarray  # n x n (any)
-    K: np.ndarray  # n x n, symmetric, null space spanned exactly by R
-    f: np.ndarray  # n, generalized force per unit input
-    R: np.ndarray  # n x r rigid-body modes (r may be 0)
-    _cache: dict = field(default_factory=dict, repr=False)
-
-    @property
-    def n(self) -> int:
-        return self.M.shape[0]
-
-    def _get(self, key, build):
-        if key not in self._cache:
-            self._cache[key] = build()
-        return self._cache[key]
-
-    @property
-    def A(self) -> np.ndarray:
-        def build():
-            n = self.n
-            Minv = sla.cho_solve(sla.cho_factor(self.M), np.eye(n))
-            A = np.zeros((2 * n, 2 * n))
-            A[:n, n:] = np.eye(n)
-            A[n:, :n] = -Minv @ self.K
-            A[n:, n:] = -Minv @ self.B
-            return A
-        return self._get("A", build)
-
-    @property
-    def b(self) -> np.ndarray:
-        def build():
-            n = self.n
-            return np.concatenate([np.zeros(n), sla.cho_solve(sla.cho_factor(self.M), self.f)])
-        return self._get("b", build)
-
-    @property
-    def deflation(self) -> tuple[np.ndarray, np.ndarray]:
-        """Orthonormal bases Q1 of the rigid subspace [R; 0] (exact eigenvectors of A for λ = 0)
-        and Q2 of its orthogonal complement."""
-        def build():
-            n, r = self.n, self.R.shape[1]
-            if r == 0:
-                return np.zeros((2 * n, 0)), np.eye(2 * n)
-            Q, _ = np.linalg.qr(np.vstack([self.R, np.zeros_like(self.R)]), mode="complete")
-            return Q[:, :r], Q[:, r:]
-        return self._get("deflation", build)
-
-    @property
-    def modal(self) -> tuple[np.ndarray, np.ndarray, tuple, float, np.ndarray]:
-        """Eigen-decomposition of A22 = Q2ᵀ A Q2 = T Yb Λ Yb⁻¹ T⁻¹ with the diagonal balancing
-        T = diag(scale) (powers of 2, exact): λ, unit eigenvectors Yb of the balanced matrix, the
-        LU factors of Yb, its condition number (1-norm, LAPACK estimate) and the scale.
-        Balancing puts displacements and velocities on one footing (|λ| spans 0.3…3·10⁵ 1/s)
-        and lowers cond(Yb) by two orders of magnitude against the unbalanced eigenvectors."""
-        def build():
-            _, Q2 = self.deflation
-            A22 = Q2.T @ self.A @ Q2
-            balanced, (scale, _) = sla.matrix_balance(A22, permute=False, separate=True)
-            lam, Y = np.linalg.eig(balanced)
-            Y = Y / np.linalg.norm(Y, axis=0)
-            lu = sla.lu_factor(Y, check_finite=False)
-            rcond, _ = zgecon(lu[0], np.abs(Y).sum(axis=0).max(), norm="1")
-            return lam, Y, lu, (1.0 / rcond if rcond > 0 else math.inf), scale
-        return self._get("modal", build)
-
-    def step_particular(self, u0: float) -> tuple[np.ndarray, np.ndarray]:
-        """(α, β) with x_p = α + β t solving ẋ = A x + b u0 [state units]."""
-        n, R = self.n, self.R
-        r = R.shape[1]
-        fu = self.f * u0
-        if r == 0:
-            q = np.linalg.solve(self.K, fu)
-            return np.concatenate([q, np.zeros(n)]), np.zeros(2 * n)
-        c = np.linalg.solve(R.T @ self.B @ R, R.T @ fu)  # spin velocities of the drift
-        v = R @ c
-        bordered = np.block([[self.K, R], [R.T, np.zeros((r, r))]])
-        q = np.linalg.solve(bordered, np.concatenate([fu - self.B @ v, np.zeros(r)]))[:n]
-        return np.concatenate([q, v]), np.concatenate([v, np.zeros(n)])
-
-    def exponential_particular(self, a: complex, mu: complex) -> np.ndarray:
-        """x_μ with x_p = Re(x_μ e^(μt)) solving ẋ = A x + b Re(a e^(μt))."""
-        q = np.linalg.solve(mu * mu * self.M + mu * self.B + self.K, self.f * a)
-        return np.concatenate([q, mu * q])
-
-
 def _grid_exponentials(lam: np.ndarray, n_points: int, dt: float, block: int):
     """exp(λ t) on t = k dt as E_block (block x r), E_outer (n_blocks x r): t = (a·block + b) dt."""
     b = np.arange(block) * dt
@@ -252,19 +160,20 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
     """Perturbation outputs y (n_points x p) by the modal closed form; (y, error estimate relative
     to the largest |y|, number of valid points, highest frequency [Hz] of a mode contributing
     more than 1 % of some output's peak)."""
-    Q1, Q2 = system.deflation
+    deflation, r = system.deflation, system.R.shape[1]
     lam, Y, lu, cond, scale = system.modal  # A22 = (T Y) Λ (T Y)⁻¹, T = diag(scale)
     alpha, beta = system.step_particular(u0)
     x_mu = system.exponential_particular(a, mu)
     xh0 = -(alpha + x_mu.real)
-    c0 = Q2.T @ xh0
-    a0 = Q1.T @ xh0
+    z0 = deflation.apply_transpose(xh0)  # [Q1ᵀ; Q2ᵀ] x_h(0)
+    a0, c0 = z0[:r], z0[r:]
     d = sla.lu_solve(lu, (c0 / scale).astype(complex), check_finite=False)
-    W = ((C @ Q2) * scale) @ Y  # p x m
-    CQ1 = C @ Q1
+    CQ = deflation.apply_transpose(C.T).T  # C [Q1 Q2]
+    CQ1 = CQ[:, :r]
+    W = (CQ[:, r:] * scale) @ Y  # p x m
     if CQ1.size and np.abs(CQ1).max() > 0.0:
         # rigid coordinates: ȧ = A12 c  ->  a(t) = a0 + A12 Y diag((e^(λt) − 1)/λ) d
-        A12 = Q1.T @ system.A @ Q2
+        A12 = system.reduced[0]
         G = CQ1 @ ((A12 * scale) @ Y)
         W = W + G / lam
         const_h = CQ1 @ a0 - (G / lam) @ d
@@ -421,17 +330,6 @@ class ResponseResult:
         return self.outputs[name] - self.steady[name]
 
 
-def _response_system(model: BogieModel, op: OperatingPoint) -> LinearSystem:
-    """LinearSystem of the bogie at ``op`` (cached on the model, a few operating points)."""
-    cache = model.__dict__.setdefault("_response_systems", {})
-    if op not in cache:
-        if len(cache) >= 4:
-            cache.pop(next(iter(cache)))
-        cache[op] = LinearSystem(model.M, damping_matrix(model, op), model.K,
-                                 model.short_circuit_force, model.rigid_body_modes)
-    return cache[op]
-
-
 def dominant_frequencies(y: np.ndarray, fs: float, count: int = 4,
                          relative: float = 0.05) -> list[tuple[float, ...]]:
     """Strongest peaks of the amplitude spectrum of each column of ``y`` (sampled at ``fs`` [Hz]),
@@ -536,7 +434,7 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
     step = motor_torque(model.parameters, op)
     u0, a, mu = excitation.terms(step)
     dt = 1.0 / fs
-    system = _response_system(model, op)
+    system = bogie_system(model, op)
     info: dict = {}
     y, used, estimate = solve_linear(system, C, u0, a, mu, n_points, dt, method, info)
     valid = y.shape[0]

@@ -33,8 +33,9 @@ import scipy.signal
 from scipy.integrate import solve_ivp
 
 from model import build_model, default_operating_point, load_parameters
+from model.eigen import bogie_system
 from model.outputs import output_matrices
-from model.response import ShortCircuit, _response_system, short_circuit_response, solve_linear
+from model.response import ShortCircuit, short_circuit_response, solve_linear
 
 
 def exact_reference(A, b, C, u0, M0, w, sigma, shift, steps, dt):
@@ -85,13 +86,13 @@ def main() -> None:
     t = np.arange(steps) * dt
 
     def cold():
-        model.__dict__.pop("_response_systems", None)
+        model.__dict__.pop("_systems", None)
         return short_circuit_response(model, op, excitation, args.t_end, args.fs)
 
     t_cold, result = best_of(cold, 3)
     t_warm, result = best_of(
         lambda: short_circuit_response(model, op, excitation, args.t_end, args.fs), 5)
-    system = _response_system(model, op)
+    system = bogie_system(model, op)
     outputs = output_matrices(model, op)
     C = np.hstack([outputs.C_q, outputs.C_v])
     u0, a, mu = excitation.terms(result.motor_torque)

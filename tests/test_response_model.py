@@ -181,9 +181,9 @@ def test_closed_form_matches_radau(bogie, s0):
     parameters, model = bogie
     op = default_operating_point(parameters, s0)
     result = short_circuit_response(model, op, ShortCircuit(), 0.1, 10_000.0, method="modal")
-    from model.response import _response_system
+    from model.eigen import bogie_system
 
-    system = _response_system(model, op)
+    system = bogie_system(model, op)
     u0, a, mu = ShortCircuit().terms(result.motor_torque)
     from model.outputs import output_matrices
 
