@@ -9,7 +9,6 @@ results for plotting.  Units: SI, except where a name says otherwise (``v_kmh`` 
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -35,6 +34,7 @@ N_REAL_TABLE = 10  # real eigenvalues in the eigenvalue table
 LOCUS_MAX_HZ = 20.0  # branches tracked up to this frequency [Hz]
 LOCUS_POINTS = 12  # points of a root-locus sweep
 LOCUS_S0 = (0.001, 0.02)  # s0 range of the creepage sweep [-]
+LIMIT_XTOL = 1e-6  # s0*(v) to 1e-6 (shown with 5 decimals)
 LOCUS_V_KMH = (40.0, 200.0)  # speed range of the speed sweep [km/h]
 GROWTH_CUT = 4.0  # plotted histories end when a torque exceeds this multiple of M_ad
 PLOT_BUCKETS = 1500  # min/max decimation of time histories for the browser (CSV keeps all)
@@ -119,7 +119,7 @@ def drawing_owner(model_, point: str) -> tuple[str, bool]:
     return f"{drive}.stator", False
 
 
-def point_displacements(model_, q: np.ndarray) -> dict[str, np.ndarray]:
+def _point_displacements_direct(model_, q: np.ndarray) -> dict[str, np.ndarray]:
     """Real translation (x, y, z) [m per unit mode amplitude] of every drawn point of
     ``model.positions`` for the displacement vector Δq (rigid-body kinematics for points carried
     by a body: u + θ × r)."""
@@ -136,6 +136,32 @@ def point_displacements(model_, q: np.ndarray) -> dict[str, np.ndarray]:
             u = u + np.cross(theta, np.asarray(position) - model_.positions[owner])
         out[point] = u
     return out
+
+
+def _displacement_map(model_) -> tuple[list[str], np.ndarray]:
+    """(drawn points, D) with the translations of all points = D Δq (3·points x n), built once
+    per model from the kinematics above (it is linear in Δq)."""
+    cached = model_.__dict__.get("_displacement_map")
+    if cached is None:
+        names = list(model_.positions)
+        columns = []
+        for j in range(model_.n):
+            unit = np.zeros(model_.n)
+            unit[j] = 1.0
+            moved = _point_displacements_direct(model_, unit)
+            columns.append(np.concatenate([moved[name] for name in names]))
+        cached = (names, np.array(columns).T)
+        model_.__dict__["_displacement_map"] = cached
+    return cached
+
+
+def point_displacements(model_, q: np.ndarray) -> dict[str, np.ndarray]:
+    """Real translation (x, y, z) [m per unit mode amplitude] of every drawn point of
+    ``model.positions`` for the displacement vector Δq (rigid-body kinematics for points carried
+    by a body: u + θ × r)."""
+    names, D = _displacement_map(model_)
+    moved = (D @ np.real(q)).reshape(len(names), 3)
+    return dict(zip(names, moved, strict=True))
 
 
 @pn.cache(max_items=256)
@@ -180,7 +206,8 @@ def limit_result(params_path: str, rail: str, v_kmh: float, N0_kN: float,
 
     m = model(params_path, rail)
     try:
-        limit = stability_limit(m, v_kmh * KMH, N0_kN * 1e3, b_M)
+        limit = stability_limit(m, v_kmh * KMH, N0_kN * 1e3, b_M, s0_low=LOCUS_S0[0] / 2,
+                                xtol=LIMIT_XTOL)
     except NoStabilityLimit as error:
         return LimitResult(None, str(error))
     return LimitResult(limit.s0_limit, "")
@@ -240,19 +267,21 @@ class ResponseView:
 
 
 def decimate(t: np.ndarray, ys: list[np.ndarray], buckets: int = PLOT_BUCKETS):
-    """Min/max decimation for plotting: keeps every extreme (peaks stay visible)."""
+    """Min/max decimation for plotting: keeps every extreme (peaks stay visible).  The samples
+    are cut into ``buckets`` runs of equal length; each run keeps its first sample and, of every
+    series, its largest and smallest."""
     n = len(t)
     if n <= 2 * buckets:
         return t, ys
-    edges = np.linspace(0, n, buckets + 1).astype(int)
-    picks = []
-    for a, b in itertools.pairwise(edges):
-        picks.append(a)
-        for y in ys:
-            picks.append(a + int(np.argmax(y[a:b])))
-            picks.append(a + int(np.argmin(y[a:b])))
-    picks.append(n - 1)
-    index = np.unique(np.array(picks))
+    size = -(-n // buckets)
+    runs = -(-n // size)
+    starts = np.arange(runs) * size
+    picks = [starts, [n - 1]]
+    for y in ys:
+        padded = np.concatenate([y, np.full(runs * size - n, y[-1])]).reshape(runs, size)
+        picks.append(starts + padded.argmax(axis=1))
+        picks.append(starts + padded.argmin(axis=1))
+    index = np.unique(np.minimum(np.concatenate(picks), n - 1))
     return t[index], [y[index] for y in ys]
 
 

@@ -109,6 +109,7 @@ class BogieDashboard(pn.viewable.Viewer):
                 self.b_M = base["motor_slope"]
         self.point: compute.PointResult | None = None  # last valid results
         self.limit: compute.LimitResult | None = None
+        self._limit_for: tuple | None = None  # (rail, v, N0, b_M) of self.limit
         self.locus_result: compute.LocusResult | None = None
         self.response: compute.ResponseView | None = None
         self.error = ""  # last rejection message ("" if the current parameters are valid)
@@ -286,11 +287,6 @@ class BogieDashboard(pn.viewable.Viewer):
         """(stability limit, root locus) for a state."""
         return self._limit(state), self._locus(state)
 
-    @staticmethod
-    async def _parallel(loop, state: State, *functions):
-        futures = [loop.run_in_executor(EXECUTOR, f, state) for f in functions]
-        return tuple(await asyncio.gather(*futures))
-
     def refresh(self, slow: bool = True) -> None:
         """Compute and show everything synchronously (initial view, tests); ``slow=False``
         skips the stability limit and the root locus."""
@@ -341,14 +337,21 @@ class BogieDashboard(pn.viewable.Viewer):
                                                    fast))
                 if self._dirty:
                     continue
-                try:
-                    slow = await self._parallel(loop, state, self._limit, self._locus)
-                except MODEL_ERRORS as error:
-                    doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
-                    continue
-                if not self._dirty:
-                    doc.add_next_tick_callback(partial(self._locked, doc, self._apply_slow,
-                                                       state, slow))
+                # the root locus and s0*(v) in parallel, each shown as soon as it is ready
+                pending = {loop.run_in_executor(EXECUTOR, self._locus, state): self._apply_locus,
+                           loop.run_in_executor(EXECUTOR, self._limit, state): self._apply_limit}
+                while pending:
+                    done, _ = await asyncio.wait(pending, return_when=asyncio.FIRST_COMPLETED)
+                    for future in done:
+                        apply = pending.pop(future)
+                        try:
+                            result = future.result()
+                        except MODEL_ERRORS as error:
+                            doc.add_next_tick_callback(partial(self._locked, doc, self._reject,
+                                                               error))
+                            continue
+                        if not self._dirty:
+                            doc.add_next_tick_callback(partial(self._locked, doc, apply, state, result))
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")
             doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
@@ -398,11 +401,19 @@ class BogieDashboard(pn.viewable.Viewer):
         self.locus_plot.zoom(self.zoom == "low")
 
     def _apply_slow(self, state: State, slow) -> None:
-        self.limit, self.locus_result = slow
-        self.creep_plot.update_limit(self.limit)
-        self.locus_plot.update_locus(self.locus_result)
-        self.locus_plot.zoom(self.zoom == "low")
+        limit, locus = slow
+        self._apply_limit(state, limit)
+        self._apply_locus(state, locus)
+
+    def _apply_limit(self, state: State, limit: compute.LimitResult) -> None:
+        self.limit, self._limit_for = limit, (state.rail, state.v, state.N0, state.b_M)
+        self.creep_plot.update_limit(limit)
         self._show_status()
+
+    def _apply_locus(self, state: State, locus: compute.LocusResult) -> None:
+        self.locus_result = locus
+        self.locus_plot.update_locus(locus)
+        self.locus_plot.zoom(self.zoom == "low")
 
     def _show_status(self) -> None:
         point = self.point
@@ -410,7 +421,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.status.object = (f'<div class="status-box {"ok" if point.stable else "bad"}">'
                               f"{word}</div>")
         s0, v_kmh = point.key[2], point.key[3]
-        if self.limit is None:
+        if self.limit is None or self._limit_for != (point.key[1], *point.key[3:]):
             limit = "s0*(v): computing…"
         elif self.limit.s0_limit is None:
             limit = f"s0*(v): none ({html.escape(self.limit.message)})"

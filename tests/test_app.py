@@ -235,3 +235,14 @@ def test_liveness_endpoint_builds_the_app(app_server):
     with urllib.request.urlopen(f"{app_server}/app", timeout=120) as r:
         assert r.status == 200
         assert b"Bokeh" in r.read()
+
+
+def test_displacement_map_matches_the_kinematics():
+    """The cached linear map gives the same point translations as the direct kinematics."""
+    m = compute.model("", "calibrated")
+    q = np.random.default_rng(3).standard_normal(m.n)
+    direct = compute._point_displacements_direct(m, q)
+    mapped = compute.point_displacements(m, q)
+    assert direct.keys() == mapped.keys()
+    for name in direct:
+        np.testing.assert_allclose(mapped[name], direct[name], rtol=1e-12, atol=1e-12)
