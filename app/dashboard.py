@@ -44,6 +44,7 @@ MODEL_ERRORS = (OperatingPointError, ParameterError, NoStabilityLimit, ValueErro
                 np.linalg.LinAlgError)
 # worker threads shared by all sessions: computations release the GIL in LAPACK
 EXECUTOR = ThreadPoolExecutor(max_workers=3, thread_name_prefix="bogie-compute")
+BUSY_DELAY_MS = 400  # the spinner appears when a change takes longer than this [ms]
 PUBLISHED_CASES = {"stable": 0.005, "unstable": 0.014}  # s0 at 120 km/h (the study's two cases)
 
 CSS = """
@@ -199,6 +200,11 @@ class BogieDashboard(pn.viewable.Viewer):
         html_pane = partial(pn.pane.HTML, sizing_mode="stretch_width", stylesheets=[CSS])
         self.status = html_pane("", css_classes=["stability-status"])
         self.details = html_pane("")
+        # a small indicator of fixed size, not an overlay (covering the results re-lays out
+        # every plot in the browser: +300 ms per slider change), shown only for computations
+        # longer than BUSY_DELAY_MS (toggling it costs the browser ~0.2 s itself)
+        self.busy = pn.indicators.LoadingSpinner(value=False, size=22, name="", width=300,
+                                                 height=26, css_classes=["busy"])
         self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
                                     css_classes=["model-notice"], sizing_mode="stretch_width")
         self.peaks = html_pane("")
@@ -217,7 +223,7 @@ class BogieDashboard(pn.viewable.Viewer):
         schematic = ASSETS / "schematic.svg"
         self.main = pn.Column(
             self.notice,
-            pn.Row(pn.Column(self.status, self.details, width=330),
+            pn.Row(pn.Column(self.status, self.busy, self.details, width=330),
                    pn.Column(pn.Row(locus_choice, zoom), bokeh_pane(self.locus_plot.figure),
                              sizing_mode="stretch_width"),
                    sizing_mode="stretch_width"),
@@ -319,7 +325,7 @@ class BogieDashboard(pn.viewable.Viewer):
             return  # the running worker picks up the newest parameters when it is done
         self._busy = True
         if loading:
-            self.main.loading = True
+            doc.add_timeout_callback(self._show_busy, BUSY_DELAY_MS)
         doc.add_next_tick_callback(without_document_lock(partial(self._worker, doc)))
 
     async def _worker(self, doc) -> None:
@@ -363,12 +369,26 @@ class BogieDashboard(pn.viewable.Viewer):
     def _locked(doc, function, *args) -> None:
         from panel.io.state import set_curdoc
 
+        # Bokeh's own hold: all changes of one result go to the browser in one go and are
+        # rendered once (Panel's ``hold`` bypasses the document lock and lost the changes of
+        # a session whose websocket was not connected yet)
         with set_curdoc(doc):
-            function(*args)
+            held = doc.callbacks.hold_value is not None
+            if not held:
+                doc.hold("combine")
+            try:
+                function(*args)
+            finally:
+                if not held:
+                    doc.unhold()
 
     def _done(self) -> None:
-        if not self._busy:
-            self.main.loading = False
+        if not self._busy and self.busy.value:
+            self.busy.param.update(value=False, name="")
+
+    def _show_busy(self) -> None:
+        if self._busy:
+            self.busy.param.update(value=True, name="computing…")
 
     def _reject(self, error: Exception) -> None:
         message = error.args[0] if error.args else str(error)

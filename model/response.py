@@ -70,6 +70,7 @@ from .outputs import output_matrices, static_deflection
 EPS = np.finfo(float).eps
 HUGE_LOG = math.log(1e250)  # beyond this the time grid is truncated (no overflow, no NaN)
 AUTO_TOLERANCE = 1e-6  # largest accepted rounding-error estimate of the modal form (relative)
+WINDOW_TOLERANCE = 1e-13  # a decayed mode's terms below this x the largest term are not evaluated
 MAX_POINTS = 2_000_001  # time points per response
 MAX_T_END = 60.0  # [s]
 
@@ -193,12 +194,37 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
         t_cut = np.min((HUGE_LOG - np.log(magnitude)) / np.maximum(lam_k.real, 1e-300))
         valid = max(2, int(t_cut / dt))
     block = max(16, int(math.sqrt(valid)))
+    # support of each term: a decaying mode is evaluated only while some output's term is above
+    # WINDOW_TOLERANCE x that output's largest term (the rest is bounded and added to the error
+    # estimate below); modes sorted by support, longest first, so each time block uses a prefix
+    reference = np.abs(coef_k).max(axis=1, initial=0.0) + 1e-300  # largest term per output
+    relative = (np.abs(coef_k) / reference[:, None]).max(axis=0, initial=0.0)
+    with np.errstate(divide="ignore"):
+        support = np.where(lam_k.real < 0.0,
+                           np.log(np.maximum(relative, 1e-300) / WINDOW_TOLERANCE)
+                           / np.maximum(-lam_k.real, 1e-300), np.inf)
+    order = np.argsort(-support, kind="stable")
+    lam_k, coef_k, support = lam_k[order], coef_k[:, order], support[order]
     E_block, E_outer = _grid_exponentials(lam_k, valid, dt, block)
-    # y_h[:, a·block + b] = Re Σ_j coef[:, j] E_outer[a, j] E_block[b, j]: one real GEMM pair
+    starts = np.arange(E_outer.shape[0]) * (block * dt)
+    active = (support[None, :] > starts[:, None]).sum(axis=1)  # modes needed per time block
+    # y_h[:, a·block + b] = Re Σ_j coef[:, j] E_outer[a, j] E_block[b, j]: a real GEMM pair per
+    # run of time blocks with a similar number of active modes
     p = C.shape[0]
-    G = (coef_k[:, None, :] * E_outer[None, :, :]).reshape(p * E_outer.shape[0], -1)
-    Yh = G.real @ np.ascontiguousarray(E_block.real.T)
-    Yh -= G.imag @ np.ascontiguousarray(E_block.imag.T)
+    Yh = np.zeros((p, E_outer.shape[0], block))
+    first = 0
+    while first < len(active) and active[first] > 0:
+        m = int(active[first])
+        last = first + 1
+        while last < len(active) and active[last] > 0.75 * m:
+            last += 1
+        G = (coef_k[:, None, :m] * E_outer[None, first:last, :m]).reshape(p * (last - first), m)
+        run = G.real @ np.ascontiguousarray(E_block.real[:, :m].T)
+        run -= G.imag @ np.ascontiguousarray(E_block.imag[:, :m].T)
+        Yh[:, first:last, :] = run.reshape(p, last - first, block)
+        first = last
+    cut = support < t_end  # bound of the terms left out [output units]
+    neglected = (np.abs(coef_k[:, cut]) * np.exp(lam_k.real[cut] * support[cut])).sum(axis=1)
     Yh = Yh.reshape(p, -1)[:, :valid]  # p x valid
     t = np.arange(valid) * dt
     Yh += (const_h.real + C @ alpha)[:, None]
@@ -210,7 +236,8 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
     terms = terms + np.abs(C @ alpha) + np.abs(C @ beta) * t[-1] + np.abs(C @ x_mu) \
         + np.abs(const_h)
     scale = np.abs(y).max(axis=0)
-    estimate = float(np.max(EPS * cond * terms / np.maximum(scale, 1e-300))) if p else 0.0
+    estimate = float(np.max((EPS * cond * terms + neglected) / np.maximum(scale, 1e-300))) \
+        if p else 0.0
     share = (np.abs(coef_k) / np.maximum(scale, 1e-300)[:, None]).max(axis=0)
     significant = lam_k.imag[share > 0.01]
     excited = float(significant.max() / (2 * np.pi)) if len(significant) else 0.0

@@ -5,8 +5,8 @@
 Starts ``bogie serve`` on a free port (a separate process, as users run it), then:
 
 1. single session: keyboard steps on the s0 slider handle (each a new value, so no cache
-   hit); latency = key press → the browser holds new eigenvalues (root-locus current point) and
-   new time histories (the status is sent in the same patch);
+   hit); latency = key press → the browser holds new eigenvalues (root-locus current point)
+   *and* new time histories (both must have changed; the status is sent with the eigenvalues);
 2. root-locus refresh: keyboard steps on the speed slider (new v → new s0*(v) and a new locus
    over s0); latency = key press → new locus branches in the browser;
 3. ``--sessions`` pages at once, each with its own wheel force N0 (so no session profits from
@@ -25,7 +25,6 @@ import random
 import socket
 import statistics
 import subprocess
-import sys
 import time
 import urllib.request
 from pathlib import Path
@@ -36,7 +35,7 @@ ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-f
         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 DATA = """(name, col) => { const d = Bokeh.documents[0].get_model_by_name(name).data;
   const v = d instanceof Map ? d.get(col) : d[col]; return Array.from(v).slice(0, 60).join(','); }"""
-FAST = f"() => ({DATA})('locus_current', 'x') + '|' + ({DATA})('response_source', 'ID1.disc_clutch.torque')"
+FAST = f"() => ({DATA})('locus_current', 'x') + '|' + ({DATA})('response:ID1.disc_clutch.torque', 'y')"
 SLOW = f"() => ({DATA})('locus_points', 'x')"
 
 
@@ -77,13 +76,16 @@ async def open_page(browser, url: str):
 
 async def step(page, control: str, key: str, probe: str, timeout: float = 120_000) -> float:
     """Seconds from a key press on a slider handle until ``probe`` changed in the browser."""
-    before = await page.evaluate(probe)
+    before = (await page.evaluate(probe)).split("|")
     handle = page.locator(f".{control} .noUi-handle")
     await handle.focus()
     t0 = time.perf_counter()
     await handle.press(key)
-    await page.wait_for_function(f"() => ({probe})() !== {json.dumps(before)}", polling=5,
-                                 timeout=timeout)
+    # every part of the probe must have changed (eigenvalues AND time histories): they may
+    # arrive in separate messages
+    await page.wait_for_function(
+        f"() => {{ const now = ({probe})().split('|'); const before = {json.dumps(before)};"
+        " return now.every((part, i) => part !== before[i]); }", polling=5, timeout=timeout)
     return time.perf_counter() - t0
 
 
@@ -114,9 +116,12 @@ async def screenshots(browser, url: str) -> None:
 async def run(args) -> dict:
     from playwright.async_api import async_playwright
 
-    port = free_port()
-    server = start_server(port)
-    url = f"http://127.0.0.1:{port}"
+    if args.url:  # a server started elsewhere (e.g. under a profiler)
+        server, url = None, args.url.rstrip("/")
+    else:
+        port = free_port()
+        server = start_server(port)
+        url = f"http://127.0.0.1:{port}"
     results: dict = {}
     try:
         async with async_playwright() as p:
@@ -135,6 +140,8 @@ async def run(args) -> dict:
             results["errors_single"] = list(page.errors)
             await page.close()
             # 3: concurrent sessions, each with its own N0 (no shared cache hits)
+            if args.sessions == 0:
+                return results
             pages = [await open_page(browser, url) for _ in range(args.sessions)]
             await asyncio.gather(*(settle_n0(pg, 2 + i) for i, pg in enumerate(pages)))
             for pg in pages:
@@ -157,8 +164,9 @@ async def run(args) -> dict:
                 await screenshots(browser, url)
             await browser.close()
     finally:
-        server.terminate()
-        server.wait(timeout=30)
+        if server is not None:
+            server.terminate()
+            server.wait(timeout=30)
     return results
 
 
@@ -171,17 +179,25 @@ def main() -> None:
     parser.add_argument("--screenshots", action="store_true")
     parser.add_argument("--only-screenshots", action="store_true")
     parser.add_argument("--json", default=None, help="write the raw numbers here")
+    parser.add_argument("--url", default=None,
+                        help="measure a running server (e.g. http://127.0.0.1:5006) instead of "
+                             "starting one")
     args = parser.parse_args()
     results = asyncio.run(run(args))
     if args.only_screenshots:
         return
     single = statistics.median(results["single_fast_s"])
-    concurrent = statistics.median(results["concurrent_fast_s"])
     locus = statistics.median(results["locus_refresh_s"])
     print(f"slider change -> eigenvalues, status, time histories: median {single * 1e3:.0f} ms "
           f"(n = {len(results['single_fast_s'])}, max {max(results['single_fast_s']) * 1e3:.0f})")
     print(f"root-locus refresh (new speed): median {locus * 1e3:.0f} ms "
           f"(n = {len(results['locus_refresh_s'])}, max {max(results['locus_refresh_s']) * 1e3:.0f})")
+    if args.json:
+        Path(args.json).write_text(json.dumps(results, indent=1))
+    if "concurrent_fast_s" not in results:
+        print(f"browser console errors: {len(results['errors_single'])}")
+        return
+    concurrent = statistics.median(results["concurrent_fast_s"])
     print(f"{args.sessions} concurrent sessions: median {concurrent * 1e3:.0f} ms "
           f"(n = {len(results['concurrent_fast_s'])}, "
           f"p90 {sorted(results['concurrent_fast_s'])[int(0.9 * len(results['concurrent_fast_s']))] * 1e3:.0f})"
@@ -189,7 +205,6 @@ def main() -> None:
     print(f"browser console errors: {len(results['errors_single']) + len(results['errors_concurrent'])}")
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1))
-    sys.exit(0)
 
 
 if __name__ == "__main__":

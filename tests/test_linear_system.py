@@ -30,7 +30,9 @@ def test_cache_keeps_the_newest_points():
     for key in ("a", "b", "a", "c"):
         cache.get(key, lambda key=key: built.append(key) or key)
     assert built == ["a", "b", "c"]  # "a" was reused, not rebuilt
-    assert cache.peek("b") is None and cache.peek("a") == "a" and cache.peek("c") == "c"
+    assert cache.peek("b") is None
+    assert cache.peek("a") == "a"
+    assert cache.peek("c") == "c"
 
 
 def test_eigen_analysis_and_response_share_one_decomposition():
