@@ -203,7 +203,7 @@ class BogieDashboard(pn.viewable.Viewer):
         # a small indicator of fixed size, not an overlay (covering the results re-lays out
         # every plot in the browser: +300 ms per slider change), shown only for computations
         # longer than BUSY_DELAY_MS (toggling it costs the browser ~0.2 s itself)
-        self.busy = pn.indicators.LoadingSpinner(value=False, size=22, name="", width=300,
+        self.busy = pn.indicators.LoadingSpinner(value=False, size=22, label="", width=300,
                                                  height=26, css_classes=["busy"])
         self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
                                     css_classes=["model-notice"], sizing_mode="stretch_width")
@@ -384,11 +384,11 @@ class BogieDashboard(pn.viewable.Viewer):
 
     def _done(self) -> None:
         if not self._busy and self.busy.value:
-            self.busy.param.update(value=False, name="")
+            self.busy.param.update(value=False, label="")
 
     def _show_busy(self) -> None:
         if self._busy:
-            self.busy.param.update(value=True, name="computing…")
+            self.busy.param.update(value=True, label="computing…")
 
     def _reject(self, error: Exception) -> None:
         message = error.args[0] if error.args else str(error)

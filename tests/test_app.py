@@ -114,8 +114,14 @@ def test_views_show_the_current_point(dash):
 def test_time_histories_change_with_the_excitation(dash):
     dash.param.update(s0=0.005, v=120.0, M0=50.0)
     before = dict(dash.response.peaks)
-    source = dash.response_plots.source
-    assert {"t", "M_C", "ID1.disc_clutch.torque", "ID2.driving_shaft.torque"} <= set(source.data)
+    sources = dash.response_plots.sources
+    assert {"M_C", "ID1.disc_clutch.torque", "ID2.driving_shaft.torque"} <= set(sources)
+    shown = sources["ID1.disc_clutch.torque"].data
+    assert len(shown["t"]) == len(shown["y"]) > 100
+    # the decimated curve keeps the extremes of the full-resolution history
+    full = dash.response.outputs["ID1.disc_clutch.torque"]
+    assert float(np.max(shown["y"])) == pytest.approx(full.max(), rel=1e-6)
+    assert float(np.min(shown["y"])) == pytest.approx(full.min(), rel=1e-6)
     dash.M0 = 80.0
     after = dash.response.peaks
     assert abs(after["ID1.driving_shaft.torque"]) != pytest.approx(
