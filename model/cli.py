@@ -267,8 +267,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("calibrate", help="fit the uncertain parameters to the published results")
     p.add_argument("--start", default=None, metavar="FILE", help="starting set (default: estimate.toml)")
     p.add_argument("--out", default=None, metavar="FILE", help="output (default: calibrated.toml)")
-    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=80,
-                   help="least-squares iterations of the structural stage (default %(default)s)")
+    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=600,
+                   help="eigen-analyses of the structural stage's pattern search "
+                        "(default %(default)s)")
     p.add_argument("--json", action="store_true", help="progress to stderr")
     p.set_defaults(func=cmd_calibrate)
 

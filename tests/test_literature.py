@@ -32,20 +32,15 @@ from model.calibration import (
     V_REF,
     driving_shaft_mode,
     match_table1_modes,
+    wheelset_yaw_fraction,
 )
 from model.operating_point import adhesion_moment, motor_torque
 from model.stability import stability_limit
 
 # documented misses of the calibrated set (see docs/validation.md); value achieved in the reason
 MISSED_MODES = {
-    3: "13.84 Hz (+155 %): the model's stator pitch on the silent blocks couples with the frame "
-       "pitch well above 5.4 Hz",
-    4: "4.01 Hz (−26 %): frame bounce with the motors",
-    6: "8.07 Hz (−5.1 %): motors' lateral opposite-phase mode (character matches)",
-    7: "8.90 Hz (+3.7 %): both wheelsets move together in our longitudinal modes",
-    8: "12.04 Hz (+31 %): as 7; the study's separate WS1/WS2 modes are not reproduced",
-    9: "10.25 Hz (−16 %): as 8",
-    10: "9.32 Hz (−26 %): as 8",
+    9: "14.09 Hz (+15 %): the wheelsets' in-phase longitudinal-yaw mode drags the frame's yaw; "
+       "the frame's yaw inertia is at its physical limit I_x + I_y",
 }
 
 
@@ -84,7 +79,9 @@ def test_driving_shaft_mode_within_3_percent(calibrated):
     (1, ("vertical", "car body")),  # vertical of car body (in phase with BF and TMs)
     (2, ("torsion of rotor 1", "twisting of disc clutch 1")),  # ID1 rotor with gears, DC twisting
     (5, ("lateral of TM", "in phase", "bogie frame in phase")),  # lateral (and roll) of BF with TMs
-    (6, ("lateral of TM 1 with TM 2 opposite phase",)),  # lateral of both TMs in opposite phase
+    # lateral of both TMs in opposite phase; the TM with the larger amplitude is named first, and
+    # which one that is depends on the small asymmetry of the drives, so the order is not asserted
+    (6, ("lateral of TM", "opposite phase", "silent blocks")),
     (10, ("longitudinal of wheelset 1",)),  # combined longitudinal–yaw of wheelset 1
 ])
 def test_generated_description_agrees_with_table2(calibrated, k, words):
@@ -94,11 +91,31 @@ def test_generated_description_agrees_with_table2(calibrated, k, words):
         assert word in description, description
 
 
-@pytest.mark.xfail(strict=True, reason="documented miss: mode 10 is longitudinal of both "
-                   "wheelsets with frame yaw, the wheelset's own yaw share is small")
+def test_wheelset_modes_told_apart_by_journal_phase(calibrated):
+    """Table 2's longitudinal–pitch modes (7, 8) move both journals of a wheelset in phase, its
+    longitudinal–yaw modes (9, 10) in opposite phase: the matched modes must do the same."""
+    _, model, result, matched = calibrated
+    for k in (7, 8, 9, 10):
+        yaw = wheelset_yaw_fraction(model, result.mode_shape(matched[k - 1]))
+        drive = "ID2" if k in (7, 9) else "ID1"
+        assert (yaw[drive] > 0.5) == (k in (9, 10)), (k, yaw)
+
+
+@pytest.mark.xfail(strict=True, reason="documented miss: the generated description calls mode 10 "
+                   "'longitudinal of wheelset 1 with wheelset 2': it ranks directions by kinetic "
+                   "energy per coordinate, and the axle's yaw shows in its nodes' x translations "
+                   "(the matching measures it by journal phase instead)")
 def test_mode10_is_wheelset_yaw(calibrated):
     _, model, result, matched = calibrated
     assert "yaw of wheelset 1" in mode_character(model, result, matched[9]).description
+
+
+def test_calibrated_frame_inertias_are_physical(calibrated):
+    """A rigid body's principal inertias obey I_z <= I_x + I_y; the calibration keeps the frame's
+    yaw inertia within it (calibration.with_constraints)."""
+    parameters = calibrated[0]
+    assert parameters["frame_inertia_z"] <= (parameters["frame_inertia_x"]
+                                             + parameters["frame_inertia_y"]) * (1 + 1e-12)
 
 
 def test_stable_at_small_creepage(calibrated):
@@ -117,8 +134,8 @@ def test_unstable_at_large_creepage(calibrated):
 
 
 @pytest.mark.xfail(strict=True, reason="documented miss: the calibrated model has 2 unstable "
-                   "pairs among the first ten (7 in all) and 1 positive real eigenvalue; the "
-                   "study has 5 and 2")
+                   "pairs among the first ten (8 in all) and 1 positive real eigenvalue "
+                   "(+14.05 1/s); the study has 5 and 2 (+7.03, +0.06)")
 def test_unstable_pattern_as_published(calibrated):
     parameters, model, _, _ = calibrated
     result = eigen_analysis(model, OperatingPoint(0.014, V_REF, parameters["wheel_force"],
