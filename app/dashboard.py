@@ -21,6 +21,7 @@ import io
 import json
 import logging
 import math
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import partial
@@ -30,7 +31,6 @@ import numpy as np
 import panel as pn
 import param
 from bokeh.document import without_document_lock
-from threadpoolctl import threadpool_limits
 
 from model import NoStabilityLimit, OperatingPointError, ParameterError
 from model.parameters import dumps_parameters
@@ -80,6 +80,23 @@ class State:
         return (self.params_path, self.rail, self.s0, self.v, self.N0, self.b_M)
 
 
+_BLAS_LIMITED = threading.Lock()
+_blas_limited = False
+
+
+def _one_blas_thread() -> None:
+    """Limit BLAS/LAPACK to one thread per call, once per process, before any computation
+    thread starts (the dashboard runs several computations in parallel; OpenBLAS's own threads
+    on top made one eigen-analysis 30-90x slower on the 2-core machine)."""
+    global _blas_limited
+    with _BLAS_LIMITED:
+        if not _blas_limited:
+            from threadpoolctl import threadpool_limits
+
+            threadpool_limits(1)
+            _blas_limited = True
+
+
 class BogieDashboard(pn.viewable.Viewer):
     """Stability and short-circuit load of the bogie at one operating point."""
 
@@ -100,6 +117,7 @@ class BogieDashboard(pn.viewable.Viewer):
     mode = param.Integer(1, bounds=(1, compute.N_COMPLEX_TABLE), doc="mode shown (ν)")
 
     def __init__(self, params_path: str | None = None, **params):
+        _one_blas_thread()
         super().__init__(**params)
         self._params_path = str(params_path or "")
         base = compute.parameters(self._params_path, "calibrated")
@@ -260,30 +278,28 @@ class BogieDashboard(pn.viewable.Viewer):
                      self.locus)
 
     # the four computations of a change; each independent of the others (run in parallel
-    # when served), each with one BLAS thread
+    # when served).  One BLAS thread each: set once per process (:func:`_one_blas_thread`), never
+    # per call — OpenBLAS's thread count is process-wide, and changing it while other threads
+    # are inside BLAS corrupted the heap (the server died with "malloc(): invalid size" under
+    # ten sessions)
     @staticmethod
     def _point(state: State):
-        with threadpool_limits(1):
-            return compute.point_result(*state.point)
+        return compute.point_result(*state.point)
 
     @staticmethod
     def _response(state: State):
-        with threadpool_limits(1):
-            return compute.response_result(*state.point, state.M0, state.f, state.D, state.dt,
-                                           state.t_end)
+        return compute.response_result(*state.point, state.M0, state.f, state.D, state.dt,
+                                       state.t_end)
 
     @staticmethod
     def _limit(state: State):
-        with threadpool_limits(1):
-            return compute.limit_result(state.params_path, state.rail, state.v, state.N0,
-                                        state.b_M)
+        return compute.limit_result(state.params_path, state.rail, state.v, state.N0, state.b_M)
 
     @staticmethod
     def _locus(state: State):
         fixed = state.v if state.locus == "s0" else state.s0
-        with threadpool_limits(1):
-            return compute.locus_result(state.params_path, state.rail, state.locus, fixed,
-                                        state.N0, state.b_M)
+        return compute.locus_result(state.params_path, state.rail, state.locus, fixed,
+                                    state.N0, state.b_M)
 
     def compute_fast(self, state: State):
         """(point result, response result) for a state (raises a MODEL_ERRORS on rejection)."""
@@ -343,21 +359,19 @@ class BogieDashboard(pn.viewable.Viewer):
                                                    fast))
                 if self._dirty:
                     continue
-                # the root locus and s0*(v) in parallel, each shown as soon as it is ready
-                pending = {loop.run_in_executor(EXECUTOR, self._locus, state): self._apply_locus,
-                           loop.run_in_executor(EXECUTOR, self._limit, state): self._apply_limit}
-                while pending:
-                    done, _ = await asyncio.wait(pending, return_when=asyncio.FIRST_COMPLETED)
-                    for future in done:
-                        apply = pending.pop(future)
-                        try:
-                            result = future.result()
-                        except MODEL_ERRORS as error:
-                            doc.add_next_tick_callback(partial(self._locked, doc, self._reject,
-                                                               error))
-                            continue
-                        if not self._dirty:
-                            doc.add_next_tick_callback(partial(self._locked, doc, apply, state, result))
+                # then the root locus (it solves on two threads itself), shown at once, then
+                # s0*(v): one after the other, so that the picture comes first
+                for compute_slow, apply in ((self._locus, self._apply_locus),
+                                            (self._limit, self._apply_limit)):
+                    try:
+                        result = await loop.run_in_executor(EXECUTOR, compute_slow, state)
+                    except MODEL_ERRORS as error:
+                        doc.add_next_tick_callback(partial(self._locked, doc, self._reject,
+                                                           error))
+                        break
+                    if self._dirty:
+                        break
+                    doc.add_next_tick_callback(partial(self._locked, doc, apply, state, result))
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")
             doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))

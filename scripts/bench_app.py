@@ -21,10 +21,13 @@ from __future__ import annotations
 import argparse
 import asyncio
 import json
+import os
 import random
 import socket
 import statistics
 import subprocess
+import sys
+import tempfile
 import time
 import urllib.request
 from pathlib import Path
@@ -39,6 +42,28 @@ FAST = f"() => ({DATA})('locus_current', 'x') + '|' + ({DATA})('response:ID1.dis
 SLOW = f"() => ({DATA})('locus_points', 'x')"
 
 
+def log(message: str) -> None:
+    print(f"bench_app: {time.strftime('%H:%M:%S')} {message}", file=sys.stderr, flush=True)
+
+
+def cpu_seconds(match: str) -> float:
+    """CPU time [s] (user + system) used so far by the processes whose command line contains
+    ``match`` (Linux /proc)."""
+    total = 0.0
+    tick = os.sysconf("SC_CLK_TCK")
+    for proc in Path("/proc").iterdir():
+        if not proc.name.isdigit():
+            continue
+        try:
+            if match not in (proc / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace"):
+                continue
+            fields = (proc / "stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        total += (int(fields[11]) + int(fields[12])) / tick
+    return total
+
+
 def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -46,8 +71,11 @@ def free_port() -> int:
 
 
 def start_server(port: int) -> subprocess.Popen:
+    server_log = Path(tempfile.gettempdir()) / f"bench_app_server_{port}.log"
+    log(f"server log: {server_log}")
     process = subprocess.Popen([str(ROOT / ".venv/bin/bogie"), "serve", "--port", str(port)],
-                               cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                               cwd=ROOT, stdout=subprocess.DEVNULL,
+                               stderr=server_log.open("w"))
     deadline = time.monotonic() + 180
     while time.monotonic() < deadline:
         try:
@@ -130,8 +158,11 @@ async def run(args) -> dict:
                 await screenshots(browser, url)
                 return results
             # 1 + 2: one session
+            log("single session: opening the page")
             page = await open_page(browser, url)
-            await settle_n0(page, 1)  # own N0 = 99 kN: nothing cached from earlier runs
+            log("single session: own wheel force")
+            await settle_n0(page, 1)
+            log("single session: s0 steps, then speed steps")  # own N0 = 99 kN: nothing cached from earlier runs
             fast = [await step(page, "ctl-s0", "ArrowRight", FAST) for _ in range(args.presses)]
             slow = [await step(page, "ctl-v", "ArrowRight", SLOW)
                     for _ in range(args.locus_presses)]
@@ -142,7 +173,9 @@ async def run(args) -> dict:
             # 3: concurrent sessions, each with its own N0 (no shared cache hits)
             if args.sessions == 0:
                 return results
+            log(f"{args.sessions} sessions: opening the pages")
             pages = [await open_page(browser, url) for _ in range(args.sessions)]
+            log(f"{args.sessions} sessions: own wheel forces")
             await asyncio.gather(*(settle_n0(pg, 2 + i) for i, pg in enumerate(pages)))
             for pg in pages:
                 await wait_idle(pg)
@@ -155,8 +188,18 @@ async def run(args) -> dict:
                     out.append(await step(pg, "ctl-s0", "ArrowRight", FAST))
                 return out
 
+            log(f"{args.sessions} sessions: s0 steps")
+            cpu_server, cpu_browser = cpu_seconds("bogie serve"), cpu_seconds("chrom")
+            began = time.perf_counter()
             latencies = await asyncio.gather(*(session(pg, i) for i, pg in enumerate(pages)))
             results["concurrent_fast_s"] = [x for xs in latencies for x in xs]
+            wall = time.perf_counter() - began
+            changes = len(results["concurrent_fast_s"])
+            # where the 2 cores went: the server and the ten browsers share this machine
+            results["concurrent_cpu"] = {
+                "wall_s": wall, "changes": changes,
+                "server_cpu_s": cpu_seconds("bogie serve") - cpu_server,
+                "browser_cpu_s": cpu_seconds("chrom") - cpu_browser}
             results["errors_concurrent"] = [e for pg in pages for e in pg.errors]
             for pg in pages:
                 await pg.close()
@@ -202,6 +245,12 @@ def main() -> None:
           f"(n = {len(results['concurrent_fast_s'])}, "
           f"p90 {sorted(results['concurrent_fast_s'])[int(0.9 * len(results['concurrent_fast_s']))] * 1e3:.0f})"
           f" = {concurrent / single:.2f} x single")
+    cpu = results["concurrent_cpu"]
+    print(f"  during it ({cpu['wall_s']:.1f} s, {cpu['changes']} changes): server "
+          f"{cpu['server_cpu_s']:.1f} CPU-s ({cpu['server_cpu_s'] / cpu['changes'] * 1e3:.0f} ms per "
+          f"change), browsers {cpu['browser_cpu_s']:.1f} CPU-s "
+          f"({cpu['browser_cpu_s'] / cpu['changes'] * 1e3:.0f} ms per change); capacity "
+          f"{2 * cpu['wall_s']:.1f} CPU-s (2 cores)")
     print(f"browser console errors: {len(results['errors_single']) + len(results['errors_concurrent'])}")
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1))
