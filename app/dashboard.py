@@ -44,7 +44,8 @@ MODEL_ERRORS = (OperatingPointError, ParameterError, NoStabilityLimit, ValueErro
                 np.linalg.LinAlgError)
 # worker threads shared by all sessions: computations release the GIL in LAPACK
 EXECUTOR = ThreadPoolExecutor(max_workers=3, thread_name_prefix="bogie-compute")
-BUSY_DELAY_MS = 400  # the spinner appears when a change takes longer than this [ms]
+BUSY_DELAY_MS = 400  # the "computing…" notice appears when a change takes longer [ms]
+BUSY_TEXT = '<div class="busy-text">⏳ computing…</div>'
 PUBLISHED_CASES = {"stable": 0.005, "unstable": 0.014}  # s0 at 120 km/h (the study's two cases)
 
 CSS = """
@@ -55,6 +56,7 @@ table.bogie {border-collapse: collapse; font-size: 12px; width: 100%}
 table.bogie th, table.bogie td {border-bottom: 1px solid #ddd; padding: 2px 6px; text-align: right}
 table.bogie td.text, table.bogie th.text {text-align: left}
 table.bogie td.bad {color: UNSTABLE_COLOR; font-weight: 700}
+.busy-text {font-size: 13px; color: #555; font-style: italic}
 """.replace("UNSTABLE_COLOR", UNSTABLE).replace("STABLE_COLOR", STABLE)
 
 
@@ -218,11 +220,11 @@ class BogieDashboard(pn.viewable.Viewer):
         html_pane = partial(pn.pane.HTML, sizing_mode="stretch_width", stylesheets=[CSS])
         self.status = html_pane("", css_classes=["stability-status"])
         self.details = html_pane("")
-        # a small indicator of fixed size, not an overlay (covering the results re-lays out
-        # every plot in the browser: +300 ms per slider change), shown only for computations
-        # longer than BUSY_DELAY_MS (toggling it costs the browser ~0.2 s itself)
-        self.busy = pn.indicators.LoadingSpinner(value=False, size=22, label="", width=300,
-                                                 height=26, css_classes=["busy"])
+        # a static notice of fixed size, shown only for changes longer than BUSY_DELAY_MS: an
+        # overlay over the results made the browser re-lay out every plot (+300 ms per change),
+        # and an animated spinner kept every waiting page busy (measured with ten sessions)
+        self.busy = pn.pane.HTML("", width=300, height=22, css_classes=["busy"],
+                                 stylesheets=[CSS])
         self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
                                     css_classes=["model-notice"], sizing_mode="stretch_width")
         self.peaks = html_pane("")
@@ -359,25 +361,43 @@ class BogieDashboard(pn.viewable.Viewer):
                                                    fast))
                 if self._dirty:
                     continue
-                # then the root locus (it solves on two threads itself), shown at once, then
-                # s0*(v): one after the other, so that the picture comes first
-                for compute_slow, apply in ((self._locus, self._apply_locus),
-                                            (self._limit, self._apply_limit)):
-                    try:
-                        result = await loop.run_in_executor(EXECUTOR, compute_slow, state)
-                    except MODEL_ERRORS as error:
-                        doc.add_next_tick_callback(partial(self._locked, doc, self._reject,
-                                                           error))
-                        break
-                    if self._dirty:
-                        break
-                    doc.add_next_tick_callback(partial(self._locked, doc, apply, state, result))
+                # then the root locus (it solves on two threads itself), shown at once
+                try:
+                    locus = await loop.run_in_executor(EXECUTOR, self._locus, state)
+                except MODEL_ERRORS as error:
+                    doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+                    continue
+                if self._dirty:
+                    continue
+                doc.add_next_tick_callback(partial(self._locked, doc, self._apply_locus, state,
+                                                   locus))
+                # s0*(v) (≈ 0.7 s) is not waited for: a change arriving meanwhile starts at
+                # once; the limit is shown when ready if it still belongs to the parameters
+                limit = loop.run_in_executor(EXECUTOR, self._limit, state)
+                limit.add_done_callback(partial(self._limit_done, doc, state))
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")
             doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
         finally:
             self._busy = False
             doc.add_next_tick_callback(partial(self._locked, doc, self._done))
+
+    def _limit_done(self, doc, state: State, future) -> None:
+        if future.cancelled():
+            return
+        current = self.state()
+        if (current.rail, current.v, current.N0, current.b_M) != (state.rail, state.v, state.N0,
+                                                                  state.b_M):
+            return  # superseded: another speed, wheel force, motor slope or rail is shown
+        error = future.exception()
+        if error is not None:
+            if isinstance(error, MODEL_ERRORS):
+                doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+            else:
+                log.error("stability limit failed", exc_info=error)
+            return
+        doc.add_next_tick_callback(partial(self._locked, doc, self._apply_limit, state,
+                                           future.result()))
 
     @staticmethod
     def _locked(doc, function, *args) -> None:
@@ -397,12 +417,12 @@ class BogieDashboard(pn.viewable.Viewer):
                     doc.unhold()
 
     def _done(self) -> None:
-        if not self._busy and self.busy.value:
-            self.busy.param.update(value=False, label="")
+        if not self._busy and self.busy.object:
+            self.busy.object = ""
 
     def _show_busy(self) -> None:
         if self._busy:
-            self.busy.param.update(value=True, label="computing…")
+            self.busy.object = BUSY_TEXT
 
     def _reject(self, error: Exception) -> None:
         message = error.args[0] if error.args else str(error)
