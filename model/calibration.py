@@ -36,7 +36,7 @@ from scipy.optimize import least_squares, linear_sum_assignment
 
 from .assembly import build_model
 from .eigen import eigen_analysis
-from .modes import characterize
+from .modes import characterize, wheelset_yaw_fraction
 from .operating_point import KMH, OperatingPoint, adhesion_moment, creep_law, motor_torque
 from .parameters import CALIBRATED_FILE, ESTIMATE_FILE, Parameters, load_parameters, save_parameters
 from .stability import stability_limit
@@ -71,19 +71,6 @@ def _pitch_with_frame(c, component: str) -> float:
     """1 if ``component`` pitches in phase with the frame, 0 against it, 0.5 if either does not
     pitch."""
     return _in_phase(c, "BF", component, "ry")
-
-
-def wheelset_yaw_fraction(model, q: np.ndarray) -> dict[str, float]:
-    """Per drive: the share of the journals' longitudinal motion that is yaw (journals 11 and 15
-    in opposite phase) rather than longitudinal translation (in phase).  The axle is a chain of
-    beam nodes, so its yaw shows in the nodes' x translations, not in an ``rz`` coordinate."""
-    fractions = {}
-    for drive in ("ID1", "ID2"):
-        x11 = q[model.dofs.index(f"{drive}.ax11.x")]
-        x15 = q[model.dofs.index(f"{drive}.ax15.x")]
-        yaw, longitudinal = abs(x15 - x11) ** 2, abs(x15 + x11) ** 2
-        fractions[drive] = float(yaw / (yaw + longitudinal)) if yaw + longitudinal > 0 else 0.0
-    return fractions
 
 
 # Table 2 characters as scores in [0, 1] (kinetic/strain energy shares, phase factors); each

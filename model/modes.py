@@ -106,7 +106,7 @@ def characterize(model: BogieModel, eigenvalue: complex, q: np.ndarray) -> ModeC
     total = sum(strain_raw.values()) or 1.0
     strain = {g: value / total for g, value in strain_raw.items()}
     directions = {c: _axis_shares(model, groups[c], q) for c in groups}
-    text = _describe(model, q, kinetic, strain, directions)
+    text = _describe(model, q, kinetic, strain, _with_wheelset_yaw(model, q, directions))
     amplitudes = {c: _amplitudes(model, groups[c], q) for c in groups}
     return ModeCharacter(complex(eigenvalue), kinetic, strain, directions, text, amplitudes)
 
@@ -121,6 +121,40 @@ def _amplitudes(model: BogieModel, parts: list[str], q: np.ndarray) -> dict[str,
     return best
 
 
+def wheelset_yaw_fraction(model: BogieModel, q: np.ndarray) -> dict[str, float]:
+    """Per drive: the share of the journals' longitudinal motion that is yaw (journals 11 and 15
+    in opposite phase) rather than longitudinal translation (in phase).  The axle is a chain of
+    beam nodes, so its yaw shows in the nodes' x translations, not in an ``rz`` coordinate."""
+    fractions = {}
+    for drive in ("ID1", "ID2"):
+        x11 = q[model.dofs.index(f"{drive}.ax11.x")]
+        x15 = q[model.dofs.index(f"{drive}.ax15.x")]
+        yaw, longitudinal = abs(x15 - x11) ** 2, abs(x15 + x11) ** 2
+        fractions[drive] = float(yaw / (yaw + longitudinal)) if yaw + longitudinal > 0 else 0.0
+    return fractions
+
+
+def _with_wheelset_yaw(model: BogieModel, q: np.ndarray,
+                       directions: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
+    """Directions for the *description*: each wheelset's longitudinal share split into
+    translation and yaw by :func:`wheelset_yaw_fraction` (``ModeCharacter.directions`` keeps the
+    per-coordinate shares the calibration's signatures were fitted with)."""
+    out = dict(directions)
+    for drive, fraction in wheelset_yaw_fraction(model, q).items():
+        component = f"{drive}.wheelset"
+        if component not in out:
+            continue
+        shares = dict(out[component])
+        x = shares.get("x", 0.0)
+        shares["x"] = x * (1.0 - fraction)
+        shares["rz"] = shares.get("rz", 0.0) + x * fraction
+        out[component] = shares
+    return out
+
+
+TRANSLATIONS_FIRST = ("x", "y", "z", "rx", "ry", "rz")  # "longitudinal–yaw", as Table 2 writes
+
+
 def _direction_words(component: str, shares: dict[str, float]) -> str:
     ranked = sorted(shares.items(), key=lambda item: -item[1])
     torsional = component.split(".")[-1] in ("rotor", "pinion", "gear")
@@ -131,6 +165,9 @@ def _direction_words(component: str, shares: dict[str, float]) -> str:
         word = "torsion" if torsional or (axis == "ry" and "hollow" in component) else AXIS_WORDS[axis]
         if word not in words:
             words.append(word)
+    if len(words) > 1 and not torsional:
+        order = {AXIS_WORDS[axis]: i for i, axis in enumerate(TRANSLATIONS_FIRST)}
+        words.sort(key=lambda word: order.get(word, len(order)))
     return ("combined " + "–".join(words)) if len(words) > 1 else words[0]
 
 
