@@ -281,9 +281,7 @@ class BogieDashboard(pn.viewable.Viewer):
 
     # the four computations of a change; each independent of the others (run in parallel
     # when served).  One BLAS thread each: set once per process (:func:`_one_blas_thread`), never
-    # per call — OpenBLAS's thread count is process-wide, and changing it while other threads
-    # are inside BLAS corrupted the heap (the server died with "malloc(): invalid size" under
-    # ten sessions)
+    # per call from the worker threads (OpenBLAS's thread count is process-wide)
     @staticmethod
     def _point(state: State):
         return compute.point_result(*state.point)
@@ -373,7 +371,7 @@ class BogieDashboard(pn.viewable.Viewer):
                                                    locus))
                 # s0*(v) (≈ 0.7 s) is not waited for: a change arriving meanwhile starts at
                 # once; the limit is shown when ready if it still belongs to the parameters
-                limit = loop.run_in_executor(EXECUTOR, self._limit, state)
+                limit = loop.run_in_executor(EXECUTOR, self._limit_if_current, state)
                 limit.add_done_callback(partial(self._limit_done, doc, state))
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")
@@ -382,12 +380,19 @@ class BogieDashboard(pn.viewable.Viewer):
             self._busy = False
             doc.add_next_tick_callback(partial(self._locked, doc, self._done))
 
-    def _limit_done(self, doc, state: State, future) -> None:
-        if future.cancelled():
-            return
+    def _limit_current(self, state: State) -> bool:
+        """Whether s0*(v) for ``state`` is still the one to show (same v, N0, b_M, rail)."""
         current = self.state()
-        if (current.rail, current.v, current.N0, current.b_M) != (state.rail, state.v, state.N0,
-                                                                  state.b_M):
+        return (current.rail, current.v, current.N0, current.b_M) == (state.rail, state.v,
+                                                                      state.N0, state.b_M)
+
+    def _limit_if_current(self, state: State) -> compute.LimitResult | None:
+        """s0*(v), unless superseded before it started (a speed slider dragged over ten values
+        must not queue ten 0.7 s root findings in front of the next change's fast stage)."""
+        return self._limit(state) if self._limit_current(state) else None
+
+    def _limit_done(self, doc, state: State, future) -> None:
+        if future.cancelled() or not self._limit_current(state):
             return  # superseded: another speed, wheel force, motor slope or rail is shown
         error = future.exception()
         if error is not None:
@@ -396,8 +401,9 @@ class BogieDashboard(pn.viewable.Viewer):
             else:
                 log.error("stability limit failed", exc_info=error)
             return
-        doc.add_next_tick_callback(partial(self._locked, doc, self._apply_limit, state,
-                                           future.result()))
+        if future.result() is not None:
+            doc.add_next_tick_callback(partial(self._locked, doc, self._apply_limit, state,
+                                               future.result()))
 
     @staticmethod
     def _locked(doc, function, *args) -> None:
