@@ -122,9 +122,8 @@ def drawing_owner(model_, point: str) -> tuple[str, bool]:
 
 
 def _point_displacements_direct(model_, q: np.ndarray) -> dict[str, np.ndarray]:
-    """Real translation (x, y, z) [m per unit mode amplitude] of every drawn point of
-    ``model.positions`` for the displacement vector Δq (rigid-body kinematics for points carried
-    by a body: u + θ × r)."""
+    """:func:`point_displacements` point by point (u + θ × r for points carried by a body);
+    used once per model to build the linear map, and by the test that checks the map."""
     index = {name: i for i, name in enumerate(model_.dofs.names)}
     out: dict[str, np.ndarray] = {}
     for point, position in model_.positions.items():

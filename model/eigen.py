@@ -32,17 +32,15 @@ class StateSpace:
         n = self.model.n
         return sla.cho_solve(sla.cho_factor(self.model.M), np.eye(n))
 
-    @cached_property
-    def minus_Minv_K(self) -> np.ndarray:
-        return -self.inverse_mass @ self.model.K
+    def system(self, B_total: np.ndarray) -> LinearSystem:
+        """The first-order form with damping ``B_total`` (input: M_C, as :func:`bogie_system`)."""
+        m = self.model
+        return LinearSystem(m.M, B_total, m.K, m.short_circuit_force, m.rigid_body_modes,
+                            self.inverse_mass)
 
     def state_matrix(self, B_total: np.ndarray) -> np.ndarray:
-        n = self.model.n
-        A = np.zeros((2 * n, 2 * n))
-        A[:n, n:] = np.eye(n)
-        A[n:, :n] = self.minus_Minv_K
-        A[n:, n:] = -self.inverse_mass @ B_total
-        return A
+        """A (2n x 2n) with damping ``B_total`` [1/s and 1/s² blocks]."""
+        return self.system(B_total).A
 
 
 def state_space(model: BogieModel) -> StateSpace:
@@ -122,13 +120,16 @@ def bogie_system(model: BogieModel, op: OperatingPoint, cached: bool = True) -> 
     ID1's rotor and stator).  ``cached``: kept with the last few operating points of the model, so
     that the eigen-analysis and the response at one point share one eigendecomposition."""
     def build() -> LinearSystem:
-        return LinearSystem(model.M, damping_matrix(model, op), model.K,
-                            model.short_circuit_force, model.rigid_body_modes,
-                            state_space(model).inverse_mass)
+        return state_space(model).system(damping_matrix(model, op))
     if not cached:
         return build()
     cache = model.__dict__.setdefault("_systems", SystemCache())
     return cache.get(op, build)
+
+
+def forget_systems(model: BogieModel) -> None:
+    """Drop the cached per-operating-point systems of ``model`` (cold timings in benchmarks)."""
+    model.__dict__.pop("_systems", None)
 
 
 def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) -> EigenResult:

@@ -15,23 +15,26 @@ from __future__ import annotations
 import argparse
 import platform
 import time
+from functools import partial
 
 import numpy as np
 from threadpoolctl import threadpool_limits
 
 from model import build_model, default_operating_point, eigen_analysis, load_parameters
+from model.eigen import forget_systems
 from model.locus import dense_generalized_eigenvalues, root_locus
 
 
-def best_of(repeat: int, function):
+def best_of(repeat: int, function, before=None):
+    """(shortest wall time of ``repeat`` calls [s], last result); ``before()`` runs untimed
+    before every call."""
     times, result = [], None
     for _ in range(repeat):
+        if before is not None:
+            before()
         start = time.perf_counter()
         result = function()
         times.append(time.perf_counter() - start)
-        forget = getattr(function, "forget", None)
-        if forget is not None:
-            forget()
     return min(times), result
 
 
@@ -48,22 +51,16 @@ def main() -> None:
     op = default_operating_point(parameters, s0=0.005, v_kmh=120.0)
     s0 = np.linspace(0.002, 0.016, args.points)
 
-    def cold(function):
-        """``function`` timed cold: the model's per-operating-point decompositions (shared by
-        the eigen-analysis and the response) are dropped before every call."""
-        def call():
-            return function()
-        call.forget = lambda: model.__dict__.pop("_systems", None)
-        call.forget()
-        return call
-
-    t_eigen, _ = best_of(args.repeat, cold(lambda: eigen_analysis(model, op)))
-    t_eigen_values, _ = best_of(args.repeat,
-                                cold(lambda: eigen_analysis(model, op, vectors=False)))
+    # timed cold: the per-operating-point decompositions (shared by the eigen-analysis and the
+    # response) are dropped before every call
+    cold = partial(forget_systems, model)
+    t_eigen, _ = best_of(args.repeat, lambda: eigen_analysis(model, op), cold)
+    t_eigen_values, _ = best_of(args.repeat, lambda: eigen_analysis(model, op, vectors=False),
+                                cold)
     t_naive_one, _ = best_of(args.repeat, lambda: dense_generalized_eigenvalues(model, op))
 
-    t_locus, locus = best_of(args.repeat, cold(lambda: root_locus(
-        model, op, "s0", s0, max_frequency_hz=args.max_frequency)))
+    t_locus, locus = best_of(args.repeat, lambda: root_locus(
+        model, op, "s0", s0, max_frequency_hz=args.max_frequency), cold)
     start = time.perf_counter()
     naive = [dense_generalized_eigenvalues(model, op.__class__(x, op.v, op.N0, op.b_M)) for x in s0]
     t_naive = time.perf_counter() - start

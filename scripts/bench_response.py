@@ -33,7 +33,7 @@ import scipy.signal
 from scipy.integrate import solve_ivp
 
 from model import build_model, default_operating_point, load_parameters
-from model.eigen import bogie_system
+from model.eigen import bogie_system, forget_systems
 from model.outputs import output_matrices
 from model.response import ShortCircuit, short_circuit_response, solve_linear
 
@@ -86,7 +86,7 @@ def main() -> None:
     t = np.arange(steps) * dt
 
     def cold():
-        model.__dict__.pop("_systems", None)
+        forget_systems(model)
         return short_circuit_response(model, op, excitation, args.t_end, args.fs)
 
     t_cold, result = best_of(cold, 3)
