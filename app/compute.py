@@ -206,9 +206,16 @@ def limit_result(params_path: str, rail: str, v_kmh: float, N0_kN: float,
     from model.stability import stability_limit
 
     m = model(params_path, rail)
+    # the root locus over s0 at this speed (usually cached: the dashboard shows it) brackets
+    # the first crossing between two of its points: ≈ 8 eigen-analyses instead of ≈ 20
+    locus = locus_result(params_path, rail, "s0", v_kmh, N0_kN, b_M)
+    turns = np.flatnonzero(~locus.stable[1:] & locus.stable[:-1])
+    bracket = None
+    if len(turns) and locus.stable[:turns[0] + 1].all():
+        bracket = (float(locus.values[turns[0]]), float(locus.values[turns[0] + 1]))
     try:
         limit = stability_limit(m, v_kmh * KMH, N0_kN * 1e3, b_M, s0_low=LOCUS_S0[0] / 2,
-                                xtol=LIMIT_XTOL)
+                                xtol=LIMIT_XTOL, bracket=bracket)
     except NoStabilityLimit as error:
         return LimitResult(None, str(error))
     return LimitResult(limit.s0_limit, "")

@@ -45,12 +45,16 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
     Websocket origins: ``allow_websocket_origin``, else the comma-separated host[:port] list in
     the environment variable BOGIE_ALLOWED_ORIGINS, else localhost:port and 127.0.0.1:port only.
     """
+    import faulthandler
     import signal
     import sys
     import threading
 
     import panel as pn
 
+    # a fatal error in native code (SIGSEGV, SIGABRT...) leaves the Python stack of every thread
+    # in the server's log instead of one line from the C library
+    faulthandler.enable(all_threads=True)
     limit_blas_threads()
     port = int(port)  # the command line parses it as a number (float)
     origins = allow_websocket_origin or os.environ.get(

@@ -28,6 +28,7 @@ The naive reference (:func:`dense_generalized_eigenvalues`) solves the generaliz
 
 from __future__ import annotations
 
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 
@@ -136,6 +137,20 @@ class _Reduced:
                 / np.maximum(np.abs(lam), 1e-300))
 
 
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+_POOLS_LOCK = threading.Lock()
+
+
+def _solver_pool(workers: int) -> ThreadPoolExecutor:
+    """A persistent pool of ``workers`` threads per process (shared by all root loci): threads
+    are not created and destroyed per call (OpenBLAS keeps per-thread buffers)."""
+    with _POOLS_LOCK:
+        if workers not in _POOLS:
+            _POOLS[workers] = ThreadPoolExecutor(max_workers=workers,
+                                                 thread_name_prefix="bogie-locus")
+        return _POOLS[workers]
+
+
 def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
                max_frequency_hz: float = 20.0, rtol: float = 1e-6, workers: int = 2) -> RootLocus:
     """Track the non-rigid eigenvalues with |λ| < 2π·max_frequency_hz (at the first value) while
@@ -168,8 +183,10 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
                        [model.rigid_body_modes, *modes(*first), *modes(*last)])
     # the reduced eigenproblems of the inner points do not depend on each other: solve them on
     # ``workers`` threads (numpy's LAPACK calls release the GIL), then track and check in order
-    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
-        solutions = list(pool.map(reduced.solve, coefficients[1:-1]))
+    if workers > 1:
+        solutions = list(_solver_pool(workers).map(reduced.solve, coefficients[1:-1]))
+    else:
+        solutions = [reduced.solve(c) for c in coefficients[1:-1]]
     tracked = np.flatnonzero(np.abs(first[0]) < radius)
     eigenvalues = np.zeros((n_points, len(tracked)), dtype=complex)
     errors = np.zeros((n_points, len(tracked)))

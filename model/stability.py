@@ -32,11 +32,17 @@ def max_real_part(model: BogieModel, op: OperatingPoint) -> float:
 
 
 def stability_limit(model: BogieModel, v: float, N0: float, b_M: float, s0_low: float = 1e-4,
-                    s0_high: float = 0.5, xtol: float = 1e-7) -> StabilityLimit:
+                    s0_high: float = 0.5, xtol: float = 1e-7,
+                    bracket: tuple[float, float] | None = None) -> StabilityLimit:
     """Smallest s0 in (s0_low, s0_high) where the largest real part crosses zero at speed v [m/s].
 
     The bracket starts at ``s0_low`` (must be stable) and doubles an upper creepage until the bogie
     is unstable; Brent's method then finds the crossing to ``xtol``.
+
+    ``bracket = (stable s0, unstable s0)`` [-] narrows the search when the caller knows where the
+    first crossing is (e.g. the neighbouring points of a root locus over s0 where its branches turn
+    unstable; the caller vouches that smaller creepages are stable).  Both ends are checked by a
+    full eigen-analysis; if either does not hold, the bracket is ignored and the search above runs.
     """
     count = 0
 
@@ -45,6 +51,11 @@ def stability_limit(model: BogieModel, v: float, N0: float, b_M: float, s0_low: 
         count += 1
         return max_real_part(model, OperatingPoint(s0, v, N0, b_M))
 
+    if bracket is not None:
+        low, high = float(bracket[0]), float(bracket[1])
+        if s0_low <= low < high <= s0_high and growth(low) <= 0 < growth(high):
+            s0 = brentq(growth, low, high, xtol=xtol, rtol=1e-10)
+            return StabilityLimit(v, float(s0), count)
     if growth(s0_low) > 0:
         raise NoStabilityLimit(f"already unstable at s0 = {s0_low:g}")
     low, high = s0_low, 2 * s0_low

@@ -11,7 +11,14 @@ Starts ``bogie serve`` on a free port (a separate process, as users run it), the
    over s0); latency = key press → new locus branches in the browser;
 3. ``--sessions`` pages at once, each with its own wheel force N0 (so no session profits from
    another's cache), pressing s0 steps at random moments (0.3–1.5 s apart);
-4. ``--screenshots``: assets/screenshots/stable.png and unstable.png (published cases).
+4. the same number of sessions, but only one of them a Chromium page (measured as in 3) and the
+   others *protocol clients*: Bokeh's Python client (``bokeh.client``) in a separate process,
+   one thread per session, changing s0 exactly as a page does (new ``value_throttled``, own
+   N0) and waiting for the same two results, but drawing nothing.  On this 2-core machine ten
+   headless Chromium pages take most of the CPU themselves; in a design review every reviewer's
+   browser runs on their own computer, so 4 is the load the *server* sees from ten reviewers,
+   and 3 the worst case of everything on one machine.  Both are reported;
+5. ``--screenshots``: assets/screenshots/stable.png and unstable.png (published cases).
 
 Prints medians and writes the numbers as JSON (``--json FILE``).
 """
@@ -128,6 +135,106 @@ async def settle_n0(page, presses: int) -> None:
         await step(page, "ctl-N0", "ArrowLeft", SLOW, timeout=300_000)
 
 
+def protocol_clients(url: str, count: int) -> None:
+    """Run ``count`` protocol clients (one thread each; see the module docstring, 4).  Talks on
+    stdin/stdout: prints ``ready`` once every client has its own N0 and its results, presses
+    after ``go`` until ``stop``, then prints the latencies [s] as one JSON line."""
+    import importlib
+    import threading
+
+    from bokeh.client import pull_session
+
+    for module in ("layout", "markup", "widgets"):  # registers Panel's Bokeh models (to
+        importlib.import_module(f"panel.models.{module}")  # deserialize the document)
+    go, stop = threading.Event(), threading.Event()
+    ready = threading.Barrier(count + 1)
+    latencies: list[float] = []
+    failures: list[str] = []
+
+    def client(index: int) -> None:
+        session = pull_session(url=f"{url}/app")
+        try:
+            doc = session.document
+
+            def control(name):
+                return next(m for m in doc.models
+                            if f"ctl-{name}" in (getattr(m, "css_classes", None) or []))
+
+            def change(slider, value, sources, timeout=300.0) -> float:
+                """Seconds from a new value_throttled until every source's data changed."""
+                seen = set()
+                callbacks = []
+                for source in sources:
+                    def changed(attr, old, new, source=source):
+                        seen.add(source.id)
+                    source.on_change("data", changed)
+                    callbacks.append((source, changed))
+                t0 = time.perf_counter()
+                slider.value = value
+                slider.set_from_json("value_throttled", value)  # as BokehJS does on release
+                deadline = t0 + timeout
+                session._connection._loop_until(
+                    lambda: len(seen) == len(sources) or time.perf_counter() > deadline)
+                elapsed = time.perf_counter() - t0
+                for source, changed in callbacks:
+                    source.remove_on_change("data", changed)
+                if len(seen) < len(sources):
+                    raise TimeoutError(f"client {index}: no new results after {timeout:.0f} s")
+                return elapsed
+
+            fast = [doc.get_model_by_name("locus_current"),
+                    doc.get_model_by_name("response:ID1.disc_clutch.torque")]
+            locus = [doc.get_model_by_name("locus_points")]
+            s0, n0 = control("s0"), control("N0")
+            change(n0, 60.0 + index, locus)  # own wheel force [kN]: no shared cache hits
+            time.sleep(2.0)  # let the session's s0*(v) finish
+        except Exception as error:  # reported; the run fails
+            failures.append(repr(error))
+            ready.abort()
+            return
+        ready.wait()
+        go.wait()
+        rng = random.Random(1000 + index)
+        try:
+            while not stop.is_set():
+                time.sleep(rng.uniform(0.3, 1.5))
+                value = s0.value + s0.step if s0.value + s0.step <= s0.end else s0.start
+                latencies.append(change(s0, round(value, 6), fast))
+        except Exception as error:
+            failures.append(repr(error))
+        finally:
+            session.close()
+
+    threads = [threading.Thread(target=client, args=(i,), daemon=True) for i in range(count)]
+    for thread in threads:
+        thread.start()
+    try:
+        ready.wait()
+    except threading.BrokenBarrierError:
+        print(json.dumps({"failures": failures}), flush=True)
+        return
+    print("ready", flush=True)
+    for line in sys.stdin:
+        if line.strip() == "go":
+            go.set()
+        elif line.strip() == "stop":
+            break
+    stop.set()
+    for thread in threads:
+        thread.join(timeout=120)
+    print(json.dumps({"latencies": latencies, "failures": failures}), flush=True)
+
+
+async def session(page, seed: int, presses: int) -> list[float]:
+    """``presses`` s0 steps at random moments (0.3–1.5 s apart); their latencies [s]."""
+    rng = random.Random(seed)
+    out = []
+    for _ in range(presses):
+        await asyncio.sleep(rng.uniform(0.3, 1.5))
+        out.append(await step(page, "ctl-s0", "ArrowRight", FAST))
+    return out
+
+
 async def screenshots(browser, url: str) -> None:
     out = ROOT / "assets" / "screenshots"
     out.mkdir(parents=True, exist_ok=True)
@@ -173,36 +280,9 @@ async def run(args) -> dict:
             # 3: concurrent sessions, each with its own N0 (no shared cache hits)
             if args.sessions == 0:
                 return results
-            log(f"{args.sessions} sessions: opening the pages")
-            pages = [await open_page(browser, url) for _ in range(args.sessions)]
-            log(f"{args.sessions} sessions: own wheel forces")
-            await asyncio.gather(*(settle_n0(pg, 2 + i) for i, pg in enumerate(pages)))
-            for pg in pages:
-                await wait_idle(pg)
-
-            async def session(pg, seed):
-                rng = random.Random(seed)
-                out = []
-                for _ in range(args.concurrent_presses):
-                    await asyncio.sleep(rng.uniform(0.3, 1.5))
-                    out.append(await step(pg, "ctl-s0", "ArrowRight", FAST))
-                return out
-
-            log(f"{args.sessions} sessions: s0 steps")
-            cpu_server, cpu_browser = cpu_seconds("bogie serve"), cpu_seconds("chrom")
-            began = time.perf_counter()
-            latencies = await asyncio.gather(*(session(pg, i) for i, pg in enumerate(pages)))
-            results["concurrent_fast_s"] = [x for xs in latencies for x in xs]
-            wall = time.perf_counter() - began
-            changes = len(results["concurrent_fast_s"])
-            # where the 2 cores went: the server and the ten browsers share this machine
-            results["concurrent_cpu"] = {
-                "wall_s": wall, "changes": changes,
-                "server_cpu_s": cpu_seconds("bogie serve") - cpu_server,
-                "browser_cpu_s": cpu_seconds("chrom") - cpu_browser}
-            results["errors_concurrent"] = [e for pg in pages for e in pg.errors]
-            for pg in pages:
-                await pg.close()
+            if not args.skip_pages:
+                await pages_at_once(browser, url, args, results)
+            await page_among_clients(browser, url, args, results)
             if args.screenshots:
                 await screenshots(browser, url)
             await browser.close()
@@ -213,19 +293,94 @@ async def run(args) -> dict:
     return results
 
 
+async def pages_at_once(browser, url: str, args, results: dict) -> None:
+    """3: ``args.sessions`` Chromium pages at once."""
+    log(f"{args.sessions} sessions: opening the pages")
+    pages = [await open_page(browser, url) for _ in range(args.sessions)]
+    log(f"{args.sessions} sessions: own wheel forces")
+    await asyncio.gather(*(settle_n0(pg, 2 + i) for i, pg in enumerate(pages)))
+    for pg in pages:
+        await wait_idle(pg)
+
+    log(f"{args.sessions} sessions: s0 steps")
+    cpu_server, cpu_browser = cpu_seconds("bogie serve"), cpu_seconds("chrom")
+    began = time.perf_counter()
+    latencies = await asyncio.gather(*(session(pg, i, args.concurrent_presses)
+                                       for i, pg in enumerate(pages)))
+    results["concurrent_fast_s"] = [x for xs in latencies for x in xs]
+    wall = time.perf_counter() - began
+    changes = len(results["concurrent_fast_s"])
+    # where the 2 cores went: the server and the ten browsers share this machine
+    results["concurrent_cpu"] = {
+        "wall_s": wall, "changes": changes,
+        "server_cpu_s": cpu_seconds("bogie serve") - cpu_server,
+        "browser_cpu_s": cpu_seconds("chrom") - cpu_browser}
+    results["errors_concurrent"] = [e for pg in pages for e in pg.errors]
+    for pg in pages:
+        await pg.close()
+
+
+async def page_among_clients(browser, url: str, args, results: dict) -> None:
+    """4: one Chromium page among ``args.sessions − 1`` protocol clients."""
+    log(f"1 page + {args.sessions - 1} protocol clients: connecting")
+    load = subprocess.Popen([sys.executable, __file__, "--protocol-clients", url,
+                             "--sessions", str(args.sessions - 1)],
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        page = await open_page(browser, url)
+        await settle_n0(page, 2 + args.sessions)  # an N0 no other session has
+        await wait_idle(page)
+        line = await asyncio.to_thread(load.stdout.readline)
+        if line.strip() != "ready":
+            raise SystemExit(f"bench_app: protocol clients failed: {line.strip()}")
+        log("1 page + protocol clients: s0 steps")
+        load.stdin.write("go\n")
+        load.stdin.flush()
+        cpu = (cpu_seconds("bogie serve"), cpu_seconds("chrom"),
+               cpu_seconds("--protocol-clients"))
+        began = time.perf_counter()
+        results["mixed_page_s"] = await session(page, 99, args.mixed_presses)
+        wall = time.perf_counter() - began
+        load.stdin.write("stop\n")
+        load.stdin.flush()
+        results["mixed_cpu"] = {
+            "wall_s": wall,
+            "server_cpu_s": cpu_seconds("bogie serve") - cpu[0],
+            "browser_cpu_s": cpu_seconds("chrom") - cpu[1],
+            "clients_cpu_s": cpu_seconds("--protocol-clients") - cpu[2]}
+        report = json.loads(await asyncio.to_thread(load.stdout.readline))
+        if report["failures"]:
+            raise SystemExit(f"bench_app: protocol clients failed: {report['failures']}")
+        results["mixed_clients_s"] = report["latencies"]
+        results["errors_mixed"] = list(page.errors)
+        await page.close()
+    finally:
+        if load.poll() is None:
+            load.kill()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--presses", type=int, default=15)
     parser.add_argument("--locus-presses", type=int, default=5)
     parser.add_argument("--sessions", type=int, default=10)
     parser.add_argument("--concurrent-presses", type=int, default=5)
+    parser.add_argument("--mixed-presses", type=int, default=20,
+                        help="s0 steps of the page among protocol clients (4)")
+    parser.add_argument("--skip-pages", action="store_true",
+                        help="leave out 3 (ten Chromium pages)")
     parser.add_argument("--screenshots", action="store_true")
     parser.add_argument("--only-screenshots", action="store_true")
+    parser.add_argument("--protocol-clients", metavar="URL", default=None,
+                        help=argparse.SUPPRESS)  # internal: the load process of 4
     parser.add_argument("--json", default=None, help="write the raw numbers here")
     parser.add_argument("--url", default=None,
                         help="measure a running server (e.g. http://127.0.0.1:5006) instead of "
                              "starting one")
     args = parser.parse_args()
+    if args.protocol_clients:
+        protocol_clients(args.protocol_clients.rstrip("/"), args.sessions)
+        return
     results = asyncio.run(run(args))
     if args.only_screenshots:
         return
@@ -237,11 +392,20 @@ def main() -> None:
           f"(n = {len(results['locus_refresh_s'])}, max {max(results['locus_refresh_s']) * 1e3:.0f})")
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1))
-    if "concurrent_fast_s" not in results:
-        print(f"browser console errors: {len(results['errors_single'])}")
-        return
+    errors = results["errors_single"] + results.get("errors_mixed", [])
+    if "concurrent_fast_s" in results:
+        errors += results["errors_concurrent"]
+        report_pages_at_once(results, args.sessions, single)
+    if "mixed_page_s" in results:
+        report_page_among_clients(results, args.sessions, single)
+    print(f"browser console errors: {len(errors)}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(results, indent=1))
+
+
+def report_pages_at_once(results: dict, sessions: int, single: float) -> None:
     concurrent = statistics.median(results["concurrent_fast_s"])
-    print(f"{args.sessions} concurrent sessions: median {concurrent * 1e3:.0f} ms "
+    print(f"{sessions} concurrent sessions: median {concurrent * 1e3:.0f} ms "
           f"(n = {len(results['concurrent_fast_s'])}, "
           f"p90 {sorted(results['concurrent_fast_s'])[int(0.9 * len(results['concurrent_fast_s']))] * 1e3:.0f})"
           f" = {concurrent / single:.2f} x single")
@@ -251,9 +415,18 @@ def main() -> None:
           f"change), browsers {cpu['browser_cpu_s']:.1f} CPU-s "
           f"({cpu['browser_cpu_s'] / cpu['changes'] * 1e3:.0f} ms per change); capacity "
           f"{2 * cpu['wall_s']:.1f} CPU-s (2 cores)")
-    print(f"browser console errors: {len(results['errors_single']) + len(results['errors_concurrent'])}")
-    if args.json:
-        Path(args.json).write_text(json.dumps(results, indent=1))
+
+
+def report_page_among_clients(results: dict, sessions: int, single: float) -> None:
+    mixed = statistics.median(results["mixed_page_s"])
+    clients = results["mixed_clients_s"]
+    print(f"1 page + {sessions - 1} protocol clients: page median {mixed * 1e3:.0f} ms "
+          f"(n = {len(results['mixed_page_s'])}, max {max(results['mixed_page_s']) * 1e3:.0f}) "
+          f"= {mixed / single:.2f} x single; clients median "
+          f"{statistics.median(clients) * 1e3:.0f} ms (n = {len(clients)})")
+    cpu = results["mixed_cpu"]
+    print(f"  during it ({cpu['wall_s']:.1f} s): server {cpu['server_cpu_s']:.1f} CPU-s, browser "
+          f"{cpu['browser_cpu_s']:.1f} CPU-s, protocol clients {cpu['clients_cpu_s']:.1f} CPU-s")
 
 
 if __name__ == "__main__":

@@ -139,3 +139,20 @@ def test_stability_limit(golden, golden_model):
     stored = golden["stability_limit"]
     limit = stability_limit(golden_model, stored["v_kmh"] * KMH, stored["N0"], stored["b_M"])
     assert limit.s0_limit == pytest.approx(stored["s0_limit"], rel=0, abs=LIMIT_ATOL), REGENERATE
+
+
+@pytest.mark.slow
+def test_stability_limit_bracket(golden, golden_model):
+    """A bracket (stable, unstable) around the crossing — as the dashboard takes from its root
+    locus — gives the same limit with fewer eigen-analyses; a bracket that does not hold (both
+    ends stable) is ignored: the full search runs and still finds the limit."""
+    stored = golden["stability_limit"]
+    args = (golden_model, stored["v_kmh"] * KMH, stored["N0"], stored["b_M"])
+    full = stability_limit(*args)
+    s0 = stored["s0_limit"]
+    narrowed = stability_limit(*args, bracket=(0.8 * s0, 1.2 * s0))
+    assert narrowed.s0_limit == pytest.approx(full.s0_limit, rel=0, abs=LIMIT_ATOL)
+    assert narrowed.evaluations < full.evaluations
+    wrong = stability_limit(*args, bracket=(0.5 * s0, 0.9 * s0))
+    assert wrong.s0_limit == pytest.approx(full.s0_limit, rel=0, abs=LIMIT_ATOL)
+    assert wrong.evaluations == full.evaluations + 2
