@@ -163,6 +163,17 @@ class LinearSystem:
             return lam, Y, lu, (1.0 / rcond if rcond > 0 else math.inf), scale
         return self._get("modal", build)
 
+    def solve_eigenvectors(self, rhs: np.ndarray) -> np.ndarray:
+        """Yb⁻¹ rhs with the cached LU factors of :attr:`modal` (thread-safe).
+
+        SciPy's LAPACK wrappers (1.17 and earlier) shift the pivot array *in place* to LAPACK's
+        1-based indices and back around each ``getrs``; two threads solving with one shared
+        pivot array shift it twice, swap rows out of range and corrupt the heap (the dashboard's
+        server aborted with "malloc(): invalid size" when sessions computed the same point).
+        Each call therefore passes its own copy of the pivots (n integers)."""
+        _, _, (lu, pivots), _, _ = self.modal
+        return sla.lu_solve((lu, pivots.copy()), rhs, check_finite=False)
+
     def step_particular(self, u0: float) -> tuple[np.ndarray, np.ndarray]:
         """(α, β) with x_p = α + β t solving ẋ = A x + b u0 [state units]."""
         n, R = self.n, self.R

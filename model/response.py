@@ -162,13 +162,13 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
     to the largest |y|, number of valid points, highest frequency [Hz] of a mode contributing
     more than 1 % of some output's peak)."""
     deflation, r = system.deflation, system.R.shape[1]
-    lam, Y, lu, cond, scale = system.modal  # A22 = (T Y) Λ (T Y)⁻¹, T = diag(scale)
+    lam, Y, _, cond, scale = system.modal  # A22 = (T Y) Λ (T Y)⁻¹, T = diag(scale)
     alpha, beta = system.step_particular(u0)
     x_mu = system.exponential_particular(a, mu)
     xh0 = -(alpha + x_mu.real)
     z0 = deflation.apply_transpose(xh0)  # [Q1ᵀ; Q2ᵀ] x_h(0)
     a0, c0 = z0[:r], z0[r:]
-    d = sla.lu_solve(lu, (c0 / scale).astype(complex), check_finite=False)
+    d = system.solve_eigenvectors((c0 / scale).astype(complex))
     CQ = deflation.apply_transpose(C.T).T  # C [Q1 Q2]
     CQ1 = CQ[:, :r]
     W = (CQ[:, r:] * scale) @ Y  # p x m

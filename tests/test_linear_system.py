@@ -1,12 +1,14 @@
 """Unit tests of the shared first-order form (model.linear_system): the Householder deflation
 and the eigendecomposition shared by the eigen-analysis and the response."""
 
+import threading
+
 import numpy as np
 import pytest
 
 from model import build_model, default_operating_point, eigen_analysis, load_parameters
 from model.eigen import bogie_system
-from model.linear_system import Deflation, SystemCache
+from model.linear_system import Deflation, LinearSystem, SystemCache
 
 
 @pytest.mark.parametrize("rank", [0, 1, 2, 3])
@@ -54,3 +56,40 @@ def test_eigen_analysis_and_response_share_one_decomposition():
     # two backward-stable solvers agree to rounding × condition: the near-rigid drivetrain-spin
     # eigenvalue (≈ −0.02 1/s) of this stiff matrix (|λ| up to 3e5 1/s) moves by ~3e-9 1/s
     assert np.all(distance <= 1e-7 * np.maximum(np.abs(fresh), 1.0))
+
+
+def _random_system(n: int = 190, seed: int = 3) -> LinearSystem:
+    rng = np.random.default_rng(seed)
+    L = rng.standard_normal((n, n))
+    M = L @ L.T + n * np.eye(n)
+    S = rng.standard_normal((n, n))
+    K = S @ S.T + np.eye(n)
+    B = 0.1 * rng.standard_normal((n, n)) + 0.5 * np.eye(n)
+    return LinearSystem(M, B, K, rng.standard_normal(n), np.zeros((n, 0)))
+
+
+def test_concurrent_solves_with_the_cached_factors_are_exact():
+    """Sessions of the dashboard solve with one cached LU of the eigenvectors at once.  SciPy's
+    getrs wrapper shifts the pivot array in place; with a shared pivot array this test aborted
+    the interpreter ("double free or corruption") or gave wrong solutions within a second
+    (reproduced with scipy 1.17.1, 3 threads); each solve now uses its own pivot copy."""
+    system = _random_system()
+    _, Y, _, _, _ = system.modal
+    rng = np.random.default_rng(7)
+    rhs = rng.standard_normal((8, Y.shape[0])) + 1j * rng.standard_normal((8, Y.shape[0]))
+    expected = [np.linalg.solve(Y, b) for b in rhs]
+    wrong = []
+
+    def solve(thread: int) -> None:
+        for k in range(3000):
+            i = (k + thread) % len(rhs)
+            x = system.solve_eigenvectors(rhs[i])
+            if not np.allclose(x, expected[i], rtol=1e-9, atol=1e-12):
+                wrong.append((thread, k))
+
+    threads = [threading.Thread(target=solve, args=(t,)) for t in range(3)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert not wrong, f"{len(wrong)} wrong solutions, first {wrong[:3]}"
