@@ -99,6 +99,12 @@ def _one_blas_thread() -> None:
             _blas_limited = True
 
 
+def _ignore_outcome(future) -> None:
+    """A computation whose result is no longer shown: retrieve its outcome when it ends (no
+    "exception was never retrieved" warning for a rejected, superseded parameter set)."""
+    future.add_done_callback(lambda f: f.cancelled() or f.exception())
+
+
 class BogieDashboard(pn.viewable.Viewer):
     """Stability and short-circuit load of the bogie at one operating point."""
 
@@ -350,18 +356,22 @@ class BogieDashboard(pn.viewable.Viewer):
             while self._dirty:
                 self._dirty = False
                 state = self.state()
+                # the root locus (≈ 0.3 s on two threads when not cached) starts at once, beside
+                # the fast stage (one thread), and is shown when both are done
+                locus_future = loop.run_in_executor(EXECUTOR, self._locus, state)
                 try:
                     fast = await loop.run_in_executor(EXECUTOR, self.compute_fast, state)
                 except MODEL_ERRORS as error:
                     doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+                    _ignore_outcome(locus_future)
                     continue
                 doc.add_next_tick_callback(partial(self._locked, doc, self._apply_fast, state,
                                                    fast))
                 if self._dirty:
+                    _ignore_outcome(locus_future)  # it still fills the cache
                     continue
-                # then the root locus (it solves on two threads itself), shown at once
                 try:
-                    locus = await loop.run_in_executor(EXECUTOR, self._locus, state)
+                    locus = await locus_future
                 except MODEL_ERRORS as error:
                     doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
                     continue
