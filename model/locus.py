@@ -142,8 +142,8 @@ _POOLS_LOCK = threading.Lock()
 
 
 def _solver_pool(workers: int) -> ThreadPoolExecutor:
-    """A persistent pool of ``workers`` threads per process (shared by all root loci): threads
-    are not created and destroyed per call (OpenBLAS keeps per-thread buffers)."""
+    """A persistent pool of ``workers`` threads per process, shared by all root loci (the
+    dashboard computes many; no threads are created and torn down per call)."""
     with _POOLS_LOCK:
         if workers not in _POOLS:
             _POOLS[workers] = ThreadPoolExecutor(max_workers=workers,
