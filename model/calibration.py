@@ -19,7 +19,8 @@ Stages: A — creep law (μ0, A, B) and gear ratio p to the operating data (leas
 determined); B — the structural parameters to the frequencies by a compass (pattern) search with
 a soft-L1 loss (:func:`frequency_cost`): the character matching makes the residuals jump where two
 modes trade places, which stalls a gradient method; C — the three modes governed by one spring
-each are polished by scaling that spring.
+each are polished by scaling that spring.  B and C run twice: first with the yaw dampers at their
+estimate, then with them free (:data:`SECOND_PASS`).
 
 The published targets live here, as *targets* of the fit; the model never reads them.
 """
@@ -139,8 +140,16 @@ STRUCTURAL_PARAMETERS = (
     FreeParameter("frame_inertia_x", 8e2, 5e3, "3–4 t frame, ~2.2 m wide"),
     FreeParameter("frame_inertia_z", 1.8e3, 1.3e4, "I_z <= I_x + I_y (see with_constraints)"),
     FreeParameter("stator_inertia_y", 80.0, 600.0, "3 t motor and gearbox about their axis"),
+    # the car body is held still in yaw (only its bounce is a coordinate), so the yaw dampers tie
+    # the frame's yaw to ground: at 12 Hz they decide how strongly the two wheelsets' yaw couple
+    FreeParameter("yaw_damping", 5e4, 1e6, "yaw damper of a 200 km/h loco, 0.05–1 MN s/m"),
 )
 FREE_PARAMETERS = CREEP_PARAMETERS + STRUCTURAL_PARAMETERS
+# freed only in the second pass of stage B: from the estimate, the yaw dampers' coupling of the
+# frame's pitch and yaw (they sit above the frame's centre) led the search into a minimum where
+# the frame's bounce and the WS1 pitch mode miss by 3–4 %; after the first pass has placed the
+# other modes, freeing them moves the wheelsets' yaw modes 9 and 10 apart as in Table 1
+SECOND_PASS = ("yaw_damping",)
 
 # a rigid body's principal inertias obey I_z <= I_x + I_y (equality for a flat body): the frame's
 # yaw inertia is kept within that as the search moves its roll and pitch inertias
@@ -327,14 +336,19 @@ def calibrate(start: Parameters, max_evaluations: int = 600, progress: Callable 
               ) -> tuple[Parameters, list[TargetRow]]:
     """Stage A fits the creep law and the gear ratio to the operating data (least squares);
     stage B the structure to the frequencies (pattern search, at most ``max_evaluations``
-    eigen-analyses); stage C polishes the single-spring modes.  Returns the calibrated set and
-    all its targets."""
+    eigen-analyses per pass); stage C polishes the single-spring modes; B and C run a second
+    time with :data:`SECOND_PASS` free as well.  Returns the calibrated set and all its
+    targets."""
     relative = lambda rows: np.array([row.error for row in rows])  # noqa: E731
     stage_a = _fit(start, CREEP_PARAMETERS, lambda p: relative(operating_rows(p)),
                    200, progress, "stage A (creep law, gear ratio)")
-    stage_b = _pattern_search(stage_a, STRUCTURAL_PARAMETERS,
-                              lambda p: frequency_cost(frequency_rows(p)),
-                              max_evaluations, progress, "stage B (structure)")
+    cost = lambda p: frequency_cost(frequency_rows(p))  # noqa: E731
+    first = tuple(f for f in STRUCTURAL_PARAMETERS if f.name not in SECOND_PASS)
+    stage_b = _pattern_search(stage_a, first, cost, max_evaluations, progress,
+                              "stage B1 (structure, yaw dampers at their estimate)")
+    stage_b = _polish(stage_b, progress)
+    stage_b = _pattern_search(stage_b, STRUCTURAL_PARAMETERS, cost, max_evaluations, progress,
+                              "stage B2 (structure and yaw dampers)")
     stage_b = _polish(stage_b, progress)
     notes = dict(start.notes)
     for f in FREE_PARAMETERS:

@@ -156,7 +156,9 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     """Track the non-rigid eigenvalues with |λ| < 2π·max_frequency_hz (at the first value) while
     ``parameter`` ("s0" [-] or "v" [m/s]) runs through ``values``; the other quantities of the
     operating point ``op`` stay fixed.  ``workers`` threads solve the reduced eigenproblems
-    (default 2, the cores of the target machine)."""
+    (default 2, the cores of the target machine).  A real eigenvalue inside the disc that meets a
+    real one outside it continues as one half of the new complex pair (the other half is not
+    tracked); pairs that start complex stay conjugate pairs."""
     if parameter not in ("s0", "v"):
         raise ValueError(f"parameter must be 's0' or 'v', got '{parameter}'")
     values = np.asarray(values, dtype=float)

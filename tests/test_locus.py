@@ -46,8 +46,14 @@ def test_branches_do_not_swap(setup):
 
 
 def test_conjugate_closed(setup):
+    """The branches that start as complex pairs stay conjugate pairs.  (A branch that starts
+    real may meet a real eigenvalue outside the tracked disc and continue as one half of a new
+    pair: with the calibrated set the real −57.5 1/s at s0 = 0.002 meets the untracked −150 1/s
+    by s0 = 0.0021; that branch is checked against the dense solution like every other.)"""
     _, _, _, locus = setup
-    for row in locus.eigenvalues:
+    first = locus.eigenvalues[0]
+    paired = np.abs(first.imag) > 1e-9 * np.abs(first)
+    for row in locus.eigenvalues[:, paired]:
         row = row[np.abs(row) < CONTROLLED]
         assert np.allclose(np.sort_complex(row), np.sort_complex(row.conj()), rtol=1e-8, atol=1e-8)
 
