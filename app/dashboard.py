@@ -21,7 +21,6 @@ import io
 import json
 import logging
 import math
-import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import partial
@@ -37,6 +36,7 @@ from model.parameters import dumps_parameters
 
 from . import compute
 from .plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
+from .serve import limit_blas_threads
 
 log = logging.getLogger(__name__)
 ASSETS = Path(__file__).resolve().parent.parent / "assets"
@@ -82,23 +82,6 @@ class State:
         return (self.params_path, self.rail, self.s0, self.v, self.N0, self.b_M)
 
 
-_BLAS_LIMITED = threading.Lock()
-_blas_limited = False
-
-
-def _one_blas_thread() -> None:
-    """Limit BLAS/LAPACK to one thread per call, once per process, before any computation
-    thread starts (the dashboard runs several computations in parallel; OpenBLAS's own threads
-    on top made one eigen-analysis 30-90x slower on the 2-core machine)."""
-    global _blas_limited
-    with _BLAS_LIMITED:
-        if not _blas_limited:
-            from threadpoolctl import threadpool_limits
-
-            threadpool_limits(1)
-            _blas_limited = True
-
-
 def _ignore_outcome(future) -> None:
     """A computation whose result is no longer shown: retrieve its outcome when it ends (no
     "exception was never retrieved" warning for a rejected, superseded parameter set)."""
@@ -125,7 +108,7 @@ class BogieDashboard(pn.viewable.Viewer):
     mode = param.Integer(1, bounds=(1, compute.N_COMPLEX_TABLE), doc="mode shown (ν)")
 
     def __init__(self, params_path: str | None = None, **params):
-        _one_blas_thread()
+        limit_blas_threads()
         super().__init__(**params)
         self._params_path = str(params_path or "")
         base = compute.parameters(self._params_path, "calibrated")
@@ -286,8 +269,7 @@ class BogieDashboard(pn.viewable.Viewer):
                      self.locus)
 
     # the four computations of a change; each independent of the others (run in parallel
-    # when served).  One BLAS thread each: set once per process (:func:`_one_blas_thread`), never
-    # per call from the worker threads (OpenBLAS's thread count is process-wide)
+    # when served).  One BLAS thread each: set once per process (app.serve.limit_blas_threads)
     @staticmethod
     def _point(state: State):
         return compute.point_result(*state.point)

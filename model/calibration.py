@@ -324,9 +324,10 @@ def _polish(parameters: Parameters, progress: Callable, iterations: int = 8) -> 
             changes[name] = float(np.clip(parameters[name] * np.clip(factor, 0.5, 2.0), *bounds[name]))
         trial = parameters.replace(**changes)
         trial_rows = frequency_rows(trial)
-        if frequency_cost(trial_rows) > cost:
+        trial_cost = frequency_cost(trial_rows)
+        if trial_cost > cost:
             break
-        parameters, rows, cost = trial, trial_rows, frequency_cost(trial_rows)
+        parameters, rows, cost = trial, trial_rows, trial_cost
     worst = max(abs(rows[i].error) for i, _ in SINGLE_SPRING_MODES)
     progress(f"  stage C (single-spring modes): largest error {100 * worst:.2f} %")
     return parameters

@@ -51,17 +51,18 @@ def stability_limit(model: BogieModel, v: float, N0: float, b_M: float, s0_low: 
         count += 1
         return max_real_part(model, OperatingPoint(s0, v, N0, b_M))
 
-    if bracket is not None:
-        low, high = float(bracket[0]), float(bracket[1])
-        if s0_low <= low < high <= s0_high and growth(low) <= 0 < growth(high):
-            s0 = brentq(growth, low, high, xtol=xtol, rtol=1e-10)
-            return StabilityLimit(v, float(s0), count)
-    if growth(s0_low) > 0:
-        raise NoStabilityLimit(f"already unstable at s0 = {s0_low:g}")
-    low, high = s0_low, 2 * s0_low
-    while growth(high) <= 0:
-        low, high = high, 2 * high
-        if high > s0_high:
-            raise NoStabilityLimit(f"stable over the whole range s0 <= {s0_high:g}")
+    def holds(low: float, high: float) -> bool:
+        return s0_low <= low < high <= s0_high and growth(low) <= 0 < growth(high)
+
+    if bracket is not None and holds(*map(float, bracket)):
+        low, high = map(float, bracket)
+    else:
+        if growth(s0_low) > 0:
+            raise NoStabilityLimit(f"already unstable at s0 = {s0_low:g}")
+        low, high = s0_low, 2 * s0_low
+        while growth(high) <= 0:
+            low, high = high, 2 * high
+            if high > s0_high:
+                raise NoStabilityLimit(f"stable over the whole range s0 <= {s0_high:g}")
     s0 = brentq(growth, low, high, xtol=xtol, rtol=1e-10)
     return StabilityLimit(v, float(s0), count)
