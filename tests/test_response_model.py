@@ -88,13 +88,17 @@ def test_both_evaluations_agree(bogie, method):
         assert np.abs(a.perturbation(name) - b.perturbation(name)).max() < TOLERANCE * scale
 
 
-def test_at_the_stability_limit_the_response_is_still_exact(bogie, tmp_path):
-    """At s0* one eigenvalue pair sits on the imaginary axis (and near the creep maximum the
-    rigid spins lose their creep damping): compare with exact stepping there."""
+@pytest.mark.parametrize("offset", [0.0, -1e-5, 1e-4])
+def test_at_the_stability_limit_the_response_is_still_exact(bogie, tmp_path, offset):
+    """At s0* a real eigenvalue passes through zero: the step's particular solution and that
+    mode cancel, the modal form's error grows like 1/|s0 − s0*| (measured 1.2e-5 at s0*, above the
+    requirement) and its estimate is 24-150x too small there.  At and beside s0* (relative
+    offsets 0, −1e-5, +1e-4) the auto choice must still meet the requirement against exact
+    stepping of the exported system."""
     parameters, model = bogie
     op0 = default_operating_point(parameters, 0.005)
     limit = stability_limit(model, op0.v, op0.N0, op0.b_M).s0_limit
-    op = default_operating_point(parameters, limit)
+    op = default_operating_point(parameters, limit * (1.0 + offset))
     path = tmp_path / "limit.npz"
     export_system(model, op, path)
     result = short_circuit_response(model, op, ShortCircuit(), 0.5, 2000.0)
