@@ -127,7 +127,7 @@ def summary_table(result) -> str:
              f"f = {e.f:g} Hz, D = {e.D:g}, Δt = {result.phase_shift:.4g} s",
              f"{len(result.t)} points to t = {result.t[-1]:g} s, method {result.method}"
              + ("" if math.isnan(result.error_estimate)
-                else f" (error estimate {result.error_estimate:.1e})")
+                else f" (rounding-error indicator {result.error_estimate:.1e}, not a bound)")
              + (f"; TRUNCATED at {result.truncated_at:g} s (growth)" if result.truncated_at
                 else ""),
              "values are totals (pre-fault + perturbation)", "",
