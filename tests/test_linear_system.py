@@ -8,7 +8,7 @@ import pytest
 
 from model import build_model, default_operating_point, eigen_analysis, load_parameters
 from model.eigen import bogie_system
-from model.linear_system import Deflation, LinearSystem, SystemCache
+from model.linear_system import Deflation, LinearSystem, SystemCache, balancing_scale
 
 
 @pytest.mark.parametrize("rank", [0, 1, 2, 3])
@@ -24,6 +24,43 @@ def test_deflation_is_orthogonal_and_spans_the_basis(rank):
     np.testing.assert_allclose(deflation.Q1, Q[:, :rank], atol=1e-14)
     A = rng.standard_normal((9, 9))
     np.testing.assert_allclose(deflation.project(A), Q.T @ A @ Q, atol=1e-13)
+
+
+def test_balancing_equalizes_rows_and_columns_by_powers_of_two():
+    """A balanced matrix spoilt by a diagonal similarity spanning 1e±9: the balancing returns
+    powers of 2, and at its end every row/column 1-norm ratio is within (1/2, 2) — the stopping
+    rule (no factor 2^round(½ log2(r/c)) left to apply); a zero row keeps its scale 1."""
+    rng = np.random.default_rng(5)
+    n = 60
+    A = rng.standard_normal((n, n))
+    spoil = 2.0 ** rng.integers(-30, 30, n)
+    A = A * spoil[None, :] / spoil[:, None]
+    A[7, :] = 0.0
+    d = balancing_scale(A)
+    np.testing.assert_array_equal(np.log2(d), np.round(np.log2(d)))
+    B = np.abs(A * d[None, :] / d[:, None])
+    np.fill_diagonal(B, 0.0)
+    rows, columns = B.sum(axis=1), B.sum(axis=0)
+    live = (rows > 0) & (columns > 0)
+    assert np.all(rows[live] / columns[live] < 2.0)
+    assert np.all(rows[live] / columns[live] > 0.5)
+    assert d[7] == 1.0
+    ratio = np.abs(A).max() / np.abs(A[np.abs(A) > 0]).min()
+    assert B.max() / B[B > 0].min() < 1e-6 * ratio  # the spread of the entries is gone
+
+
+def test_real_form_solve_matches_the_complex_solve():
+    """The eigenvectors' LU is of their real form (Re y, Im y per pair); real and complex
+    right-hand sides must give Yb⁻¹ rhs as a complex solve would."""
+    system = _random_system(n=40, seed=11)
+    lam, Y, _, cond, _ = system.modal
+    assert np.any(lam.imag > 0)
+    assert np.isfinite(cond)
+    rng = np.random.default_rng(2)
+    for rhs in (rng.standard_normal(Y.shape[0]),
+                rng.standard_normal(Y.shape[0]) + 1j * rng.standard_normal(Y.shape[0])):
+        np.testing.assert_allclose(system.solve_eigenvectors(rhs), np.linalg.solve(Y, rhs),
+                                   rtol=1e-10, atol=1e-12 * np.abs(np.linalg.solve(Y, rhs)).max())
 
 
 def test_cache_keeps_the_newest_points():

@@ -91,8 +91,8 @@ def test_both_evaluations_agree(bogie, method):
 @pytest.mark.parametrize("offset", [0.0, -1e-5, 1e-4])
 def test_at_the_stability_limit_the_response_is_still_exact(bogie, tmp_path, offset):
     """At s0* a real eigenvalue passes through zero: the step's particular solution and that
-    mode cancel, the modal form's error grows like 1/|s0 − s0*| (measured 1.2e-5 at s0*, above the
-    requirement) and its estimate is 24-150x too small there.  At and beside s0* (relative
+    mode cancel; the modal form's estimate grows like 1/|s0 − s0*|, its error reaches 1.2e-5 at
+    s0* (above the requirement) while the estimate says 5e-7 (24-150x too small near s0*).  At and beside s0* (relative
     offsets 0, −1e-5, +1e-4) the auto choice must still meet the requirement against exact
     stepping of the exported system."""
     parameters, model = bogie
