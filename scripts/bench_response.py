@@ -163,7 +163,7 @@ def main() -> None:
         rows[name] = (t_radau, error(y_radau @ C.T, reference[:done]) if done else np.nan)
     print(f"system: {model.n} DOF, state {2 * model.n}, {len(outputs.names)} outputs, "
           f"{steps} points ({args.t_end:g} s at {args.fs:g} Hz); method {method}, "
-          f"error estimate {estimate:.1e}; reference (exact stepping) took {t_reference:.2f} s")
+          f"rounding-error indicator {estimate:.1e} (not a bound); reference (exact stepping) took {t_reference:.2f} s")
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"load average {os.getloadavg()[0]:.2f}; numpy {np.__version__}, scipy "
           f"{scipy.__version__}; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}")
