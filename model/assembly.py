@@ -86,12 +86,12 @@ class BogieModel:
 
 
 class _Assembler:
-    def __init__(self, dofs: DofMap):
+    def __init__(self, dofs: DofMap, dtype=float):
         self.dofs = dofs
         n = len(dofs)
-        self.M = np.zeros((n, n))
-        self.K = np.zeros((n, n))
-        self.B = np.zeros((n, n))
+        self.M = np.zeros((n, n), dtype=dtype)
+        self.K = np.zeros((n, n), dtype=dtype)
+        self.B = np.zeros((n, n), dtype=dtype)
         self.mass_parts: dict[str, np.ndarray] = {}
         self.stiffness_parts: dict[str, np.ndarray] = {}
         self.connections: list[SpringDamper] = []
@@ -149,8 +149,8 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
            axle_x: float, positions: dict[str, np.ndarray]) -> dict[str, Body]:
     """Add one individual wheelset drive.  ``sign`` maps drive-1 geometry to this drive's."""
     dofs = asm.dofs
-    pos = lambda x, y, z: sign @ np.array([x, y, z], dtype=float)  # noqa: E731
-    direction = lambda v: sign @ np.asarray(v, dtype=float)  # noqa: E731
+    pos = lambda x, y, z: sign @ np.array([x, y, z], dtype=np.result_type(x, y, z, float))  # noqa: E731
+    direction = lambda v: sign @ np.asarray(v, dtype=np.result_type(*v, float))  # noqa: E731
     loss_rubber, loss_steel = p["rubber_loss_time"], p["shaft_loss_time"]
 
     ratio, r_gear = p["gear_ratio"], p["gear_radius"]
@@ -268,7 +268,9 @@ def build_model(parameters: Parameters) -> BogieModel:
     """Assemble the constant matrices of the bogie for a parameter set."""
     p = parameters
     dofs = DofMap(dof_names())
-    asm = _Assembler(dofs)
+    # complex values (a complex-step perturbation, model.sensitivity) give complex matrices
+    dtype = complex if any(isinstance(value, complex) for value in p.values.values()) else float
+    asm = _Assembler(dofs, dtype)
     positions: dict[str, np.ndarray] = {}
     n = len(dofs)
 
@@ -314,7 +316,7 @@ def build_model(parameters: Parameters) -> BogieModel:
     short_circuit[dofs.index("ID1.rotor.ry")] = -1.0
     short_circuit[dofs.index("ID1.stator.ry")] = 1.0
 
-    rigid = np.zeros((n, 2))
+    rigid = np.zeros((n, 2), dtype=dtype)
     for column, prefix in enumerate(DRIVES):
         for name in dofs.names:
             if name.startswith(prefix) and name.endswith(".ry") and ".stator." not in name:

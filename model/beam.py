@@ -38,7 +38,9 @@ def beam_local_matrices(length: float, section: TubeSection, young: float, poiss
     L = length
     E, G = young, young / (2 * (1 + poisson))
     A, Iyz, J = section.area, section.second_moment, section.polar_moment
-    K = np.zeros((12, 12))
+    # complex if a value is complex (complex-step sensitivities, model.sensitivity)
+    dtype = np.result_type(L, E, poisson, density, A, Iyz, float)
+    K = np.zeros((12, 12), dtype=dtype)
     K[np.ix_([0, 6], [0, 6])] = E * A / L * np.array([[1, -1], [-1, 1]])
     K[np.ix_([3, 9], [3, 9])] = G * J / L * np.array([[1, -1], [-1, 1]])
     bend = E * Iyz / L**3 * np.array([[12, 6 * L, -12, 6 * L], [6 * L, 4 * L * L, -6 * L, 2 * L * L],
@@ -48,7 +50,7 @@ def beam_local_matrices(length: float, section: TubeSection, young: float, poiss
     K[np.ix_([2, 4, 8, 10], [2, 4, 8, 10])] = flip @ bend @ flip
 
     m = density * A * L
-    M = np.zeros((12, 12))
+    M = np.zeros((12, 12), dtype=dtype)
     M[np.ix_([0, 6], [0, 6])] = m / 6 * np.array([[2, 1], [1, 2]])
     M[np.ix_([3, 9], [3, 9])] = density * J * L / 6 * np.array([[2, 1], [1, 2]])
     mb = m / 420 * np.array([[156, 22 * L, 54, -13 * L], [22 * L, 4 * L * L, 13 * L, -3 * L * L],
@@ -58,14 +60,19 @@ def beam_local_matrices(length: float, section: TubeSection, young: float, poiss
     return K, M
 
 
+def _length(vector: np.ndarray):
+    """Euclidean length √(v·v), analytic in a complex perturbation (``np.linalg.norm`` is not)."""
+    return np.sqrt(vector @ vector) if np.iscomplexobj(vector) else float(np.linalg.norm(vector))
+
+
 def local_frame(start: np.ndarray, end: np.ndarray) -> np.ndarray:
     """3 x 3 rotation whose rows are the local axes in global coordinates (local x along the beam;
     local y chosen perpendicular to it, preferring the global z axis)."""
-    ex = np.asarray(end, float) - np.asarray(start, float)
-    ex /= np.linalg.norm(ex)
-    helper = np.array([0.0, 0.0, 1.0]) if abs(ex[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    ex = np.asarray(end) - np.asarray(start)
+    ex = ex / _length(ex)
+    helper = np.array([0.0, 0.0, 1.0]) if abs(ex[2].real) < 0.9 else np.array([1.0, 0.0, 0.0])
     ey = helper - ex * (helper @ ex)
-    ey /= np.linalg.norm(ey)
+    ey = ey / _length(ey)
     return np.vstack([ex, ey, np.cross(ex, ey)])
 
 
@@ -73,7 +80,7 @@ def beam_global_matrices(start, end, section: TubeSection, young: float, poisson
                          density: float) -> tuple[np.ndarray, np.ndarray]:
     """12 x 12 stiffness and mass of a beam between two nodes, in global axes (DOF order per node
     ``[x, y, z, rx, ry, rz]``)."""
-    length = float(np.linalg.norm(np.asarray(end, float) - np.asarray(start, float)))
+    length = _length(np.asarray(end) - np.asarray(start))
     K, M = beam_local_matrices(length, section, young, poisson, density)
     T = np.kron(np.eye(4), local_frame(start, end))
     return T.T @ K @ T, T.T @ M @ T

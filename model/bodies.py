@@ -17,6 +17,13 @@ import numpy as np
 from .dofs import AXES6, DofMap
 
 
+def _coordinates(values) -> np.ndarray:
+    """Float array of a point or vector; complex if a value is complex (complex-step
+    sensitivities carry a parameter's perturbation through the geometry, :mod:`model.sensitivity`)."""
+    values = np.asarray(values)
+    return values.astype(complex if np.iscomplexobj(values) else float)
+
+
 def skew(r: np.ndarray) -> np.ndarray:
     """Matrix S(r) with S(r) a = r × a."""
     x, y, z = r
@@ -26,7 +33,7 @@ def skew(r: np.ndarray) -> np.ndarray:
 def point_map(offset: np.ndarray) -> np.ndarray:
     """3 x 6 map from a body's 6-vector at its origin to the displacement of a point at ``offset``:
     ``u_P = u + θ × r = [I, −S(r)] [u; θ]``."""
-    return np.hstack([np.eye(3), -skew(np.asarray(offset, dtype=float))])
+    return np.hstack([np.eye(3), -skew(_coordinates(offset))])
 
 
 @dataclass(frozen=True)
@@ -39,7 +46,7 @@ class Body:
 
     def point(self, position: np.ndarray) -> np.ndarray:
         """3 x n map from q to the displacement of the material point at ``position`` [m]."""
-        return point_map(np.asarray(position, float) - self.origin) @ self.W
+        return point_map(_coordinates(position) - self.origin) @ self.W
 
     def rotation(self) -> np.ndarray:
         """3 x n map from q to the body's small rotation vector."""
@@ -51,15 +58,16 @@ def free_body(name: str, origin, dofs: DofMap, axes=AXES6) -> Body:
     W = np.zeros((6, len(dofs)))
     for axis in axes:
         W[AXES6.index(axis), dofs.index(f"{name}.{axis}")] = 1.0
-    return Body(name, np.asarray(origin, dtype=float), W)
+    return Body(name, _coordinates(origin), W)
 
 
 def carried_body(name: str, origin, carrier: Body, dofs: DofMap, spin_axis: str = "ry") -> Body:
     """A body borne in ``carrier``: it translates and tilts with the carrier and owns only its
     rotation about ``spin_axis`` (coordinate ``name.<spin_axis>``)."""
-    origin = np.asarray(origin, dtype=float)
-    W = np.zeros((6, len(dofs)))
-    W[:3] = carrier.point(origin)
+    origin = _coordinates(origin)
+    carried = carrier.point(origin)
+    W = np.zeros((6, len(dofs)), dtype=carried.dtype)
+    W[:3] = carried
     W[3:] = carrier.rotation()
     k = AXES6.index(spin_axis)
     W[k] = 0.0

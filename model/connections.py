@@ -51,8 +51,12 @@ class SpringDamper:
     def matrices(self) -> tuple[np.ndarray, np.ndarray]:
         """Global stiffness and damping contributions (n x n)."""
         n = self.a.W.shape[1]
-        K = np.zeros((n, n))
-        B = np.zeros((n, n))
+        values = [self.a.W, self.b.W, self.position]
+        for spring in self.springs:
+            values += [spring.direction, np.asarray(spring.stiffness), np.asarray(spring.damping)]
+        dtype = np.result_type(*values)
+        K = np.zeros((n, n), dtype=dtype)  # complex for complex-step sensitivities
+        B = np.zeros((n, n), dtype=dtype)
         for spring in self.springs:
             g = self.relative(spring)
             outer = np.outer(g, g)
@@ -61,11 +65,16 @@ class SpringDamper:
         return K, B
 
 
+def _scalar(value) -> float | complex:
+    """float, or complex if complex (complex-step sensitivities, :mod:`model.sensitivity`)."""
+    return complex(value) if np.iscomplexobj(value) else float(value)
+
+
 def axis_springs(stiffness_xyz, damping_xyz=(0.0, 0.0, 0.0), rotational=False,
                  channels=("", "", "")) -> tuple[Spring, ...]:
     """Springs along (or about) the global x, y, z axes; zero stiffness and damping are skipped."""
     springs = []
     for axis, k, c, channel in zip(np.eye(3), stiffness_xyz, damping_xyz, channels, strict=True):
         if k or c:
-            springs.append(Spring(axis, float(k), float(c), rotational, channel))
+            springs.append(Spring(axis, _scalar(k), _scalar(c), rotational, channel))
     return tuple(springs)
