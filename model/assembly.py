@@ -181,7 +181,7 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
     hollow = TubeSection(p["hollow_shaft_outer_radius"], p["hollow_shaft_inner_radius"])
     for k1, k2 in pairwise(HOLLOW_SHAFT_NODES):
         asm.add_beam(f"{prefix}.hollow_shaft", f"{prefix}.hollow_shaft", hs[k1], hs[k2], hollow, p)
-    axle_order = sorted(axle_y, key=axle_y.get)
+    axle_order = sorted(axle_y, key=lambda k: np.real(axle_y[k]))
     solid = TubeSection(p["axle_radius"])
     for k1, k2 in pairwise(axle_order):
         asm.add_beam(f"{prefix}.axle", f"{prefix}.wheelset", ax[k1], ax[k2], solid, p)

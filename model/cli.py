@@ -298,6 +298,10 @@ from .response_cli import register as _register_response  # noqa: E402
 
 EXTRA_COMMANDS.append(_register_response)
 
+from .sensitivity_cli import register as _register_sensitivity  # noqa: E402  (issue 12)
+
+EXTRA_COMMANDS.append(_register_sensitivity)
+
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits

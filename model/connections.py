@@ -51,7 +51,7 @@ class SpringDamper:
     def matrices(self) -> tuple[np.ndarray, np.ndarray]:
         """Global stiffness and damping contributions (n x n)."""
         n = self.a.W.shape[1]
-        values = [self.a.W, self.b.W, self.position]
+        values = [self.a.W, self.b.W, self.a.origin, self.b.origin, self.position]
         for spring in self.springs:
             values += [spring.direction, np.asarray(spring.stiffness), np.asarray(spring.damping)]
         dtype = np.result_type(*values)

@@ -119,7 +119,8 @@ class PolachLaw:
     slope: float  # [-] initial creep slope (dμ/ds at s = 0 is (2/π)(kA + kS) slope μ_f/μ_f)
 
     def _parts(self, s, v):
-        s = np.asarray(s, dtype=float)
+        s = np.asarray(s)
+        s = s.astype(complex if np.iscomplexobj(s) else float)  # complex step (model.sensitivity)
         decay = np.exp(-self.B * s * v)
         mu_f = self.mu0 * ((1 - self.A) * decay + self.A)
         dmu_f = self.mu0 * (1 - self.A) * decay * (-self.B * v)
@@ -166,7 +167,7 @@ def creep_block(b11: float, b22: float, b23: float, b33: float, r0: float) -> np
     b11 [N s/m] = N0 μ'(s0)/v, b22 [N s/m] = f22/v, b23 [N s] = f23/v, b33 [N s m] = f33/v.
     """
     X, Y, _, RX, RY, RZ = range(6)  # the vertical z has no creep term
-    B = np.zeros((6, 6))
+    B = np.zeros((6, 6), dtype=np.result_type(b11, b22, b23, b33, r0, float))  # complex step too
     # longitudinal: slip velocity r0 ω_y − ẋ,  F_x = b11 (r0 ṙy − ẋ), M_y = −r0 F_x
     B[X, X], B[X, RY], B[RY, X], B[RY, RY] = b11, -r0 * b11, -r0 * b11, r0 * r0 * b11
     # lateral: slip velocity ẏ + r0 ṙx; spin ṙz.  F_y = −b22 (ẏ + r0 ṙx) − b23 ṙz, M_x = r0 F_y,
