@@ -1,0 +1,276 @@
+"""Sensitivities (model/sensitivity.py) and the uncertainty pipeline (model/uncertainty.py).
+
+* analytic dλ/dp against fourth-order central differences of eigenvalues (test-only) for every
+  parameter and s0, v, N0, b_M at three operating points (slow).  Tolerance 1e-5 relative to the
+  parameter's largest derivative over the ten modes.  The difference step is chosen so that the
+  largest eigenvalue change is 1e-3 of |λ| (capped at 5 % of the parameter): the eigenvalues of the
+  386-state problem carry rounding noise of ~1e-13 |λ|, and a parameter that hardly moves the ten
+  lowest modes (the gear mesh: p |dλ/dp| ≈ 2e-4 |λ|) would otherwise be measured in noise (with a
+  fixed 1e-3 relative step the differences disagreed with themselves at 1e-3);
+* completeness (Euler's theorem for homogeneous functions): all masses, stiffnesses and dampers
+  scaled by one factor leave every eigenvalue unchanged, so the sensitivities summed along that
+  direction vanish; and the derivative matrices sum to M, K, B along it;
+* the rigid-body spin's damping: only the creep acts on it, so s0* is the creep maximum and no
+  structural parameter moves it (checked by recomputing s0* with a changed parameter);
+* the Sobol pipeline on the Ishigami function (known indices);
+* bad input: one line, exit status 2.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from model.assembly import build_model
+from model.cli import main
+from model.eigen import eigen_analysis
+from model.operating_point import KMH, OperatingPoint, creep_law, damping_matrix
+from model.parameters import SCHEMA, Parameters, load_parameters
+from model.sensitivity import (
+    NOT_IN_ASSEMBLY,
+    OPERATING_PARAMETERS,
+    MatrixDerivative,
+    SensitivityError,
+    complex_step_parameters,
+    eigen_sensitivities,
+    null_vectors,
+    structural_derivatives,
+)
+from model.stability import stability_limit
+from model.uncertainty import UncertaintyError, run_uncertainty, sobol_study
+
+
+@pytest.fixture(scope="module")
+def setup():
+    parameters = load_parameters()
+    return parameters, build_model(parameters)
+
+
+def _op(parameters, s0, v_kmh=120.0):
+    return OperatingPoint(s0, v_kmh * KMH, parameters["wheel_force"], parameters["motor_slope"])
+
+
+def _eigenvalues(parameters, model, op, name, value):
+    if name in OPERATING_PARAMETERS:
+        return eigen_analysis(model, OperatingPoint(**{**op.__dict__, name: value}),
+                              vectors=False).eigenvalues
+    values = dict(parameters.values)
+    values[name] = value
+    return eigen_analysis(build_model(Parameters(values)), op, vectors=False).eigenvalues
+
+
+# s0 = 0.005 stable, 0.0080 just below the limit (s0* = 0.0082), 0.014 unstable (Table 1)
+@pytest.mark.slow
+@pytest.mark.parametrize("s0", [0.005, 0.0080, 0.014])
+def test_against_finite_differences(setup, s0):
+    parameters, model = setup
+    op = _op(parameters, s0)
+    sens = eigen_sensitivities(model, op)
+    assert sens.reliable.all()
+    lam = sens.eigenvalues
+    failures = []
+    for i, name in enumerate(sens.names):
+        analytic = sens.derivatives[i]
+        largest = np.abs(analytic).max()
+        if largest == 0.0:  # e.g. motor_slope at a fixed b_M: no entry at all; checked below
+            continue
+        value = sens.values[i]
+        h = 1e-3 * np.abs(lam).min() / largest
+        if value != 0.0:
+            h = min(h, 0.05 * abs(value))
+        if name == "polach_kA":  # at its upper bound 1: the law is analytic beyond it
+            h = min(h, 0.01)
+        ev = {c: _eigenvalues(parameters, model, op, name, value + c * h) for c in (-2, -1, 1, 2)}
+        pick = lambda e, target: e[np.argmin(np.abs(e - target))]  # noqa: E731
+        fd = np.array([(-pick(ev[2], t) + 8 * pick(ev[1], t) - 8 * pick(ev[-1], t) + pick(ev[-2], t))
+                       / (12 * h) for t in lam])
+        error = np.abs(analytic - fd).max() / np.abs(fd).max()
+        if error > 1e-5:
+            failures.append(f"{name}: {error:.2e}")
+    assert not failures, f"at s0 = {s0}: " + ", ".join(failures)
+
+
+def test_unlinked_motor_slope_and_linked_rows(setup):
+    parameters, model = setup
+    op = _op(parameters, 0.005)
+    free = eigen_sensitivities(model, op, parameters=["motor_slope", "wheel_force"])
+    assert np.all(free.row("motor_slope") == 0)  # b_M of the operating point is fixed
+    linked = eigen_sensitivities(model, op, linked=["motor_slope", "wheel_force"],
+                                 parameters=["motor_slope", "wheel_force"])
+    np.testing.assert_array_equal(linked.row("motor_slope"), free.row("b_M"))
+    np.testing.assert_allclose(linked.row("wheel_force"), free.row("wheel_force") + free.row("N0"))
+
+
+def test_not_in_assembly_is_true(setup):
+    """The parameters skipped by structural_derivatives really do not enter M, B, K."""
+    parameters, model = setup
+    for name in sorted(NOT_IN_ASSEMBLY):
+        perturbed = build_model(complex_step_parameters(parameters, name, 1e-20))
+        for matrix in (perturbed.M, perturbed.B, perturbed.K):
+            assert np.all(np.imag(matrix) == 0), name
+
+
+def _homogeneous_direction():
+    masses = [n for n, (unit, _, _) in SCHEMA.items() if unit in ("kg", "kg m^2", "kg/m^3")]
+    stiffnesses = [n for n, (unit, _, _) in SCHEMA.items()
+                   if unit in ("N/m", "N m/rad") or n == "young_modulus"]
+    dampers = [n for n, (unit, _, _) in SCHEMA.items() if unit == "N s/m"]
+    return masses, stiffnesses, dampers
+
+
+def test_euler_matrices(setup):
+    """Σ p ∂M/∂p over the masses = M, Σ p ∂K/∂p over the stiffnesses = K, and B (structural) is
+    reproduced by stiffnesses (loss-time dampers) plus dampers: no parameter is missing."""
+    parameters, model = setup
+    derivatives = structural_derivatives(model)
+    masses, stiffnesses, dampers = _homogeneous_direction()
+
+    def summed(names, which):
+        total = np.zeros((model.n, model.n))
+        for name in names:
+            d = derivatives.get(name)
+            if d is not None and getattr(d, which) is not None:
+                total[np.ix_(d.index, d.index)] += parameters[name] * getattr(d, which)
+        return total
+
+    np.testing.assert_allclose(summed(masses, "M"), model.M, atol=1e-9 * np.abs(model.M).max())
+    np.testing.assert_allclose(summed(stiffnesses, "K"), model.K, atol=1e-9 * np.abs(model.K).max())
+    np.testing.assert_allclose(summed(stiffnesses + dampers, "B"), model.B,
+                               atol=1e-9 * np.abs(model.B).max())
+
+
+@pytest.mark.parametrize("s0", [0.005, 0.014])
+def test_euler_eigenvalues(setup, s0):
+    """Scaling M, K and all damping (structural, b_M, B_ad) by one factor leaves λ unchanged:
+    Σ p ∂λ/∂p along that direction + the B_ad and b_M terms = 0 (to 1e-8 of the terms)."""
+    parameters, model = setup
+    op = _op(parameters, s0)
+    masses, stiffnesses, dampers = _homogeneous_direction()
+    result = eigen_analysis(model, op)
+    indices = result.complex_index[:10]
+    lam = result.eigenvalues[indices]
+    B_total = damping_matrix(model, op)
+    X = np.empty((model.n, len(lam)), complex)
+    Y = np.empty_like(X)
+    for k, i in enumerate(indices):
+        X[:, k], Y[:, k] = null_vectors(model, B_total, lam[k], result.vectors[:model.n, i])
+    denominator = np.einsum("ik,ik->k", Y.conj(), 2 * lam * (model.M @ X) + B_total @ X)
+    derivatives = structural_derivatives(model)
+    total = np.zeros(len(lam), complex)
+    magnitude = np.zeros(len(lam))
+    for name in masses + stiffnesses + dampers:
+        if name in derivatives:
+            term = -parameters[name] * derivatives[name].quadratic(lam, X, Y) / denominator
+            total += term
+            magnitude += np.abs(term)
+    operating = B_total - model.B  # b_M B_M + B_ad: scaled with the rest
+    index = np.arange(model.n)
+    term = -MatrixDerivative(index, None, operating, None).quadratic(lam, X, Y) / denominator
+    total += term
+    magnitude += np.abs(term)
+    assert np.all(np.abs(total) <= 1e-8 * magnitude), np.abs(total) / magnitude
+
+
+def test_limit_is_creep_maximum_and_structure_cannot_move_it(setup):
+    parameters, model = setup
+    from model.sensitivity import limit_sensitivity
+
+    v, N0, b_M = 120 * KMH, parameters["wheel_force"], parameters["motor_slope"]
+    limit = limit_sensitivity(model, v, N0, b_M)
+    s_max, _ = creep_law(parameters, N0).maximum(v)
+    assert limit.mechanism == "creep maximum"
+    assert abs(limit.s0_limit - s_max) < 1e-6
+    d = dict(zip(limit.names, limit.derivatives, strict=True))
+    assert d["disc_clutch_torsional_stiffness"] == 0.0 and d["polach_B"] != 0.0
+    # a 30 % stiffer disc clutch: s0* unchanged (within Brent's xtol 1e-7)
+    stiffer = build_model(parameters.replace(
+        disc_clutch_torsional_stiffness=1.3 * parameters["disc_clutch_torsional_stiffness"]))
+    assert abs(stability_limit(stiffer, v, N0, b_M).s0_limit - limit.s0_limit) < 2e-7
+    # polach_B: the implicit-function derivative against the creep maximum's central difference
+    h = 1e-4 * parameters["polach_B"]
+    up = creep_law(parameters.replace(polach_B=parameters["polach_B"] + h), N0).maximum(v)[0]
+    down = creep_law(parameters.replace(polach_B=parameters["polach_B"] - h), N0).maximum(v)[0]
+    assert d["polach_B"] == pytest.approx((up - down) / (2 * h), rel=1e-5)
+
+
+def test_unknown_parameter(setup):
+    parameters, model = setup
+    with pytest.raises(SensitivityError, match="unknown parameter 'nope'"):
+        eigen_sensitivities(model, _op(parameters, 0.005), parameters=["nope"])
+
+
+def test_ishigami_sobol_indices():
+    """Ishigami f = sin x1 + 7 sin² x2 + 0.1 x3⁴ sin x1 on [−π, π]³ (a = 7, b = 0.1): first order
+    (0.3139, 0.4424, 0), total (0.5576, 0.4424, 0.2437) (Saltelli et al., Global Sensitivity
+    Analysis: The Primer, 2008).  With n = 4096 the estimates sit within 0.03 of them and inside
+    their bootstrap intervals widened by 0.02."""
+    from scipy import stats
+
+    def ishigami(chunk):
+        x1, x2, x3 = np.atleast_2d(chunk).T
+        return (np.sin(x1) + 7 * np.sin(x2) ** 2 + 0.1 * x3**4 * np.sin(x1))[:, None]
+
+    calls = []
+
+    def counting_map(func, chunks):  # a map-like executor: every chunk goes through it
+        for chunk in chunks:
+            calls.append(len(chunk))
+            yield func(chunk)
+
+    dists = [stats.uniform(-np.pi, 2 * np.pi)] * 3
+    runs, samples, values, first, total, first_ci, total_ci = sobol_study(
+        ishigami, dists, 4096, map_fn=counting_map, chunk_size=1000, n_resamples=99)
+    assert runs == 4096 * 5 == sum(calls)
+    assert samples.shape == (8192, 3) and values.shape == (8192, 1)
+    np.testing.assert_allclose(first[0], [0.3139, 0.4424, 0.0], atol=0.03)
+    np.testing.assert_allclose(total[0], [0.5576, 0.4424, 0.2437], atol=0.03)
+    assert np.all(first_ci[0, 0] - 0.02 <= [0.3139, 0.4424, 0.0])
+    assert np.all([0.3139, 0.4424, 0.0] <= first_ci[1, 0] + 0.02)
+
+
+def test_uncertainty_bad_input(setup):
+    parameters, _ = setup
+    with pytest.raises(UncertaintyError, match="power of 2"):
+        run_uncertainty(parameters, 3)
+    with pytest.raises(UncertaintyError, match="power of 2"):
+        run_uncertainty(parameters, 1)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["sensitivity", "--s0", "0.005", "--only", "nope"], "unknown parameter 'nope'"),
+    (["sensitivity", "--s0", "2"], "--s0"),
+    (["uncertainty", "--samples", "1"], "power of 2"),
+    (["uncertainty", "--samples", "6"], "power of 2"),
+    (["uncertainty", "--samples", "x"], "invalid int"),
+    (["uncertainty", "--samples", "4", "--out", "/no/such/dir/u.json"], "does not exist"),
+])
+def test_cli_bad_input(argv, message, capsys):
+    with pytest.raises(SystemExit) if "x" in argv or argv[-1] == "2" else _nothing():
+        status = main(argv)
+        assert status == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+
+
+class _nothing:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+
+def test_cli_json_keys(capsys):
+    import json
+
+    status = main(["sensitivity", "--s0", "0.005", "--v", "120", "--json",
+                   "--only", "disc_clutch_torsional_stiffness,polach_B"])
+    assert status == 0
+    data = json.loads(capsys.readouterr().out)
+    assert {"operating_point", "modes", "parameters"} <= set(data)
+    assert len(data["modes"]) == 10 and {"re", "im_hz", "description"} <= set(data["modes"][0])
+    row = data["parameters"][0]
+    assert row["name"] == "disc_clutch_torsional_stiffness"
+    assert set(row) == {"name", "value", "unit", "d_re_dp", "d_im_hz_dp", "d_s0_limit_dp"}
+    assert len(row["d_re_dp"]) == 10 and len(row["d_im_hz_dp"]) == 10
+    assert row["d_s0_limit_dp"] == 0.0 and data["parameters"][1]["d_s0_limit_dp"] != 0.0
