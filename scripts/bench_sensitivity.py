@@ -1,0 +1,119 @@
+"""Benchmark of the sensitivities and of the uncertainty study's cost.
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/bench_sensitivity.py [--repeats 3]
+        [--sobol-n 8] [--json FILE]
+
+In one run, on the calibrated set at s0 = 0.005, 120 km/h:
+
+* reference: one eigen-analysis with vectors at a fresh operating point (cold decomposition);
+* sensitivities: every parameter and s0, v, N0, b_M for the ten lowest modes
+  (:func:`model.sensitivity.eigen_sensitivities`, the decomposition cached) plus ds0*/dp at a
+  known s0* (:func:`model.sensitivity.limit_sensitivity`, its eigen-analysis included); the
+  ratio (reference + sensitivities)/reference is the issue's "≤ 2×" target;
+* cold: the derivative matrices of the parameter set (complex step, once per set);
+* peak loads: central differences of the response for three parameters (cost per parameter);
+* Sobol: ``run_uncertainty`` with base size ``--sobol-n`` (n (d + 2) runs), the widths of the
+  95 % bootstrap intervals of the leading total indices, and the n projected for width 0.05
+  (width ∝ n^(−1/2)) with its serial cost and on N workers (runs are independent).
+
+Times are the median of ``--repeats`` repeats, wall clock; the machine may be shared (ratios are
+from the same run).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import time
+
+import numpy as np
+
+from model import build_model, load_parameters
+from model.eigen import eigen_analysis, forget_systems
+from model.operating_point import KMH, OperatingPoint
+from model.sensitivity import (
+    eigen_sensitivities,
+    limit_sensitivity,
+    peak_load_sensitivities,
+    structural_derivatives,
+)
+from model.stability import stability_limit
+from model.uncertainty import UNCERTAIN_PARAMETERS, run_uncertainty
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--sobol-n", type=int, default=8)
+    parser.add_argument("--json", default=None)
+    args = parser.parse_args()
+    parameters = load_parameters()
+    model = build_model(parameters)
+    N0, b_M, v = parameters["wheel_force"], parameters["motor_slope"], 120 * KMH
+    report: dict = {}
+
+    start = time.perf_counter()
+    derivatives = structural_derivatives(model)
+    report["derivative_matrices_s"] = time.perf_counter() - start
+    report["derivative_parameters"] = len(derivatives)
+    print(f"derivative matrices (cold, once per set): {report['derivative_matrices_s']:.2f} s "
+          f"for {len(derivatives)} parameters")
+    s0_limit = stability_limit(model, v, N0, b_M).s0_limit
+
+    eig_times, sens_times, limit_times = [], [], []
+    for k in range(args.repeats):
+        op = OperatingPoint(0.005 * (1 + 1e-6 * k), v, N0, b_M)  # a fresh point each repeat
+        forget_systems(model)
+        start = time.perf_counter()
+        eigen_analysis(model, op)
+        eig_times.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        eigen_sensitivities(model, op, linked=("wheel_force", "motor_slope"))
+        sens_times.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        limit_sensitivity(model, v, N0, b_M, linked=("wheel_force", "motor_slope"), s0_limit=s0_limit)
+        limit_times.append(time.perf_counter() - start)
+    t_eig, t_sens, t_limit = (statistics.median(x) for x in (eig_times, sens_times, limit_times))
+    ratio = (t_eig + t_sens + t_limit) / t_eig
+    report.update(eigen_s=t_eig, sensitivities_s=t_sens, limit_s=t_limit, ratio=ratio)
+    print(f"one eigen-analysis with vectors: {1e3 * t_eig:.0f} ms; sensitivities of 10 modes to "
+          f"{len(parameters.values) + 4} parameters: +{1e3 * t_sens:.0f} ms; ds0*/dp at known s0*: "
+          f"+{1e3 * t_limit:.0f} ms; all together {ratio:.2f}x one eigen-analysis")
+
+    op = OperatingPoint(0.005, v, N0, b_M)
+    peaks = peak_load_sensitivities(parameters, op, names=["disc_clutch_torsional_stiffness",
+                                                           "gear_ratio", "motor_slope"])
+    report["peak_per_parameter_s"] = peaks.seconds / 3
+    print(f"peak-load sensitivities: {peaks.seconds / 3:.2f} s per parameter "
+          f"(x{len(parameters.values)} parameters = {peaks.seconds / 3 * len(parameters.values):.0f} s)")
+
+    n = args.sobol_n
+    start = time.perf_counter()
+    result = run_uncertainty(parameters, n, n_resamples=499)
+    seconds = time.perf_counter() - start
+    per_run = seconds / (result.runs + 1)
+    widths = result.total_order_ci[1] - result.total_order_ci[0]  # outputs x d
+    leading = np.nanargmax(result.total_order, axis=1)
+    lead_width = np.array([widths[j, leading[j]] for j in range(len(result.outputs))])
+    worst = float(np.nanmax(lead_width))
+    needed = 2 ** math.ceil(math.log2(n * (worst / 0.05) ** 2)) if worst > 0.05 else n
+    d = len(UNCERTAIN_PARAMETERS)
+    cost = needed * (d + 2) * per_run
+    report.update(sobol_n=n, sobol_runs=result.runs, sobol_s=seconds, per_run_s=per_run,
+                  widest_leading_ci=worst, n_needed=needed, cost_serial_s=cost,
+                  median_leading_ci=float(np.nanmedian(lead_width)))
+    print(f"Sobol n = {n}: {result.runs} runs in {seconds:.0f} s ({per_run:.2f} s per run); widest "
+          f"95 % interval of a leading total index {worst:.2f} (median "
+          f"{np.nanmedian(lead_width):.2f})")
+    print(f"projected for width <= 0.05 (width ∝ n^-1/2): n = {needed}, {needed * (d + 2)} runs, "
+          f"{cost / 3600:.1f} h serial, {cost / 3600 / 8:.2f} h on 8 workers, "
+          f"{cost / 3600 / 32:.2f} h on 32")
+    if args.json:
+        with open(args.json, "w", encoding="utf-8") as handle:
+            json.dump(report, handle, indent=1)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,208 @@
+"""Figures of the sensitivities and the uncertainty band, as PNG under assets/figures/.
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/figures_sensitivity.py
+        [--uncertainty assets/data/uncertainty_n16.json] [--out assets/figures] [--no-peaks]
+
+* ``sensitivity_limit.png`` — tornado of p/s0* · ds0*/dp at 120 and 200 km/h;
+* ``sensitivity_growth_014.png`` — tornado of p · ∂Re λ/∂p [1/s] of the unstable modes among the
+  ten lowest pairs and of the divergent real eigenvalue at s0 = 0.014, 120 km/h;
+* ``sensitivity_damping.png`` — p · ∂ζ/∂p of the ten lowest modes at s0 = 0.005 (heat map of the
+  parameters with the largest effect);
+* ``sensitivity_peaks.png`` — tornado of p/peak · d peak/dp of the four peak drive loads
+  (central differences of the closed form, ≈ 2 responses per parameter; ``--no-peaks`` skips);
+* ``uncertainty_limit.png`` — s0*(v) of the calibrated set, the 5–95 % band of the creep
+  maximum s_max(v) over the sampled creep-law parameters, the sampled s0*(120), s0*(200)
+  (from ``bogie uncertainty --samples N --out FILE``) and the published 0.0082 at 120 km/h.
+
+Also prints the numbers docs/sensitivity.md quotes.  matplotlib only here (test extra).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from model import build_model, load_parameters
+from model.operating_point import KMH, OperatingPoint, creep_law
+from model.parameters import Parameters
+from model.sensitivity import (
+    eigen_sensitivities,
+    limit_sensitivity,
+    peak_load_sensitivities,
+)
+
+LINKED = ("wheel_force", "motor_slope")
+PUBLISHED_LIMIT = 0.0082  # target only: drawn as a marker, never used by the model
+
+
+def tornado(ax, names, values, title, xlabel, count=12):
+    order = np.argsort(-np.abs(np.nan_to_num(values)))[:count][::-1]
+    colors = ["tab:red" if values[i] > 0 else "tab:blue" for i in order]
+    ax.barh(np.arange(len(order)), values[order], color=colors)
+    ax.set_yticks(np.arange(len(order)), [names[i] for i in order], fontsize=7)
+    ax.axvline(0, color="k", lw=0.6)
+    ax.set_title(title, fontsize=8)
+    ax.set_xlabel(xlabel, fontsize=8)
+    ax.tick_params(axis="x", labelsize=7)
+    ax.grid(axis="x", alpha=0.3)
+
+
+def figure_limit(model, parameters, out: Path) -> None:
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), layout="constrained")
+    for ax, v_kmh in zip(axes, (120.0, 200.0), strict=True):
+        limit = limit_sensitivity(model, v_kmh * KMH, parameters["wheel_force"],
+                                  parameters["motor_slope"], linked=LINKED)
+        nonzero = int(np.count_nonzero(limit.derivatives))
+        print(f"s0*({v_kmh:g} km/h) = {limit.s0_limit:.6f}, {limit.mechanism}; {nonzero} of "
+              f"{len(limit.names)} derivatives non-zero")
+        for i in np.argsort(-np.abs(limit.normalized))[:6]:
+            print(f"   {limit.names[i]:<30} p/s0* ds0*/dp = {limit.normalized[i]:+.4f}")
+        tornado(ax, limit.names, limit.normalized, f"s0* = {limit.s0_limit:.5f} at {v_kmh:g} km/h "
+                f"({limit.mechanism}): {nonzero} of {len(limit.names)} non-zero",
+                "p/s0* · ds0*/dp [-]", count=8)
+    fig.suptitle("Stability-limit sensitivities: set by the creep maximum, so only the creep law, "
+                 "speed and wheel force move it", fontsize=9)
+    fig.savefig(out / "sensitivity_limit.png", dpi=110)
+    plt.close(fig)
+
+
+def figure_growth(model, parameters, out: Path) -> None:
+    op = OperatingPoint(0.014, 120 * KMH, parameters["wheel_force"], parameters["motor_slope"])
+    sens = eigen_sensitivities(model, op, linked=LINKED)
+    from model.eigen import eigen_analysis
+
+    result = eigen_analysis(model, op)
+    divergent = int(result.real_index[0])
+    real = eigen_sensitivities(model, op, indices=[divergent], linked=LINKED, result=result)
+    unstable = [k for k in range(len(sens.eigenvalues)) if sens.eigenvalues[k].real > 0]
+    panels = [(sens, k) for k in unstable] + [(real, 0)]
+    fig, axes = plt.subplots(1, len(panels), figsize=(3.6 * len(panels), 4.2), layout="constrained")
+    for ax, (s, k) in zip(np.atleast_1d(axes), panels, strict=True):
+        lam = s.eigenvalues[k]
+        values = s.growth_per_relative_change[:, k]
+        label = (f"Re λ = {lam.real:+.3f} 1/s, {lam.imag / (2 * np.pi):.3f} Hz" if lam.imag
+                 else f"real λ = {lam.real:+.3f} 1/s")
+        print(f"s0 = 0.014: {label}: {s.descriptions[k]}")
+        for i in np.argsort(-np.abs(np.nan_to_num(values)))[:5]:
+            print(f"   {s.names[i]:<30} p dRe/dp = {values[i]:+.4g} 1/s")
+        tornado(ax, s.names, values, f"{label}\n{s.descriptions[k][:60]}", "p · ∂Re λ/∂p [1/s]")
+    fig.suptitle("Growth-rate sensitivities of the unstable modes at s0 = 0.014, 120 km/h "
+                 "(red: a larger p destabilizes)", fontsize=9)
+    fig.savefig(out / "sensitivity_growth_014.png", dpi=110)
+    plt.close(fig)
+
+
+def figure_damping(model, parameters, out: Path) -> None:
+    op = OperatingPoint(0.005, 120 * KMH, parameters["wheel_force"], parameters["motor_slope"])
+    sens = eigen_sensitivities(model, op, linked=LINKED)
+    values = sens.values[:, None] * sens.d_damping_ratio  # p dζ/dp
+    keep = np.argsort(-np.nanmax(np.abs(values), axis=1))[:18]
+    fig, ax = plt.subplots(figsize=(10, 5.6), layout="constrained")
+    limit = np.nanmax(np.abs(values[keep]))
+    image = ax.imshow(values[keep], cmap="RdBu_r", vmin=-limit, vmax=limit, aspect="auto")
+    ax.set_yticks(np.arange(len(keep)), [sens.names[i] for i in keep], fontsize=7)
+    ax.set_xticks(np.arange(len(sens.eigenvalues)),
+                  [f"{lam.imag / (2 * np.pi):.2f} Hz\nζ={-lam.real / abs(lam):.3f}"
+                   for lam in sens.eigenvalues], fontsize=6)
+    fig.colorbar(image, ax=ax, label="p · ∂ζ/∂p [-]")
+    ax.set_title("Damping-ratio sensitivities of the ten lowest modes at s0 = 0.005, 120 km/h "
+                 "(red: a larger p adds damping)", fontsize=9)
+    fig.savefig(out / "sensitivity_damping.png", dpi=110)
+    plt.close(fig)
+    for k, lam in enumerate(sens.eigenvalues):
+        i = int(np.nanargmax(np.abs(values[:, k])))
+        print(f"mode {k + 1} {lam.imag / (2 * np.pi):.3f} Hz ζ = {-lam.real / abs(lam):.4f}: "
+              f"largest p dζ/dp {sens.names[i]} {values[i, k]:+.3g}; participation "
+              + ", ".join(f"{s} {v:.2f}" for s, v in sens.participation[k].items()))
+
+
+def figure_peaks(parameters, out: Path) -> None:
+    op = OperatingPoint(0.005, 120 * KMH, parameters["wheel_force"], parameters["motor_slope"])
+    peaks = peak_load_sensitivities(parameters, op)
+    print(f"peak loads: {peaks.seconds:.0f} s for {len(peaks.names)} parameters")
+    fig, axes = plt.subplots(1, 4, figsize=(14, 4), layout="constrained")
+    for j, (ax, name) in enumerate(zip(axes, peaks.outputs, strict=True)):
+        values = peaks.normalized[:, j]
+        print(f"{name}: peak {peaks.peaks[j]:.0f} N m at {peaks.peak_times[j]:.4f} s")
+        for i in np.argsort(-np.abs(values))[:5]:
+            print(f"   {peaks.names[i]:<30} p/peak dpeak/dp = {values[i]:+.4f}")
+        tornado(ax, peaks.names, values, f"{name}\npeak {peaks.peaks[j] / 1e3:.1f} kN m at "
+                f"{peaks.peak_times[j]:.3f} s", "p/peak · d peak/dp [-]", count=10)
+    fig.suptitle("Peak drive loads after the short circuit (s0 = 0.005, 120 km/h; totals)",
+                 fontsize=9)
+    fig.savefig(out / "sensitivity_peaks.png", dpi=110)
+    plt.close(fig)
+
+
+def figure_uncertainty(model, parameters, path: Path, out: Path) -> None:
+    data = json.loads(path.read_text(encoding="utf-8"))
+    names = [p["name"] for p in data["parameters"]]
+    outputs = {o["name"]: o for o in data["outputs"]}
+    samples = np.array(data["samples"], dtype=float)
+    values = np.array(data["values"], dtype=float)
+    speeds = np.linspace(60, 220, 33)
+    curves = []
+    for row in samples:
+        changed = {n: v for n, v in zip(names, row, strict=True)
+                   if n.startswith("polach_") or n == "creep_slope"}
+        law = creep_law(Parameters({**parameters.values, **changed}))
+        curves.append([law.maximum(v * KMH)[0] for v in speeds])
+    curves = np.array(curves)
+    nominal = [creep_law(parameters).maximum(v * KMH)[0] for v in speeds]
+    fig, ax = plt.subplots(figsize=(8, 4.2), layout="constrained")
+    low, mid, high = np.percentile(curves, [5, 50, 95], axis=0)
+    ax.fill_between(speeds, low, high, color="tab:blue", alpha=0.25,
+                    label="5–95 % of the creep maximum over the prior samples")
+    ax.plot(speeds, mid, color="tab:blue", lw=0.8, ls="--", label="median")
+    ax.plot(speeds, nominal, color="k", lw=1.2, label="calibrated set")
+    for k, v in enumerate((120.0, 200.0)):
+        column = list(outputs).index(f"s0_limit_{v:g}")
+        ax.plot(np.full(len(values), v) + np.linspace(-2, 2, len(values)), values[:, column], ".",
+                ms=3, color="tab:red", label="s0* of each sample (root finding)" if k == 0 else None)
+        o = outputs[f"s0_limit_{v:g}"]
+        print(f"s0*({v:g} km/h): nominal {o['nominal']:.5f}, 5/50/95 % {o['p5']:.5f} "
+              f"{o['p50']:.5f} {o['p95']:.5f}; leading S_T "
+              + ", ".join(f"{n} {t:.2f}" for n, t in sorted(zip(names, o["total_order"], strict=True),
+                                                               key=lambda x: -(x[1] or 0))[:3]))
+    ax.plot([120], [PUBLISHED_LIMIT], "k*", ms=12, label="published s0* = 0.0082 at 120 km/h")
+    ax.set(xlabel="speed v [km/h]", ylabel="stability limit s0* [-]",
+           title=f"Uncertainty band of s0*(v): prior ranges of {len(names)} unpublished parameters, "
+                 f"n = {data['base_samples']} ({data['runs']} runs)")
+    ax.title.set_fontsize(9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.savefig(out / "uncertainty_limit.png", dpi=110)
+    plt.close(fig)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--params", default=None)
+    parser.add_argument("--uncertainty", default="assets/data/uncertainty_n16.json")
+    parser.add_argument("--out", default="assets/figures")
+    parser.add_argument("--no-peaks", action="store_true")
+    args = parser.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    parameters = load_parameters(args.params)
+    model = build_model(parameters)
+    figure_limit(model, parameters, out)
+    figure_growth(model, parameters, out)
+    figure_damping(model, parameters, out)
+    if Path(args.uncertainty).is_file():
+        figure_uncertainty(model, parameters, Path(args.uncertainty), out)
+    else:
+        print(f"no {args.uncertainty}: run `bogie uncertainty --samples 16 --out {args.uncertainty}`")
+    if not args.no_peaks:
+        figure_peaks(parameters, out)
+
+
+if __name__ == "__main__":
+    main()
