@@ -2,11 +2,13 @@
 
 * analytic dλ/dp against fourth-order central differences of eigenvalues (test-only) for every
   parameter and s0, v, N0, b_M at three operating points (slow).  Tolerance 1e-5 relative to the
-  parameter's largest derivative over the ten modes.  The difference step is chosen so that the
-  largest eigenvalue change is 1e-3 of |λ| (capped at 5 % of the parameter): the eigenvalues of the
-  386-state problem carry rounding noise of ~1e-13 |λ|, and a parameter that hardly moves the ten
-  lowest modes (the gear mesh: p |dλ/dp| ≈ 2e-4 |λ|) would otherwise be measured in noise (with a
-  fixed 1e-3 relative step the differences disagreed with themselves at 1e-3);
+  parameter's largest derivative over the ten modes.  The reference's step h is chosen so that the
+  largest eigenvalue change is 1e-3 of |λ| (capped at 5 % of the parameter), and the best of the
+  steps h, h/2, h/4 counts: the eigenvalues of the 386-state problem carry rounding noise of
+  ~1e-13 |λ|, so a parameter that hardly moves the ten lowest modes (the gear mesh:
+  p |dλ/dp| ≈ 2e-4 |λ|) needs a large step, while a 5 % step of a strongly nonlinear one leaves a
+  truncation error of ~2.5e-5 (both measured: with one fixed step, 1e-3 relative, the references
+  disagreed with themselves by up to 1e-3; with 5 % alone, ten parameters missed by 1.2-3.5e-5);
 * completeness (Euler's theorem for homogeneous functions): all masses, stiffnesses and dampers
   scaled by one factor leave every eigenvalue unchanged, so the sensitivities summed along that
   direction vanish; and the derivative matrices sum to M, K, B along it;
@@ -78,15 +80,20 @@ def test_against_finite_differences(setup, s0):
         h = 1e-3 * np.abs(lam).min() / largest
         if value != 0.0:
             h = min(h, 0.05 * abs(value))
+        if name in ("wheel_radius", "rail_head_radius"):  # Kalker's table is piecewise linear in
+            h = min(h, 1e-4 * abs(value))  # a/b, which these move: stay between its nodes
         if name == "polach_kA":  # at its upper bound 1: the law is analytic beyond it
             h = min(h, 0.01)
-        ev = {c: _eigenvalues(parameters, model, op, name, value + c * h) for c in (-2, -1, 1, 2)}
+        ev = {c: _eigenvalues(parameters, model, op, name, value + c * h / 4)
+              for c in (-8, -4, -2, -1, 1, 2, 4, 8)}
         pick = lambda e, target: e[np.argmin(np.abs(e - target))]  # noqa: E731
-        fd = np.array([(-pick(ev[2], t) + 8 * pick(ev[1], t) - 8 * pick(ev[-1], t) + pick(ev[-2], t))
-                       / (12 * h) for t in lam])
-        error = np.abs(analytic - fd).max() / np.abs(fd).max()
-        if error > 1e-5:
-            failures.append(f"{name}: {error:.2e}")
+        errors = []
+        for k in (1, 2, 4):  # steps h/4, h/2, h: the best step of the reference is not known
+            fd = np.array([(-pick(ev[2 * k], t) + 8 * pick(ev[k], t) - 8 * pick(ev[-k], t)
+                            + pick(ev[-2 * k], t)) / (12 * k * h / 4) for t in lam])
+            errors.append(np.abs(analytic - fd).max() / np.abs(fd).max())
+        if min(errors) > 1e-5:
+            failures.append(f"{name}: {min(errors):.2e}")
     assert not failures, f"at s0 = {s0}: " + ", ".join(failures)
 
 
@@ -103,7 +110,7 @@ def test_unlinked_motor_slope_and_linked_rows(setup):
 
 def test_not_in_assembly_is_true(setup):
     """The parameters skipped by structural_derivatives really do not enter M, B, K."""
-    parameters, model = setup
+    parameters, _model = setup
     for name in sorted(NOT_IN_ASSEMBLY):
         perturbed = build_model(complex_step_parameters(parameters, name, 1e-20))
         for matrix in (perturbed.M, perturbed.B, perturbed.K):
@@ -181,7 +188,8 @@ def test_limit_is_creep_maximum_and_structure_cannot_move_it(setup):
     assert limit.mechanism == "creep maximum"
     assert abs(limit.s0_limit - s_max) < 1e-6
     d = dict(zip(limit.names, limit.derivatives, strict=True))
-    assert d["disc_clutch_torsional_stiffness"] == 0.0 and d["polach_B"] != 0.0
+    assert d["disc_clutch_torsional_stiffness"] == 0.0
+    assert d["polach_B"] != 0.0
     # a 30 % stiffer disc clutch: s0* unchanged (within Brent's xtol 1e-7)
     stiffer = build_model(parameters.replace(
         disc_clutch_torsional_stiffness=1.3 * parameters["disc_clutch_torsional_stiffness"]))
@@ -218,10 +226,11 @@ def test_ishigami_sobol_indices():
             yield func(chunk)
 
     dists = [stats.uniform(-np.pi, 2 * np.pi)] * 3
-    runs, samples, values, first, total, first_ci, total_ci = sobol_study(
+    runs, samples, values, first, total, first_ci, _total_ci = sobol_study(
         ishigami, dists, 4096, map_fn=counting_map, chunk_size=1000, n_resamples=99)
     assert runs == 4096 * 5 == sum(calls)
-    assert samples.shape == (8192, 3) and values.shape == (8192, 1)
+    assert samples.shape == (8192, 3)
+    assert values.shape == (8192, 1)
     np.testing.assert_allclose(first[0], [0.3139, 0.4424, 0.0], atol=0.03)
     np.testing.assert_allclose(total[0], [0.5576, 0.4424, 0.2437], atol=0.03)
     assert np.all(first_ci[0, 0] - 0.02 <= [0.3139, 0.4424, 0.0])
@@ -236,7 +245,7 @@ def test_uncertainty_bad_input(setup):
         run_uncertainty(parameters, 1)
 
 
-@pytest.mark.parametrize("argv, message", [
+@pytest.mark.parametrize(("argv", "message"), [
     (["sensitivity", "--s0", "0.005", "--only", "nope"], "unknown parameter 'nope'"),
     (["sensitivity", "--s0", "2"], "--s0"),
     (["uncertainty", "--samples", "1"], "power of 2"),
@@ -245,19 +254,14 @@ def test_uncertainty_bad_input(setup):
     (["uncertainty", "--samples", "4", "--out", "/no/such/dir/u.json"], "does not exist"),
 ])
 def test_cli_bad_input(argv, message, capsys):
-    with pytest.raises(SystemExit) if "x" in argv or argv[-1] == "2" else _nothing():
+    try:
         status = main(argv)
-        assert status == 2
+    except SystemExit as stop:  # argparse's own errors (one line, see model.cli._Parser)
+        status = stop.code
+    assert status == 2
     err = capsys.readouterr().err
-    assert message in err and err.count("\n") == 1
-
-
-class _nothing:
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        return False
+    assert message in err
+    assert err.count("\n") == 1
 
 
 def test_cli_json_keys(capsys):
@@ -268,9 +272,12 @@ def test_cli_json_keys(capsys):
     assert status == 0
     data = json.loads(capsys.readouterr().out)
     assert {"operating_point", "modes", "parameters"} <= set(data)
-    assert len(data["modes"]) == 10 and {"re", "im_hz", "description"} <= set(data["modes"][0])
+    assert len(data["modes"]) == 10
+    assert {"re", "im_hz", "description"} <= set(data["modes"][0])
     row = data["parameters"][0]
     assert row["name"] == "disc_clutch_torsional_stiffness"
     assert set(row) == {"name", "value", "unit", "d_re_dp", "d_im_hz_dp", "d_s0_limit_dp"}
-    assert len(row["d_re_dp"]) == 10 and len(row["d_im_hz_dp"]) == 10
-    assert row["d_s0_limit_dp"] == 0.0 and data["parameters"][1]["d_s0_limit_dp"] != 0.0
+    assert len(row["d_re_dp"]) == 10
+    assert len(row["d_im_hz_dp"]) == 10
+    assert row["d_s0_limit_dp"] == 0.0
+    assert data["parameters"][1]["d_s0_limit_dp"] != 0.0
