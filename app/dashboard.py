@@ -36,6 +36,7 @@ from model.parameters import dumps_parameters
 
 from . import compute
 from .plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
+from .sensitivity_view import SensitivityView  # issue 12: sensitivity tornado
 from .serve import limit_blas_threads
 
 log = logging.getLogger(__name__)
@@ -229,6 +230,7 @@ class BogieDashboard(pn.viewable.Viewer):
             self.param.zoom, options={"all modes ≤ 20 Hz": "all", "low modes": "low"},
             css_classes=["ctl-zoom"])
         bokeh_pane = partial(pn.pane.Bokeh, sizing_mode="stretch_width")
+        self.sensitivity = SensitivityView()  # issue 12: sensitivity tornado
         schematic = ASSETS / "schematic.svg"
         self.main = pn.Column(
             self.notice,
@@ -248,6 +250,7 @@ class BogieDashboard(pn.viewable.Viewer):
             "### Mode shape",
             self.mode_select,
             pn.Row(*(bokeh_pane(f) for f in self.mode_plot.figures), sizing_mode="stretch_width"),
+            self.sensitivity.panel,  # issue 12: sensitivity tornado
             "### Schematic of the bogie (names used in the tables)",
             pn.pane.SVG(schematic, width=640)
             if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*"),
@@ -432,6 +435,7 @@ class BogieDashboard(pn.viewable.Viewer):
     def _on_mode(self, *_events) -> None:
         if self.point is not None and 1 <= self.mode <= len(self.point.modes):
             self.mode_plot.update(self.point.modes[self.mode - 1].displacement)
+            self.sensitivity.show(mode=self.mode)  # issue 12: sensitivity tornado
 
     # --- showing results -----------------------------------------------------------------------
 
@@ -451,6 +455,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.mode_select.value = min(self.mode, len(point.modes))
         self._on_mode()
         self.locus_plot.zoom(self.zoom == "low")
+        self.sensitivity.request(self, state)  # issue 12: sensitivity tornado (when ready)
 
     def _apply_slow(self, state: State, slow) -> None:
         limit, locus = slow
