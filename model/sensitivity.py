@@ -189,6 +189,31 @@ def _b11(values: Mapping) -> complex:
     return values["N0"] * law.dmu_ds(values["s0"], values["v"]) / values["v"]
 
 
+_kalker_cache: dict = {}
+_kalker_lock = threading.Lock()
+
+
+def _kalker_derivative(parameters: Parameters, N0: float, name: str) -> np.ndarray:
+    """d(f22, f23, f33)/dp by central differences (relative step :data:`KALKER_STEP`); they do
+    not depend on s0 or v, so they are kept per (parameter set, N0, name)."""
+    key = (id(parameters), N0, name)
+    with _kalker_lock:
+        cached = _kalker_cache.get(key)
+    if cached is not None and cached[0] is parameters:
+        return cached[1]
+    values = dict(parameters.values)
+    values["N0"] = N0
+    h = KALKER_STEP * abs(values[name])
+    up, down = dict(values), dict(values)
+    up[name], down[name] = values[name] + h, values[name] - h
+    derivative = (_kalker(up, up["N0"]) - _kalker(down, down["N0"])) / (2 * h)
+    with _kalker_lock:
+        if len(_kalker_cache) > 512:
+            _kalker_cache.clear()
+        _kalker_cache[key] = (parameters, derivative)
+    return derivative
+
+
 def creep_coefficient_derivatives(parameters: Parameters, op: OperatingPoint,
                                   name: str) -> np.ndarray:
     """d(b11, b22, b23, b33, r0)/dp at ``op`` for a parameter or operating quantity ``name``
@@ -201,10 +226,7 @@ def creep_coefficient_derivatives(parameters: Parameters, op: OperatingPoint,
         stepped[name] = values[name] + 1j * h
         out[0] = float(np.imag(_b11(stepped))) / h
     if name in KALKER_INPUTS or name == "N0":
-        h = KALKER_STEP * abs(values[name])
-        up, down = dict(values), dict(values)
-        up[name], down[name] = values[name] + h, values[name] - h
-        out[1:4] = (_kalker(up, up["N0"]) - _kalker(down, down["N0"])) / (2 * h) / op.v
+        out[1:4] = _kalker_derivative(parameters, op.N0, name) / op.v
     if name == "v":
         out[1:4] = -_kalker(values, op.N0) / op.v**2
     if name == "wheel_radius":
@@ -229,7 +251,7 @@ def operating_derivative(model: BogieModel, op: OperatingPoint, name: str) -> Ma
         h = _step(r0)
         block = block + d[4] * creep_block(b11, f[0], f[1], f[2], r0 + 1j * h).imag / h
     index = np.concatenate(list(model.rims.values()))
-    blocks = sla.block_diag(*([block] * len(model.rims)))
+    blocks = np.kron(np.eye(len(model.rims)), block)  # the same block on every rim
     return MatrixDerivative(index, None, blocks, None)
 
 
@@ -324,12 +346,14 @@ def _subsystem_of(model: BogieModel) -> np.ndarray:
 
 def eigen_sensitivities(model: BogieModel, op: OperatingPoint, indices: Iterable[int] | None = None,
                         linked: Iterable[str] = (), parameters: Iterable[str] | None = None,
-                        result: EigenResult | None = None) -> EigenSensitivities:
+                        result: EigenResult | None = None,
+                        describe: bool = True) -> EigenSensitivities:
     """dλ/dp at ``op`` for the eigenvalues ``indices`` of the eigen-analysis (default: the ten
     lowest complex pairs), every parameter (or those named in ``parameters``) and s0, v, N0, b_M.
 
     ``linked``: parameter names of :data:`LINKED` whose rows add the operating quantity's
-    derivative (the operating point took them from the set)."""
+    derivative (the operating point took them from the set).  ``describe=False`` skips the
+    energy shares and descriptions of the modes (empty; the caller has them already)."""
     linked = tuple(linked)
     for name in linked:
         if name not in LINKED:
@@ -346,8 +370,10 @@ def eigen_sensitivities(model: BogieModel, op: OperatingPoint, indices: Iterable
     n = model.n
     X = np.empty((n, len(lam)), dtype=complex)
     Y = np.empty((n, len(lam)), dtype=complex)
+    generic = np.random.default_rng(0).standard_normal(n)  # start vector without eigenvectors
     for k, (i, value) in enumerate(zip(indices, lam, strict=True)):
-        X[:, k], Y[:, k] = null_vectors(model, B_total, value, result.vectors[:n, i])
+        guess = generic if result.vectors is None else result.vectors[:n, i]
+        X[:, k], Y[:, k] = null_vectors(model, B_total, value, guess)
     denominator = np.einsum("ik,ik->k", Y.conj(), (2 * lam[None, :]) * (model.M @ X) + B_total @ X)
 
     # near-repeated eigenvalues and conditioning
@@ -401,13 +427,15 @@ def eigen_sensitivities(model: BogieModel, op: OperatingPoint, indices: Iterable
     subsystem = _subsystem_of(model)
     participation = tuple({name: float(np.real(weights[subsystem == s, k].sum()))
                            for s, name in enumerate(SUBSYSTEMS)} for k in range(len(lam)))
-    characters = [characterize(model, lam[k], X[:, k]) for k in range(len(lam))]
+    characters = [characterize(model, lam[k], X[:, k]) for k in range(len(lam))] if describe else []
     return EigenSensitivities(
         operating_point=op, eigenvalues=lam, indices=np.asarray(indices),
-        descriptions=tuple(c.description for c in characters), names=names, units=units,
+        descriptions=tuple(c.description for c in characters) if describe else ("",) * len(lam),
+        names=names, units=units,
         values=values, derivatives=derivatives, condition=condition, gap=gap, reliable=reliable,
         notes=tuple(notes), participation=participation,
-        kinetic=tuple(c.kinetic for c in characters), strain=tuple(c.strain for c in characters),
+        kinetic=tuple(c.kinetic for c in characters) if describe else ({},) * len(lam),
+        strain=tuple(c.strain for c in characters) if describe else ({},) * len(lam),
         linked=linked, n_rigid=result.n_rigid)
 
 
@@ -458,13 +486,14 @@ def limit_sensitivity(model: BogieModel, v: float, N0: float, b_M: float,
     if s0_limit is None:
         s0_limit = stability_limit(model, v, N0, b_M).s0_limit
     op = OperatingPoint(s0_limit, v, N0, b_M)
-    result = eigen_analysis(model, op)
+    result = eigen_analysis(model, op, vectors=False)  # the critical vector by inverse iteration
     critical = int(np.argmax(result.eigenvalues.real))
     lam_c = complex(result.eigenvalues[critical])
     law = _law(model.parameters.values, N0)
     s_max, _ = law.maximum(v)
     dmu = float(law.dmu_ds(s0_limit, v))
-    q = result.vectors[:model.n, critical]
+    q, _ = null_vectors(model, damping_matrix(model, op), lam_c,
+                        np.random.default_rng(0).standard_normal(model.n))
     spin = lam_c.imag == 0 and _rigid_spin_mac(model, q)[0] > RIGID_SPIN_MAC
     names = (*tuple(wanted), "v", "N0", "b_M")
     units = (*tuple(SCHEMA[name][0] for name in wanted), "m/s", "N", "N m s/rad")
@@ -492,13 +521,14 @@ def limit_sensitivity(model: BogieModel, v: float, N0: float, b_M: float,
         return LimitSensitivity(v, N0, b_M, s0_limit, "creep maximum", lam_c, s_max, dmu, names,
                                 units, values, derivatives, note)
     sens = eigen_sensitivities(model, op, indices=[critical], linked=linked, parameters=wanted,
-                               result=result)
+                               result=result, describe=False)
     d = sens.derivatives[:, 0].real
     d_s0 = d[sens.names.index("s0")]
     keep = [i for i, name in enumerate(sens.names) if name != "s0"]
     derivatives = -d[keep] / d_s0
     mechanism = "divergence" if lam_c.imag == 0 else "flutter"
-    note = (f"s0* = {s0_limit:.7f} set by {mechanism} of '{sens.descriptions[0]}' "
+    description = characterize(model, lam_c, q).description
+    note = (f"s0* = {s0_limit:.7f} set by {mechanism} of '{description}' "
             f"(λc = {lam_c.real:.2e}{lam_c.imag:+.4g}i 1/s, ∂Re λc/∂s0 = {d_s0:.4g} 1/s); "
             "ds0*/dp = −Re(∂λc/∂p)/Re(∂λc/∂s0)")
     return LimitSensitivity(v, N0, b_M, s0_limit, mechanism, lam_c, s_max, dmu, names, units,

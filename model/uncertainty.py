@@ -249,8 +249,8 @@ def sobol_study(evaluate: Callable[[np.ndarray], np.ndarray], distributions: Seq
             if progress is not None:
                 progress(done, runs)
         Y = np.vstack(parts)
-        recorded.append((X, Y))
-        return Y.T
+        recorded.append((X.copy(), Y))
+        return Y.T.copy()  # scipy centres the outputs in place: keep the recorded ones
 
     sobol = stats.sobol_indices(func=func, n=n, dists=list(distributions),
                                 rng=np.random.default_rng(seed))

@@ -1,7 +1,7 @@
 """Benchmark of the sensitivities and of the uncertainty study's cost.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/bench_sensitivity.py [--repeats 3]
-        [--sobol-n 8] [--json FILE]
+        [--uncertainty assets/data/uncertainty_n16.json] [--timed-runs 6] [--json FILE]
 
 In one run, on the calibrated set at s0 = 0.005, 120 km/h:
 
@@ -12,9 +12,10 @@ In one run, on the calibrated set at s0 = 0.005, 120 km/h:
   ratio (reference + sensitivities)/reference is the issue's "≤ 2×" target;
 * cold: the derivative matrices of the parameter set (complex step, once per set);
 * peak loads: central differences of the response for three parameters (cost per parameter);
-* Sobol: ``run_uncertainty`` with base size ``--sobol-n`` (n (d + 2) runs), the widths of the
-  95 % bootstrap intervals of the leading total indices, and the n projected for width 0.05
-  (width ∝ n^(−1/2)) with its serial cost and on N workers (runs are independent).
+* Sobol: the widths of the 95 % bootstrap intervals of each output's leading total index in a
+  stored study (``bogie uncertainty --samples 16 --out assets/data/uncertainty_n16.json``), the
+  cost of one model run timed here, and the n projected for width 0.05 on every output
+  (width ∝ n^(−1/2)) with its serial cost and on N workers (the runs are independent).
 
 Times are the median of ``--repeats`` repeats, wall clock; the machine may be shared (ratios are
 from the same run).
@@ -27,6 +28,7 @@ import json
 import math
 import statistics
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -40,13 +42,15 @@ from model.sensitivity import (
     structural_derivatives,
 )
 from model.stability import stability_limit
-from model.uncertainty import UNCERTAIN_PARAMETERS, run_uncertainty
+from model.uncertainty import UNCERTAIN_PARAMETERS, evaluate_chunk
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--sobol-n", type=int, default=8)
+    parser.add_argument("--uncertainty", default="assets/data/uncertainty_n16.json",
+                        help="a stored `bogie uncertainty --out` result (interval widths)")
+    parser.add_argument("--timed-runs", type=int, default=6, help="model runs timed here")
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
     parameters = load_parameters()
@@ -89,27 +93,35 @@ def main() -> None:
     print(f"peak-load sensitivities: {peaks.seconds / 3:.2f} s per parameter "
           f"(x{len(parameters.values)} parameters = {peaks.seconds / 3 * len(parameters.values):.0f} s)")
 
-    n = args.sobol_n
+    # Sobol: interval widths from a stored study, the cost of one model run timed here
+    data = json.loads(Path(args.uncertainty).read_text(encoding="utf-8"))
+    n, d = data["base_samples"], len(data["parameters"])
+    lead_width = []
+    for output in data["outputs"]:
+        total = np.array(output["total_order"], dtype=float)
+        low, high = (np.array(x, dtype=float) for x in output["total_order_ci"])
+        k = int(np.nanargmax(total))
+        lead_width.append(high[k] - low[k])
+    lead_width = np.array(lead_width)
+    worst, median = float(np.nanmax(lead_width)), float(np.nanmedian(lead_width))
+    base = dict(parameters.values)
+    names = [item.name for item in UNCERTAIN_PARAMETERS]
+    rng = np.random.default_rng(1)
+    rows = np.array([[item.low + (item.high - item.low) * rng.random() for item in UNCERTAIN_PARAMETERS]
+                     for _ in range(args.timed_runs)])
     start = time.perf_counter()
-    result = run_uncertainty(parameters, n, n_resamples=499)
-    seconds = time.perf_counter() - start
-    per_run = seconds / (result.runs + 1)
-    widths = result.total_order_ci[1] - result.total_order_ci[0]  # outputs x d
-    leading = np.nanargmax(result.total_order, axis=1)
-    lead_width = np.array([widths[j, leading[j]] for j in range(len(result.outputs))])
-    worst = float(np.nanmax(lead_width))
+    evaluate_chunk(rows, base, names)
+    per_run = (time.perf_counter() - start) / args.timed_runs
     needed = 2 ** math.ceil(math.log2(n * (worst / 0.05) ** 2)) if worst > 0.05 else n
-    d = len(UNCERTAIN_PARAMETERS)
     cost = needed * (d + 2) * per_run
-    report.update(sobol_n=n, sobol_runs=result.runs, sobol_s=seconds, per_run_s=per_run,
-                  widest_leading_ci=worst, n_needed=needed, cost_serial_s=cost,
-                  median_leading_ci=float(np.nanmedian(lead_width)))
-    print(f"Sobol n = {n}: {result.runs} runs in {seconds:.0f} s ({per_run:.2f} s per run); widest "
-          f"95 % interval of a leading total index {worst:.2f} (median "
-          f"{np.nanmedian(lead_width):.2f})")
-    print(f"projected for width <= 0.05 (width ∝ n^-1/2): n = {needed}, {needed * (d + 2)} runs, "
-          f"{cost / 3600:.1f} h serial, {cost / 3600 / 8:.2f} h on 8 workers, "
-          f"{cost / 3600 / 32:.2f} h on 32")
+    report.update(sobol_n=n, per_run_s=per_run, widest_leading_ci=worst,
+                  median_leading_ci=median, n_needed=needed, cost_serial_s=cost)
+    print(f"Sobol ({args.uncertainty}: n = {n}, {n * (d + 2)} runs): widest 95 % interval of a "
+          f"leading total index {worst:.2f} (median {median:.2f}); one model run {per_run:.2f} s "
+          f"(mean of {args.timed_runs})")
+    print(f"projected for width <= 0.05 on every output (width ∝ n^-1/2): n = {needed}, "
+          f"{needed * (d + 2)} runs, {cost / 3600:.1f} h serial, {cost / 3600 / 8:.2f} h on 8 "
+          f"workers, {cost / 3600 / 32:.2f} h on 32")
     if args.json:
         with open(args.json, "w", encoding="utf-8") as handle:
             json.dump(report, handle, indent=1)
