@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -83,7 +84,7 @@ def figure_growth(model, parameters, out: Path) -> None:
     real = eigen_sensitivities(model, op, indices=[divergent], linked=LINKED, result=result)
     unstable = [k for k in range(len(sens.eigenvalues)) if sens.eigenvalues[k].real > 0]
     panels = [(sens, k) for k in unstable] + [(real, 0)]
-    fig, axes = plt.subplots(1, len(panels), figsize=(3.6 * len(panels), 4.2), layout="constrained")
+    fig, axes = plt.subplots(1, len(panels), figsize=(3.9 * len(panels), 4.6), layout="constrained")
     for ax, (s, k) in zip(np.atleast_1d(axes), panels, strict=True):
         lam = s.eigenvalues[k]
         values = s.growth_per_relative_change[:, k]
@@ -92,7 +93,9 @@ def figure_growth(model, parameters, out: Path) -> None:
         print(f"s0 = 0.014: {label}: {s.descriptions[k]}")
         for i in np.argsort(-np.abs(np.nan_to_num(values)))[:5]:
             print(f"   {s.names[i]:<30} p dRe/dp = {values[i]:+.4g} 1/s")
-        tornado(ax, s.names, values, f"{label}\n{s.descriptions[k][:60]}", "p · ∂Re λ/∂p [1/s]")
+        text = s.descriptions[k]
+        wrapped = "\n".join(textwrap.wrap(text, 46)[:2])
+        tornado(ax, s.names, values, f"{label}\n{wrapped}", "p · ∂Re λ/∂p [1/s]")
     fig.suptitle("Growth-rate sensitivities of the unstable modes at s0 = 0.014, 120 km/h "
                  "(red: a larger p destabilizes)", fontsize=9)
     fig.savefig(out / "sensitivity_growth_014.png", dpi=110)
@@ -102,24 +105,34 @@ def figure_growth(model, parameters, out: Path) -> None:
 def figure_damping(model, parameters, out: Path) -> None:
     op = OperatingPoint(0.005, 120 * KMH, parameters["wheel_force"], parameters["motor_slope"])
     sens = eigen_sensitivities(model, op, linked=LINKED)
+    zeta = -sens.eigenvalues.real / np.abs(sens.eigenvalues)
     values = sens.values[:, None] * sens.d_damping_ratio  # p dζ/dp
-    keep = np.argsort(-np.nanmax(np.abs(values), axis=1))[:18]
-    fig, ax = plt.subplots(figsize=(10, 5.6), layout="constrained")
-    limit = np.nanmax(np.abs(values[keep]))
-    image = ax.imshow(values[keep], cmap="RdBu_r", vmin=-limit, vmax=limit, aspect="auto")
+    relative = values / zeta[None, :]  # p/ζ dζ/dp: every mode on its own scale
+    keep: list[int] = []
+    for k in range(len(zeta)):  # each mode's two leading parameters, then the overall leaders
+        keep += [int(i) for i in np.argsort(-np.abs(relative[:, k]))[:2] if int(i) not in keep]
+    for i in np.argsort(-np.nanmax(np.abs(relative), axis=1)):
+        if len(keep) >= 24:
+            break
+        if int(i) not in keep:
+            keep.append(int(i))
+    fig, ax = plt.subplots(figsize=(10, 6.4), layout="constrained")
+    limit = np.nanpercentile(np.abs(relative[keep]), 97)
+    image = ax.imshow(relative[keep], cmap="RdBu_r", vmin=-limit, vmax=limit, aspect="auto")
     ax.set_yticks(np.arange(len(keep)), [sens.names[i] for i in keep], fontsize=7)
     ax.set_xticks(np.arange(len(sens.eigenvalues)),
                   [f"{lam.imag / (2 * np.pi):.2f} Hz\nζ={-lam.real / abs(lam):.3f}"
                    for lam in sens.eigenvalues], fontsize=6)
-    fig.colorbar(image, ax=ax, label="p · ∂ζ/∂p [-]")
-    ax.set_title("Damping-ratio sensitivities of the ten lowest modes at s0 = 0.005, 120 km/h "
-                 "(red: a larger p adds damping)", fontsize=9)
+    fig.colorbar(image, ax=ax, label="p/ζ · ∂ζ/∂p [-] (colour clipped at the 97th percentile)")
+    ax.set_title("Relative damping-ratio sensitivities of the ten lowest modes at s0 = 0.005, "
+                 "120 km/h (red: a larger p adds damping)", fontsize=9)
     fig.savefig(out / "sensitivity_damping.png", dpi=110)
     plt.close(fig)
     for k, lam in enumerate(sens.eigenvalues):
         i = int(np.nanargmax(np.abs(values[:, k])))
         print(f"mode {k + 1} {lam.imag / (2 * np.pi):.3f} Hz ζ = {-lam.real / abs(lam):.4f}: "
-              f"largest p dζ/dp {sens.names[i]} {values[i, k]:+.3g}; participation "
+              f"largest p dζ/dp {sens.names[i]} {values[i, k]:+.3g} (p/ζ dζ/dp "
+              f"{relative[i, k]:+.3g}); participation "
               + ", ".join(f"{s} {v:.2f}" for s, v in sens.participation[k].items()))
 
 
