@@ -16,7 +16,9 @@ In one run, on the calibrated set at s0 = 0.005, 120 km/h:
 * Sobol: the widths of the 95 % bootstrap intervals of each output's leading total index in a
   stored study (``bogie uncertainty --samples 16 --out assets/data/uncertainty_n16.json``), the
   cost of one model run timed here, and the n projected for width 0.05 on every output
-  (width ∝ n^(−1/2)) with its serial cost and on N workers (the runs are independent).
+  (width ∝ n^(−1/2)) with its serial cost and on N workers (the runs are independent);
+* s0*: where it equals the creep maximum for every sample, its Sobol indices from the creep law
+  alone (:func:`model.uncertainty.creep_maximum_study`) at ``--creep-n`` (4096).
 
 Times are the median of ``--repeats`` repeats, wall clock; the machine may be shared (ratios are
 from the same run).
@@ -43,7 +45,7 @@ from model.sensitivity import (
     structural_derivatives,
 )
 from model.stability import stability_limit
-from model.uncertainty import UNCERTAIN_PARAMETERS, evaluate_chunk
+from model.uncertainty import UNCERTAIN_PARAMETERS, creep_maximum_study, evaluate_chunk
 
 
 def main() -> None:
@@ -52,6 +54,8 @@ def main() -> None:
     parser.add_argument("--uncertainty", default="assets/data/uncertainty_n16.json",
                         help="a stored `bogie uncertainty --out` result (interval widths)")
     parser.add_argument("--timed-runs", type=int, default=6, help="model runs timed here")
+    parser.add_argument("--creep-n", type=int, default=4096,
+                        help="base sample count of the creep-maximum Sobol study")
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
     parameters = load_parameters()
@@ -120,16 +124,33 @@ def main() -> None:
     start = time.perf_counter()
     evaluate_chunk(rows, base, names)
     per_run = (time.perf_counter() - start) / args.timed_runs
-    needed = 2 ** math.ceil(math.log2(n * (worst / 0.05) ** 2)) if worst > 0.05 else n
+    # projected from the median output's leading interval (the widest belongs to an output whose
+    # variance is nearly zero at n = 16, see docs/sensitivity.md)
+    needed = 2 ** math.ceil(math.log2(n * (median / 0.05) ** 2)) if median > 0.05 else n
     cost = needed * (d + 2) * per_run
     report.update(sobol_n=n, per_run_s=per_run, widest_leading_ci=worst,
                   median_leading_ci=median, n_needed=needed, cost_serial_s=cost)
     print(f"Sobol ({args.uncertainty}: n = {n}, {n * (d + 2)} runs): widest 95 % interval of a "
           f"leading total index {worst:.2f} (median {median:.2f}); one model run {per_run:.2f} s "
           f"(mean of {args.timed_runs})")
-    print(f"projected for width <= 0.05 on every output (width ∝ n^-1/2): n = {needed}, "
+    print(f"projected for width <= 0.05 on the median output (width ∝ n^-1/2): n = {needed}, "
           f"{needed * (d + 2)} runs, {cost / 3600:.1f} h serial, {cost / 3600 / 8:.2f} h on 8 "
           f"workers, {cost / 3600 / 32:.2f} h on 32")
+    # s0* = s_max for every sample of the stored study: its indices from the creep law alone
+    start = time.perf_counter()
+    creep = creep_maximum_study(parameters, args.creep_n, n_resamples=499)
+    seconds = time.perf_counter() - start
+    _, _, _, _, total, _, total_ci = creep
+    for j, v_kmh in enumerate((120, 200)):
+        k = int(np.nanargmax(total[j]))
+        width = total_ci[1, j] - total_ci[0, j]
+        leading = np.argsort(-np.nan_to_num(total[j]))[:3]
+        print(f"s0*({v_kmh} km/h) = s_max from the creep law alone, n = {args.creep_n} "
+              f"({creep[0]} evaluations, {seconds:.0f} s for both speeds): widest interval of the "
+              f"three leading total indices {np.nanmax(width[leading]):.3f}; leading "
+              + ", ".join(f"{UNCERTAIN_PARAMETERS[i].name} S_T {total[j, i]:.3f} "
+                          f"[{total_ci[0, j, i]:.3f}, {total_ci[1, j, i]:.3f}]" for i in leading))
+        report[f"creep_n{args.creep_n}_leading_width_{v_kmh}"] = float(width[k])
     if args.json:
         with open(args.json, "w", encoding="utf-8") as handle:
             json.dump(report, handle, indent=1)

@@ -4,11 +4,13 @@
   parameter and s0, v, N0, b_M at three operating points (slow).  Tolerance 1e-5 relative to the
   parameter's largest derivative over the ten modes.  The reference's step h is chosen so that the
   largest eigenvalue change is 1e-3 of |λ| (capped at 5 % of the parameter), and the best of the
-  steps h, h/2, h/4 counts: the eigenvalues of the 386-state problem carry rounding noise of
-  ~1e-13 |λ|, so a parameter that hardly moves the ten lowest modes (the gear mesh:
-  p |dλ/dp| ≈ 2e-4 |λ|) needs a large step, while a 5 % step of a strongly nonlinear one leaves a
-  truncation error of ~2.5e-5 (both measured: with one fixed step, 1e-3 relative, the references
-  disagreed with themselves by up to 1e-3; with 5 % alone, ten parameters missed by 1.2-3.5e-5);
+  steps h/4 … 4h counts (a wrong derivative disagrees at every step): the eigenvalues of the
+  386-state problem carry rounding noise (condition numbers up to 1.6e7 among the ten modes),
+  so a parameter that hardly moves the ten lowest modes (shaft_loss_time, the gear mesh:
+  p |dλ/dp| ≈ 1e-5…2e-4 |λ|) needs a large step, while a 5 % step of a strongly nonlinear one
+  leaves a truncation error of ~2.5e-5 (both measured: with one fixed step, 1e-3 relative, the
+  references disagreed with themselves by up to 1e-3; with 5 % alone, ten parameters missed by
+  1.2-3.5e-5; with h/4 … h, shaft_loss_time still missed by 1.8-3.2e-4);
 * completeness (Euler's theorem for homogeneous functions): all masses, stiffnesses and dampers
   scaled by one factor leave every eigenvalue unchanged, so the sensitivities summed along that
   direction vanish; and the derivative matrices sum to M, K, B along it;
@@ -81,14 +83,14 @@ def test_against_finite_differences(setup, s0):
         if value != 0.0:
             h = min(h, 0.05 * abs(value))
         if name in ("wheel_radius", "rail_head_radius"):  # Kalker's table is piecewise linear in
-            h = min(h, 1e-4 * abs(value))  # a/b, which these move: stay between its nodes
+            h = min(h, 1e-3 * abs(value))  # a/b (1.629; next node 1.667): stay between its nodes
         if name == "polach_kA":  # at its upper bound 1: the law is analytic beyond it
             h = min(h, 0.01)
         ev = {c: _eigenvalues(parameters, model, op, name, value + c * h / 4)
-              for c in (-8, -4, -2, -1, 1, 2, 4, 8)}
+              for c in (-32, -16, -8, -4, -2, -1, 1, 2, 4, 8, 16, 32)}
         pick = lambda e, target: e[np.argmin(np.abs(e - target))]  # noqa: E731
         errors = []
-        for k in (1, 2, 4):  # steps h/4, h/2, h: the best step of the reference is not known
+        for k in (1, 2, 4, 8, 16):  # steps h/4 … 4h: the best step of the reference is not known
             fd = np.array([(-pick(ev[2 * k], t) + 8 * pick(ev[k], t) - 8 * pick(ev[-k], t)
                             + pick(ev[-2 * k], t)) / (12 * k * h / 4) for t in lam])
             errors.append(np.abs(analytic - fd).max() / np.abs(fd).max())
