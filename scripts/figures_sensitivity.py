@@ -178,7 +178,10 @@ def figure_uncertainty(model, parameters, path: Path, out: Path) -> None:
     for k, v in enumerate((120.0, 200.0)):
         column = list(outputs).index(f"s0_limit_{v:g}")
         ax.plot(np.full(len(values), v) + np.linspace(-2, 2, len(values)), values[:, column], ".",
-                ms=3, color="tab:red", label="s0* of each sample (root finding)" if k == 0 else None)
+                ms=3, color="tab:red", label="s0* of each sample (model run)" if k == 0 else None)
+        at_maximum = np.abs(values[:, column] - curves[:, np.argmin(np.abs(speeds - v))]) <= 1e-9
+        print(f"s0*({v:g} km/h) equals the creep maximum for {int(at_maximum.sum())} of "
+              f"{len(values)} prior samples")
         o = outputs[f"s0_limit_{v:g}"]
         print(f"s0*({v:g} km/h): nominal {o['nominal']:.5f}, 5/50/95 % {o['p5']:.5f} "
               f"{o['p50']:.5f} {o['p95']:.5f}; leading S_T "
