@@ -2,7 +2,8 @@
 
 * analytic dλ/dp against fourth-order central differences of eigenvalues (test-only) for every
   parameter and s0, v, N0, b_M at three operating points (slow).  Tolerance 1e-5 relative to the
-  parameter's largest derivative over the ten modes.  The reference's step h is chosen so that the
+  parameter's largest derivative over the ten modes (1e-3 for the few that hardly move the modes,
+  see WEAK).  The reference's step h is chosen so that the
   largest eigenvalue change is 1e-3 of |λ| (capped at 5 % of the parameter), and the best of the
   steps h/4 … 4h counts (a wrong derivative disagrees at every step): the eigenvalues of the
   386-state problem carry rounding noise (condition numbers up to 1.6e7 among the ten modes),
@@ -63,6 +64,15 @@ def _eigenvalues(parameters, model, op, name, value):
     return eigen_analysis(build_model(Parameters(values)), op, vectors=False).eigenvalues
 
 
+# Parameters that hardly move the ten modes (|p| max|dλ/dp| < WEAK · min|λ|: shaft_loss_time
+# 7.7e-6, pressure_angle 5.5e-5, gear_mesh_stiffness 2.2e-4, track_mass 2.3e-4 at s0 = 0.005):
+# the differences of eigenvalues cannot resolve 1e-5 of their derivatives (measured at s0 = 0.005
+# over the steps h/4 … 4h: best 1.7e-4, 2.1e-5, 2.5e-5, 2.9e-6 — the references scatter by as much
+# between neighbouring steps); they are checked at WEAK_TOLERANCE, and their derivative matrices
+# are covered exactly by the Euler checks below.
+WEAK, WEAK_TOLERANCE = 1e-3, 1e-3
+
+
 # s0 = 0.005 stable, 0.0080 just below the limit (s0* = 0.0082), 0.014 unstable (Table 1)
 @pytest.mark.slow
 @pytest.mark.parametrize("s0", [0.005, 0.0080, 0.014])
@@ -94,8 +104,10 @@ def test_against_finite_differences(setup, s0):
             fd = np.array([(-pick(ev[2 * k], t) + 8 * pick(ev[k], t) - 8 * pick(ev[-k], t)
                             + pick(ev[-2 * k], t)) / (12 * k * h / 4) for t in lam])
             errors.append(np.abs(analytic - fd).max() / np.abs(fd).max())
-        if min(errors) > 1e-5:
-            failures.append(f"{name}: {min(errors):.2e}")
+        influence = abs(value) * largest / np.abs(lam).min()
+        tolerance = 1e-5 if value == 0.0 or influence >= WEAK else WEAK_TOLERANCE
+        if min(errors) > tolerance:
+            failures.append(f"{name}: {min(errors):.2e} (influence {influence:.1e})")
     assert not failures, f"at s0 = {s0}: " + ", ".join(failures)
 
 
