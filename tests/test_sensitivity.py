@@ -298,3 +298,34 @@ def test_cli_json_keys(capsys):
     assert len(row["d_im_hz_dp"]) == 10
     assert row["d_s0_limit_dp"] == 0.0
     assert data["parameters"][1]["d_s0_limit_dp"] != 0.0
+
+
+@pytest.mark.slow
+def test_uncertainty_pipeline_on_the_model(setup):
+    """Two parameters, n = 2: 8 model runs through a map-like executor, in chunks; the result's
+    distributions are the model's own outputs at the sampled values."""
+    from model.uncertainty import OUTPUT_NAMES, UNCERTAIN_PARAMETERS, sample_outputs
+
+    parameters, _ = setup
+    chosen = [u for u in UNCERTAIN_PARAMETERS if u.name in ("polach_B", "rotor_inertia")]
+    chunks = []
+
+    def recording_map(func, items):
+        for chunk in items:
+            chunks.append(len(chunk))
+            yield func(chunk)
+
+    progress = []
+    result = run_uncertainty(parameters, 2, uncertain=chosen, map_fn=recording_map, chunk_size=3,
+                             progress=lambda done, total: progress.append((done, total)),
+                             n_resamples=9)
+    assert result.runs == 8 == sum(chunks)
+    assert max(chunks) <= 3
+    assert progress[-1] == (8, 8)
+    assert result.values.shape == (4, len(OUTPUT_NAMES))
+    values = dict(parameters.values)
+    values.update(zip(result.names, result.samples[0], strict=True))
+    np.testing.assert_allclose(result.values[0], sample_outputs(values), rtol=1e-12)
+    data = result.as_dict()
+    assert [o["name"] for o in data["outputs"]] == list(OUTPUT_NAMES)
+    assert data["runs"] == 8
