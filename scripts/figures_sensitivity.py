@@ -43,6 +43,16 @@ LINKED = ("wheel_force", "motor_slope")
 PUBLISHED_LIMIT = 0.0082  # target only: drawn as a marker, never used by the model
 
 
+def save(fig, path: Path) -> None:
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def at_120(parameters, s0: float) -> OperatingPoint:
+    """The operating point (s0, 120 km/h) with N0 and b_M of the set."""
+    return OperatingPoint(s0, 120 * KMH, parameters["wheel_force"], parameters["motor_slope"])
+
+
 def tornado(ax, names, values, title, xlabel, count=12):
     order = np.argsort(-np.abs(np.nan_to_num(values)))[:count][::-1]
     colors = ["tab:red" if values[i] > 0 else "tab:blue" for i in order]
@@ -70,12 +80,11 @@ def figure_limit(model, parameters, out: Path) -> None:
                 "p/s0* · ds0*/dp [-]", count=8)
     fig.suptitle("Stability-limit sensitivities: set by the creep maximum, so only the creep law, "
                  "speed and wheel force move it", fontsize=9)
-    fig.savefig(out / "sensitivity_limit.png", dpi=110)
-    plt.close(fig)
+    save(fig, out / "sensitivity_limit.png")
 
 
 def figure_growth(model, parameters, out: Path) -> None:
-    op = OperatingPoint(0.014, 120 * KMH, parameters["wheel_force"], parameters["motor_slope"])
+    op = at_120(parameters, 0.014)
     sens = eigen_sensitivities(model, op, linked=LINKED)
     from model.eigen import eigen_analysis
 
@@ -98,12 +107,11 @@ def figure_growth(model, parameters, out: Path) -> None:
         tornado(ax, s.names, values, f"{label}\n{wrapped}", "p · ∂Re λ/∂p [1/s]")
     fig.suptitle("Growth-rate sensitivities of the unstable modes at s0 = 0.014, 120 km/h "
                  "(red: a larger p destabilizes)", fontsize=9)
-    fig.savefig(out / "sensitivity_growth_014.png", dpi=110)
-    plt.close(fig)
+    save(fig, out / "sensitivity_growth_014.png")
 
 
 def figure_damping(model, parameters, out: Path) -> None:
-    op = OperatingPoint(0.005, 120 * KMH, parameters["wheel_force"], parameters["motor_slope"])
+    op = at_120(parameters, 0.005)
     sens = eigen_sensitivities(model, op, linked=LINKED)
     zeta = -sens.eigenvalues.real / np.abs(sens.eigenvalues)
     values = sens.values[:, None] * sens.d_damping_ratio  # p dζ/dp
@@ -126,8 +134,7 @@ def figure_damping(model, parameters, out: Path) -> None:
     fig.colorbar(image, ax=ax, label="p/ζ · ∂ζ/∂p [-] (colour clipped at the 97th percentile)")
     ax.set_title("Relative damping-ratio sensitivities of the ten lowest modes at s0 = 0.005, "
                  "120 km/h (red: a larger p adds damping)", fontsize=9)
-    fig.savefig(out / "sensitivity_damping.png", dpi=110)
-    plt.close(fig)
+    save(fig, out / "sensitivity_damping.png")
     for k, lam in enumerate(sens.eigenvalues):
         i = int(np.nanargmax(np.abs(values[:, k])))
         print(f"mode {k + 1} {lam.imag / (2 * np.pi):.3f} Hz ζ = {-lam.real / abs(lam):.4f}: "
@@ -137,7 +144,7 @@ def figure_damping(model, parameters, out: Path) -> None:
 
 
 def figure_peaks(parameters, out: Path) -> None:
-    op = OperatingPoint(0.005, 120 * KMH, parameters["wheel_force"], parameters["motor_slope"])
+    op = at_120(parameters, 0.005)
     peaks = peak_load_sensitivities(parameters, op)
     print(f"peak loads: {peaks.seconds:.0f} s for {len(peaks.names)} parameters")
     fig, axes = plt.subplots(1, 4, figsize=(14, 4), layout="constrained")
@@ -150,8 +157,7 @@ def figure_peaks(parameters, out: Path) -> None:
                 f"{peaks.peak_times[j]:.3f} s", "p/peak · d peak/dp [-]", count=10)
     fig.suptitle("Peak drive loads after the short circuit (s0 = 0.005, 120 km/h; totals)",
                  fontsize=9)
-    fig.savefig(out / "sensitivity_peaks.png", dpi=110)
-    plt.close(fig)
+    save(fig, out / "sensitivity_peaks.png")
 
 
 def figure_uncertainty(model, parameters, path: Path, out: Path) -> None:
@@ -194,8 +200,7 @@ def figure_uncertainty(model, parameters, path: Path, out: Path) -> None:
     ax.title.set_fontsize(9)
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
-    fig.savefig(out / "uncertainty_limit.png", dpi=110)
-    plt.close(fig)
+    save(fig, out / "uncertainty_limit.png")
 
 
 def main() -> None:
