@@ -329,3 +329,16 @@ def test_uncertainty_pipeline_on_the_model(setup):
     data = result.as_dict()
     assert [o["name"] for o in data["outputs"]] == list(OUTPUT_NAMES)
     assert data["runs"] == 8
+
+
+def test_modes_are_the_ten_lowest_pairs_with_the_tools_descriptions(setup):
+    from model.modes import describe_modes
+
+    parameters, model = setup
+    op = _op(parameters, 0.005)
+    result = eigen_analysis(model, op)
+    sens = eigen_sensitivities(model, op, parameters=["gear_ratio"])
+    np.testing.assert_array_equal(sens.indices, result.complex_index[:10])
+    assert list(sens.descriptions) == describe_modes(model, result, result.complex_index[:10])
+    for shares in sens.participation:  # participation factors per subsystem sum to one
+        assert sum(shares.values()) == pytest.approx(1.0, abs=1e-9)
