@@ -35,6 +35,7 @@ data, so that a process pool or a Dask client's ``map`` can run it).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import partial
@@ -254,7 +255,11 @@ def sobol_study(evaluate: Callable[[np.ndarray], np.ndarray], distributions: Seq
 
     sobol = stats.sobol_indices(func=func, n=n, dists=list(distributions),
                                 rng=np.random.default_rng(seed))
-    boot = sobol.bootstrap(confidence_level=0.95, n_resamples=n_resamples)
+    with warnings.catch_warnings():  # degenerate bootstrap distributions (small n, an output
+        # that does not vary): their intervals come out NaN, which the result shows as such
+        warnings.simplefilter("ignore", RuntimeWarning)
+        warnings.simplefilter("ignore", stats.DegenerateDataWarning)
+        boot = sobol.bootstrap(confidence_level=0.95, n_resamples=n_resamples)
     samples = np.vstack([recorded[0][0], recorded[1][0]])
     values = np.vstack([recorded[0][1], recorded[1][1]])
     first = np.atleast_2d(sobol.first_order)
