@@ -109,6 +109,12 @@ class PolachLaw:
     ``μ_f(w) = μ0 [(1 − A) e^(−B w) + A]`` with slip velocity ``w = s v``,
     ``ε = slope · s / μ_f`` where ``slope = G π a b C11 / (4 N)`` is kept as its own parameter,
     ``μ = (2 μ_f / π) [kA ε / (1 + (kA ε)²) + arctan(kS ε)]``.
+
+    Defined for every creepage: the friction falls with the slip *speed* ``|w| = |s| v`` (Polach
+    2005, eq. 12 writes it for the magnitude), so μ is odd in s (braking creepage gives the
+    mirrored force) and bounded by μ_f ≤ μ0 at any slip (slip velocities of metres per second:
+    μ_f → μ0 A).  At s = 0 the kink of |s| enters μ only at order s⁴ (ε ∝ s/μ_f and F is odd), so
+    μ and ∂μ/∂s are continuous there.
     """
 
     mu0: float  # [-]
@@ -120,9 +126,9 @@ class PolachLaw:
 
     def _parts(self, s, v):
         s = np.asarray(s, dtype=float)
-        decay = np.exp(-self.B * s * v)
+        decay = np.exp(-self.B * np.abs(s) * v)  # friction falls with the slip speed |s v|
         mu_f = self.mu0 * ((1 - self.A) * decay + self.A)
-        dmu_f = self.mu0 * (1 - self.A) * decay * (-self.B * v)
+        dmu_f = self.mu0 * (1 - self.A) * decay * (-self.B * v) * np.sign(s)
         eps = self.slope * s / mu_f
         deps = self.slope / mu_f - self.slope * s * dmu_f / mu_f**2
         a, k = self.kA * eps, self.kS * eps
