@@ -34,7 +34,7 @@ def law(s, v, mu0, A, B, kA, kS, slope):
 def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, P1, p0_2,
           p1_2, W, D1, contact_scale, law_params, s0, v, N0, mu_s0, dmu_s0, tangent,
           detect_rows, threshold, det_state, M_step, delay, rate, floor, Z_out, z_out,
-          phi_out, u2_out, iterations):
+          phi_out, u2_out, iterations, n_creep):
     """Steps k0 → k1 (exclusive of k0's state, which is given).  Writes the modal states,
     contact velocities, remainder forces and ΔM_2 of steps k0+1 … k1 into rows 0 … of the
     outputs; updates zeta, phi, z, u2_now, det_state in place.  Returns 0, or the step at
@@ -53,11 +53,12 @@ def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, 
     for k in range(k0, k1):
         t1 = (k + 1) * h
         # ΔM_2 at the end of the step (the detection is known up to step k)
-        u2_next = 0.0
+        reduction = 0.0  # 1 − ρ: the share of ID2's motor torque taken away at the end of the step
         if det_state[0] >= 0.0:
             t_act = det_state[0] + delay
             if t1 > t_act:
-                u2_next = -M_step * (1.0 - floor) * min(1.0, rate * (t1 - t_act))
+                reduction = (1.0 - floor) * min(1.0, rate * (t1 - t_act))
+        u2_next = -M_step * reduction
         gc = g.conjugate()
         for j in range(m):
             acc = E[j] * zeta[j] + inc_step[j] + cp[j] * g + cm[j] * gc \
@@ -78,7 +79,10 @@ def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, 
         it = 0
         while True:
             for i in range(nc):
-                if tangent:
+                if i >= n_creep:  # ID2's motor slope torque, scaled by ρ with the rest
+                    r[i] = -reduction * znew[i]
+                    dr[i] = -reduction
+                elif tangent:
                     mu_t = mu_s0 + dmu_s0 * (znew[i] / v)
                     r[i] = N0 * (mu_t - mu_s0) - N0 * dmu_s0 * znew[i] / v
                     dr[i] = 0.0
@@ -126,7 +130,9 @@ def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, 
         iterations[0] += it
         # final remainder at the converged z
         for i in range(nc):
-            if tangent:
+            if i >= n_creep:
+                r[i] = -reduction * znew[i]
+            elif tangent:
                 mu_t = mu_s0 + dmu_s0 * (znew[i] / v)
                 r[i] = N0 * (mu_t - mu_s0) - N0 * dmu_s0 * znew[i] / v
             else:

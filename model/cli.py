@@ -298,6 +298,10 @@ from .response_cli import register as _register_response  # noqa: E402
 
 EXTRA_COMMANDS.append(_register_response)
 
+from .nonlinear_cli import register as _register_antislip  # noqa: E402
+
+EXTRA_COMMANDS.append(_register_antislip)  # issue 10: bogie antislip
+
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits

@@ -46,10 +46,12 @@ block of steps by one matrix product.  Every step the anti-slip logic sees the c
 
 Anti-slip protection (:class:`AntiSlip`): detection when the slip velocity of ID2's wheelset
 (mean of its two wheels) departs from its pre-fault value by more than ``threshold``, action
-``delay`` seconds later, then ID2's motor torque ramps down at ``rate`` (fraction of M(s0, v) per
-second) to ``floor`` × M(s0, v).  ID1's motor is the one that short-circuited: its torque is the
-fault torque M_C(t) of its machine, which no converter controls, so the protection cannot act on
-it.
+``delay`` seconds later; then ID2's motor torque — the pre-fault M(s0, v) *and* its slope part
+``−b_M Δω`` (eq. 6), i.e. the whole characteristic — is scaled by ρ(t), which ramps from 1 at
+``rate`` (per second) down to ``floor``.  The slope part depends on the state, so ρ·(−b_M Δω) is
+solved with the creep forces in the same Newton iteration (a fifth channel).  ID1's motor is the
+one that short-circuited: its torque is the fault torque M_C(t) of its machine, which no converter
+controls, so the protection cannot act on it.
 """
 
 from __future__ import annotations
@@ -123,7 +125,7 @@ class AntiSlip:
       few km/h); the pre-fault slip speed s0·v (0.17 m/s at s0 = 0.005, 0.47 m/s at 0.014,
       120 km/h) is not counted.
     * ``delay = 0.1 s``: the reaction time under study (the study: "within about 0.35 s").
-    * ``rate = 10 1/s``: the converter takes the full torque away in 0.1 s.
+    * ``rate = 10 1/s``: the converter takes the full torque (characteristic) away in 0.1 s.
     * ``floor = 0``: the torque is taken away completely (with ID1 failed, traction on that bogie is
       cut) and held there for the rest of the run.
     """
@@ -202,7 +204,7 @@ class NonlinearResult:
     motor_torque: float  # M(s0, v) before the fault [N m]
     mu_max: float  # μ_max(v) [-]
     newton_iterations: float  # mean Newton iterations per step
-    torque_reduction: np.ndarray  # ΔM_2(t) of the protection on ID2's motor torque (≤ 0) [N m]
+    torque_reduction: np.ndarray  # change of ID2's motor torque by the protection [N m]
     contact_velocity: np.ndarray | None = None  # N x contacts: H Δq̇ [m/s] (for checks)
     remainder_force: np.ndarray | None = None  # N x contacts: r(H Δq̇) [N]
     states: np.ndarray | None = None  # N x 2n: [Δq; Δq̇] without the rigid angles, if asked
@@ -238,12 +240,12 @@ class _Setup:
     w0: np.ndarray  # first-order-hold weights h(φ1 − φ2) per mode
     w1: np.ndarray  # h φ2
     beta_mc: np.ndarray  # modal input of M_C
-    P0: np.ndarray  # m x contacts: β_c w0
-    P1: np.ndarray  # m x contacts: β_c w1
+    P0: np.ndarray  # m x channels: β_c w0
+    P1: np.ndarray  # m x channels: β_c w1
     p0_2: np.ndarray  # m: β_2 w0 (ID2 motor torque)
     p1_2: np.ndarray
-    W: np.ndarray  # contacts x m: H Δq̇ = Re(W ζ)
-    D1: np.ndarray  # contacts x contacts: Re(W P1)
+    W: np.ndarray  # channels x m: [H; slope row] Δq̇ = Re(W ζ) (4 contacts + ID2's slope torque)
+    D1: np.ndarray  # channels x channels: Re(W P1)
     lam: np.ndarray  # kept eigenvalues [1/s]
     modal_to_state: np.ndarray  # 2n x m: x = Re(X ζ) (rigid angles left out)
 
@@ -263,10 +265,13 @@ def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
     Minv = system.Minv
     G = creep_force_map(model)
     f_m2 = _motor2_force(model)
-    inputs = np.zeros((2 * n, 2 + G.shape[1]))
+    # inputs: M_C, ΔM_2, the creep remainders, ID2's motor torque again (the channel through
+    # which the protection scales the motor's slope torque b_M Δω)
+    inputs = np.zeros((2 * n, 3 + G.shape[1]))
     inputs[n:, 0] = Minv @ model.short_circuit_force
     inputs[n:, 1] = Minv @ f_m2
-    inputs[n:, 2:] = Minv @ G
+    inputs[n:, 2:-1] = Minv @ G
+    inputs[n:, -1] = Minv @ f_m2
     rhs = deflation.apply_transpose(inputs)[r:] / scale[:, None]
     beta = system.solve_eigenvectors(rhs)[keep]  # m x (2 + contacts)
     lam_k = lam[keep]
@@ -278,7 +283,9 @@ def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
     Xc = deflation.apply(np.vstack([np.zeros((r, keep.sum())), (Y[:, keep] * scale[:, None])]))
     X = Xc * weight[None, :]
     H = creep_velocity_map(model)
-    W = H @ X[n:]
+    rotor2 = model.dofs.index("ID2.rotor.ry")
+    slope_row = op.b_M * model.motor_pattern[rotor2]  # ID2's slope torque change = row · Δq̇
+    W = np.vstack([H, slope_row]) @ X[n:]
     P1 = beta[:, 2:] * w1[:, None]
     setup = _Setup(E=E, w0=w0, w1=w1, beta_mc=beta[:, 0], P0=beta[:, 2:] * w0[:, None], P1=P1,
                    p0_2=beta[:, 1] * w0, p1_2=beta[:, 1] * w1, W=np.ascontiguousarray(W),
@@ -365,7 +372,8 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
         cp = cm = np.zeros_like(lam)
     g_step = complex(np.exp(mu * h))
     rims = contact_names(model)
-    detect_rows = np.array([0.5 if rim.startswith("ID2.") else 0.0 for rim in rims])
+    # channels: the four contacts, then ID2's slope torque (not a detection signal)
+    detect_rows = np.array([0.5 if rim.startswith("ID2.") else 0.0 for rim in rims] + [0.0])
     protection = anti_slip if anti_slip is not None and anti_slip.enabled else None
     threshold = protection.threshold if protection else math.inf
     delay = protection.delay if protection else 0.0
@@ -374,7 +382,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     law_params = np.array([law.mu0, law.A, law.B, law.kA, law.kS, law.slope])
     march = _kernel()
     m = len(lam)
-    nc = len(rims)
+    nc = len(rims) + 1
     zeta = np.zeros(m, dtype=complex)
     phi = np.zeros(nc)
     z = np.zeros(nc)
@@ -384,9 +392,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     loads = [name for name in names if not name.endswith(("creep_force", "adhesion_moment"))]
     C = np.array([np.concatenate([matrices.C_q[matrices.index(nm)], matrices.C_v[matrices.index(nm)]])
                   for nm in loads]).reshape(len(loads), 2 * n)
-    rotor2 = model.dofs.index("ID2.rotor.ry")
-    slope_row = np.concatenate([np.zeros(n), op.b_M * model.motor_pattern[rotor2]])
-    V = np.vstack([C, slope_row]) @ setup.modal_to_state  # (loads + 1) x m
+    V = C @ setup.modal_to_state  # loads x m
     Vt = np.ascontiguousarray(V.T)
     Y = np.empty((n_points, V.shape[0]))
     Y[0] = 0.0
@@ -408,7 +414,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
                        complex(1.0), setup.P0, setup.P1, setup.p0_2, setup.p1_2, setup.W,
                        setup.D1, scale, law_params, op.s0, op.v, op.N0, mu_s0, dmu_s0,
                        creep == "tangent", detect_rows, threshold, det_state, step, delay, rate,
-                       floor, Z_out, z_out, phi_out, u2_out, iterations)
+                       floor, Z_out, z_out, phi_out, u2_out, iterations, len(rims))
         if status < 0:
             raise NonlinearError(f"the creep-force iteration did not converge at t = "
                                  f"{-status * h:.6g} s")
@@ -430,6 +436,8 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     for j, name in enumerate(loads):
         i = matrices.index(name)
         totals[name] = Y[:, j] + matrices.steady[i]
+    slope_torque, slope_cut = z_hist[:, -1], r_hist[:, -1]
+    z_hist, r_hist = z_hist[:, :-1], r_hist[:, :-1]
     creep_total = np.asarray(law.mu(op.s0 + z_hist / op.v, op.v)) if creep == "nonlinear" \
         else mu_s0 + dmu_s0 * z_hist / op.v
     forces = op.N0 * creep_total  # N x contacts, totals
@@ -450,7 +458,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
         units[name], steady[name] = matrices.units[i], float(matrices.steady[i])
     M_C = excitation.torque(t, step) * excitation_scale
     motor = {"ID1.motor.torque": step + M_C,
-             "ID2.motor.torque": step + u2_hist + Y[:, len(loads)]}
+             "ID2.motor.torque": step + slope_torque + u2_hist + slope_cut}
     creepage = {rim: op.s0 + z_hist[:, i] / op.v for i, rim in enumerate(rims)}
     slip = {rim: creepage[rim] * op.v for rim in rims}
     utilisation = {rim: creep_total[:, i] / mu_max for i, rim in enumerate(rims)}
@@ -487,5 +495,5 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
         anti_slip=protection, detection_time=detection,
         action_time=None if detection is None else detection + delay, motor_torque=step,
         mu_max=float(mu_max), newton_iterations=float(iterations[0]) / max(n_steps, 1),
-        torque_reduction=u2_hist,
+        torque_reduction=u2_hist + slope_cut,
         contact_velocity=z_hist, remainder_force=r_hist, states=X_hist)
