@@ -264,7 +264,7 @@ def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
     weight = np.where(lam.imag > 0, 2.0, 1.0)[keep]
     Minv = system.Minv
     G = creep_force_map(model)
-    f_m2 = _motor2_force(model)
+    f_m2 = motor2_force(model)
     # inputs: M_C, ΔM_2, the creep remainders, ID2's motor torque again (the channel through
     # which the protection scales the motor's slope torque b_M Δω)
     inputs = np.zeros((2 * n, 3 + G.shape[1]))
@@ -295,7 +295,7 @@ def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
     return setup
 
 
-def _motor2_force(model: BogieModel) -> np.ndarray:
+def motor2_force(model: BogieModel) -> np.ndarray:
     """Generalized force of a unit driving torque of ID2's motor (rotor −ry, stator +ry)."""
     f = np.zeros(model.n)
     f[model.dofs.index("ID2.rotor.ry")] = -1.0

@@ -25,10 +25,10 @@ from model.contact import PolachLaw
 from model.nonlinear import (
     AntiSlip,
     NonlinearError,
-    _motor2_force,
     creep_force_map,
     creep_velocity_map,
     damping_without_longitudinal_creep,
+    motor2_force,
     nonlinear_response,
 )
 from model.operating_point import creep_coefficients, creep_law, damping_matrix
@@ -157,7 +157,7 @@ def test_energy_balance(bogie, s0):
     q, qd = r.states[:, :n], r.states[:, n:]
     energy = 0.5 * ((qd @ model.M) * qd).sum(axis=1) + 0.5 * ((q @ model.K) * q).sum(axis=1)
     dissipation = ((qd @ damping_without_longitudinal_creep(model, op).T) * qd).sum(axis=1)
-    inputs = qd @ model.short_circuit_force * r.M_C + qd @ _motor2_force(model) * r.torque_reduction
+    inputs = qd @ model.short_circuit_force * r.M_C + qd @ motor2_force(model) * r.torque_reduction
     mu_s0 = creep_coefficients(parameters, op).mu
     forces = np.column_stack([r.outputs[f"{rim}.creep_force"] for rim in model.rims])
     creep_power = -(r.contact_velocity * (forces - mu_s0 * op.N0)).sum(axis=1)
