@@ -1,9 +1,9 @@
 """Compiled step loop of :mod:`model.nonlinear` (numba, cached on disk).
 
 Kept apart so that importing :mod:`model.nonlinear` does not import numba; see that module's
-docstring for the scheme.  One loop step: propagate the modal state exactly, solve the four
-contact velocities z = zp + D1 r(z) by Newton (4 x 4, partial pivoting), add the remainder's
-end-of-step input, detect slip on ID2's wheelset.
+docstring for the scheme.  One loop step: propagate the modal state exactly, solve the channels
+z = zp + D1 r(z) by Newton (the four contact velocities and ID2's slope torque: 5 x 5, partial
+pivoting), add the remainder's end-of-step input, detect slip on ID2's wheelset.
 """
 
 from __future__ import annotations

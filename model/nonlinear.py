@@ -24,25 +24,26 @@ eq. 20 again: ``B + b_M B_M + B_ad = B_nl − G diag(N0 μ'(s0)/v) H``.  Kept li
 the lateral and spin creep forces (Kalker, eq. 9–10), the vertical wheel forces (N = N0 in the
 creep law; the track's m_R, b_R, k_R stay in M, B, K), the healthy motor's slope b_M.
 
-Method (exact linear part, implicit remainder).  The equation is split at the tangent:
+Method (exact linear part, implicit remainder). The equation is split at the tangent:
 
     M Δq̈ + B_total Δq̇ + K Δq = f_mc M_C + f_m2 ΔM_2 + G r(H Δq̇),
     r_i(z) = N0 [μ(s0 + z/v) − μ(s0)] − N0 μ'(s0) z/v        (zero with zero slope at z = 0)
 
 The linear part is the closed form's system (:func:`model.eigen.bogie_system`, the *same* cached
 eigendecomposition, rigid spins deflated) in its eigenbasis ``ζ``, stepped exactly: each mode by
-``e^(λh)``, the step and the damped sinusoid of M_C by their exact integrals over the step.  The
+``e^(λh)``, the step and the damped sinusoid of M_C by their exact integrals over the step. The
 four remainder forces and ΔM_2 enter as piecewise-linear inputs (first-order hold; exact modal
 weights ``h(φ1 − φ2)``, ``h φ2``), and the remainder at the end of each step is solved implicitly
-from the four contact velocities ``z = H Δq̇`` by a 4 x 4 Newton iteration (the creep feedback is
-stiff: ``N0 μ'/v`` reaches 10⁶ N s/m on a rim of ≈ 200 kg).  Why split at the tangent and not at
-``B_nl``: without the b11 terms the drivetrain spins lose their only damping (a double zero
-eigenvalue, a Jordan block the modal basis cannot hold), the linear part would need its own
-eigendecomposition, and the whole creep feedback would carry the hold error; at the tangent the
-linear part is exact, the remainder is O(Δs²), and ``creep="tangent"`` (μ replaced by its tangent
-in the *same* loop: the remainder evaluates to rounding) reproduces the closed form to rounding.
-The loop runs compiled (numba; per step O(modes x contacts)); the outputs are formed after each
-block of steps by one matrix product.  Every step the anti-slip logic sees the contact velocities.
+from the four contact velocities ``z = H Δq̇`` by a Newton iteration (5 x 5 with the anti-slip
+channel below; the creep feedback is stiff: ``N0 μ'/v`` reaches 10⁶ N s/m on a rim of ≈ 200 kg).
+Why split at the tangent and not at ``B_nl``: without the b11 terms the drivetrain spins lose their
+only damping (a double zero eigenvalue, a Jordan block the modal basis cannot hold), the linear
+part would need its own eigendecomposition, and the whole creep feedback would carry the hold
+error; at the tangent the linear part is exact, the remainder is O(Δs²), and ``creep="tangent"`` (μ
+replaced by its tangent in the *same* loop: the remainder evaluates to rounding) reproduces the
+closed form to rounding. The loop runs compiled (numba; per step O(modes x contacts)); the outputs
+are formed after each block of steps by one matrix product. Every step the anti-slip logic sees the
+contact velocities.
 
 Anti-slip protection (:class:`AntiSlip`): detection when the slip velocity of ID2's wheelset
 (mean of its two wheels) departs from its pre-fault value by more than ``threshold``, action
