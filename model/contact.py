@@ -110,8 +110,8 @@ class PolachLaw:
     ``ε = slope · s / μ_f`` where ``slope = G π a b C11 / (4 N)`` is kept as its own parameter,
     ``μ = (2 μ_f / π) [kA ε / (1 + (kA ε)²) + arctan(kS ε)]``.
 
-    Defined for every creepage: the friction falls with the slip *speed* ``|w| = |s| v`` (Polach
-    2005, eq. 12 writes it for the magnitude), so μ is odd in s (braking creepage gives the
+    Defined for every creepage: the friction falls with the slip *speed* ``|w| = |s| v`` (a
+    speed, whatever the direction of slip), so μ is odd in s (braking creepage gives the
     mirrored force) and bounded by μ_f ≤ μ0 at any slip (slip velocities of metres per second:
     μ_f → μ0 A).  At s = 0 the kink of |s| enters μ only at order s⁴ (ε ∝ s/μ_f and F is odd), so
     μ and ∂μ/∂s are continuous there.
