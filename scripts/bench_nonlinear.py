@@ -34,12 +34,13 @@ import argparse
 import json
 import os
 import platform
+import sys
 import time
 
 import numpy as np
 import scipy
 import scipy.signal
-from scipy.integrate import Radau
+from bench_response import best_of, run_radau  # the same Radau loop and timing as there
 
 from model import build_model, default_operating_point, load_parameters
 from model.eigen import bogie_system, forget_systems
@@ -52,15 +53,6 @@ from model.nonlinear import (
 from model.operating_point import creep_law
 from model.outputs import output_matrices
 from model.response import ShortCircuit
-
-
-def best_of(function, repeats):
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        value = function()
-        times.append(time.perf_counter() - start)
-    return min(times), value
 
 
 def radau_system(model, op, excitation, step):
@@ -91,23 +83,6 @@ def radau_system(model, op, excitation, step):
         return J
 
     return fun, jac, law
-
-
-def run_radau(fun, jac, size, t_eval, rtol, atol, budget):
-    """solve_ivp(Radau)'s loop stopped after ``budget`` CPU seconds: (seconds, states, t)."""
-    solver = Radau(fun, 0.0, np.zeros(size), t_eval[-1], rtol=rtol, atol=atol, jac=jac)
-    states, i = [], 0
-    start = time.process_time()
-    while solver.status == "running" and time.process_time() - start < budget:
-        solver.step()
-        if solver.status == "failed":
-            raise RuntimeError(f"Radau failed: {solver.message}")
-        j = np.searchsorted(t_eval, solver.t, side="right")
-        if j > i:
-            states.append(solver.dense_output()(t_eval[i:j]).T)
-            i = j
-    seconds = time.process_time() - start
-    return seconds, np.vstack(states) if states else np.zeros((0, size)), solver.t
 
 
 def outputs_from_states(model, op, X, law, names):
@@ -190,6 +165,7 @@ def main() -> None:
             "nonlinear, first call in the process (numba cache load)": t_first,
             "scipy.signal.lsim (linear system)": t_lsim}
     report = {"times": rows}
+    print(f"timed: {json.dumps(rows)}", file=sys.stderr, flush=True)
 
     # accuracy 2: step halving over the whole horizon
     runs = {k: nonlinear_response(model, op, excitation, args.t_end, args.fs, substeps=k)
@@ -200,6 +176,7 @@ def main() -> None:
     report["step_halving"] = {"h": {"error": halving[1][0], "output": halving[1][1]},
                               "h/2": {"error": halving[2][0], "output": halving[2][1]},
                               "order": order}
+    print(f"halving: {json.dumps(report['step_halving'])}", file=sys.stderr, flush=True)
 
     radau_note = ""
     if not args.skip_radau:
@@ -215,6 +192,7 @@ def main() -> None:
                                               rows=slice(0, len(X_ref)))
         report["radau_reference"] = {"t_end": float(t[len(X_ref) - 1]), "error": error_ref,
                                      "output": which_ref, "cpu_seconds": t_reference}
+        print(f"reference: {json.dumps(report['radau_reference'])}", file=sys.stderr, flush=True)
         # speed: Radau rtol 1e-8 on the whole horizon under the budget
         x_scale = 1e-3
         t_radau, X_radau, reached = run_radau(fun, jac, size, t, 1e-8, 1e-8 * 1e-3 * x_scale,
