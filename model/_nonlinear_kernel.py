@@ -15,7 +15,7 @@ import numba
 import numpy as np
 
 
-@numba.njit(cache=True, fastmath=False, nogil=True)
+@numba.njit(cache=True, fastmath={"reassoc", "contract", "nsz", "arcp"}, nogil=True)
 def law(s, v, mu0, A, B, kA, kS, slope):
     """Polach's μ(s, v) and ∂μ/∂s (as :class:`model.contact.PolachLaw`)."""
     w = abs(s) * v
@@ -31,7 +31,7 @@ def law(s, v, mu0, A, B, kA, kS, slope):
     dF = kA * (1.0 - a * a) / ((1.0 + a * a) ** 2) + kS / (1.0 + k * k)
     return 2.0 / math.pi * mu_f * F, 2.0 / math.pi * (dmu_f * F + mu_f * dF * deps)
 
-@numba.njit(cache=True, fastmath=False, nogil=True)
+@numba.njit(cache=True, fastmath={"reassoc", "contract", "nsz", "arcp"}, nogil=True)
 def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, P1, p0_2,
           p1_2, W, D1, contact_scale, law_params, s0, v, N0, mu_s0, dmu_s0, tangent,
           detect_rows, threshold, det_state, M_step, delay, rate, floor, Z_out, z_out,

@@ -394,7 +394,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     C = np.array([np.concatenate([matrices.C_q[matrices.index(nm)], matrices.C_v[matrices.index(nm)]])
                   for nm in loads]).reshape(len(loads), 2 * n)
     V = C @ setup.modal_to_state  # loads x m
-    Vt = np.ascontiguousarray(V.T)
+    V_real, V_imag = np.ascontiguousarray(V.real.T), np.ascontiguousarray(-V.imag.T)
     Y = np.empty((n_points, V.shape[0]))
     Y[0] = 0.0
     z_hist = np.zeros((n_points, nc))
@@ -422,8 +422,8 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
         sel = np.arange(substeps - 1, k1 - k, substeps)  # block rows that are samples
         samples = (k + sel + 1) // substeps
         u2_now = float(u2_out[k1 - k - 1])
-        Zs = Z_out[sel]
-        Y[samples] = (Zs @ Vt).real
+        Zs = Z_out[: k1 - k] if substeps == 1 else Z_out[sel]
+        Y[samples] = Zs.real @ V_real + Zs.imag @ V_imag  # Re(Z Vᵀ): two real products
         z_hist[samples] = z_out[sel]
         r_hist[samples] = phi_out[sel]
         u2_hist[samples] = u2_out[sel]
