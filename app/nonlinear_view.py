@@ -3,7 +3,7 @@ histories overlaid on the linear ones, each wheel's creepage path on the creep p
 required reaction time of the protection in the status area for unstable points.
 
 The linear closed form stays the fast first answer (the dashboard's fast stage); this view
-starts its own computations after it, on the dashboard's worker threads when served, and shows
+starts its own computations after it, on worker threads of its own when served, and shows
 them when ready, if they still belong to what is on screen (a notice says "computing…" in the
 meantime; the page never waits).  Bad anti-slip input shows a notice and keeps the last valid
 values and results.
@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import html
 import logging
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import partial
 
@@ -38,6 +39,12 @@ WHEEL_COLORS = {"ID1.rim12": "#8c564b", "ID1.rim14": "#e377c2", "ID2.rim12": "#1
 REACTION_DELAYS = np.linspace(0.0, 0.5, 11)  # [s] delay grid of the dashboard's reaction time
 REACTION_FS = 5_000.0  # [Hz] its sampling (the CLI's default is 10 kHz)
 PATH_POINTS = 1500  # points of each wheel's creepage path sent to the browser
+# workers of their own: the nonlinear runs (0.3-0.6 s) and the reaction times (≈ 20 runs each)
+# never hold up the dashboard's workers (the linear first answer stays as fast as before), and a
+# running reaction time never holds up the next nonlinear history; a request superseded before
+# it starts is skipped
+HISTORY_EXECUTOR = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bogie-nonlinear")
+REACTION_EXECUTOR = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bogie-reaction")
 
 
 @dataclass(frozen=True)
@@ -272,10 +279,19 @@ class NonlinearView:
             except (NonlinearError, ValueError, np.linalg.LinAlgError) as error:
                 self._reject(error)
             return
-        from .dashboard import EXECUTOR
 
-        future = EXECUTOR.submit(work)
+        def if_current():
+            return work() if self._current(key, apply) else None
+
+        executor = REACTION_EXECUTOR if apply == self._apply_reaction else HISTORY_EXECUTOR
+        future = executor.submit(if_current)
         future.add_done_callback(partial(self._done, doc, key, apply))
+
+    def _current(self, key, apply) -> bool:
+        """Whether a request is still the one to show (checked before it starts)."""
+        if apply == self._apply_reaction:
+            return key == self._reaction_key
+        return self.creep.value == "nonlinear" and self._state is not None and key == self._key()
 
     def _done(self, doc, key, apply, future) -> None:
         error = future.exception()
@@ -284,7 +300,9 @@ class NonlinearView:
                 log.error("nonlinear computation failed", exc_info=error)
             doc.add_next_tick_callback(partial(self.dash._locked, doc, self._reject, error))
             return
-        doc.add_next_tick_callback(partial(self.dash._locked, doc, apply, key, future.result()))
+        if future.result() is not None:
+            doc.add_next_tick_callback(partial(self.dash._locked, doc, apply, key,
+                                               future.result()))
 
     def _apply_histories(self, key, histories: NonlinearHistories) -> None:
         if self.creep.value != "nonlinear" or key != self._key():
