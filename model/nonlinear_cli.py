@@ -57,6 +57,10 @@ def add_creep_arguments(p: argparse.ArgumentParser) -> None:
                    help="anti-slip protection on ID2's motor torque (needs --creep nonlinear or "
                         "tangent; default off)")
     add_anti_slip_arguments(p)
+    p.add_argument("--strength", type=number("--strength (N m)", 0, 1e9,
+                                             allowed="must be in (0, 1e9) N m"), default=None,
+                   help="design strength [N m] of the disc and claw clutch (the driving shaft: "
+                        "strength/p); crossings are listed (needs --creep nonlinear or tangent)")
 
 
 def anti_slip_from(args: argparse.Namespace, delay: bool = True):
@@ -81,6 +85,8 @@ def check_creep_arguments(args: argparse.Namespace) -> None:
                          "no protection)")
     if given and args.anti_slip == "off":
         raise UsageError(f"--{given[0].replace('_', '-')} needs --anti-slip on")
+    if getattr(args, "strength", None) is not None and args.creep == "linear":
+        raise UsageError("--strength needs --creep nonlinear or tangent")
     if args.creep != "linear" and getattr(args, "method", "auto") != "auto":
         raise UsageError("--method applies to --creep linear only")
 
@@ -193,7 +199,7 @@ def cmd_nonlinear_response(args: argparse.Namespace, excitation, names, out: Pat
     anti_slip = anti_slip_from(args) if args.anti_slip == "on" else None
     model, op, _ = load_model(args)
     result = nonlinear_response(model, op, excitation, args.t_end, args.fs, creep=args.creep,
-                                anti_slip=anti_slip, outputs=names)
+                                anti_slip=anti_slip, outputs=names, strength=args.strength)
     if out is not None:
         write_result(result, out)
     summary = summary_data(result)

@@ -55,6 +55,11 @@ def test_tangent_csv_and_json(tmp_path, capsys):
     data = json.loads(out)
     assert data["creep"] == "nonlinear"
     assert data["anti_slip"] is None
+    code, out, err = run([*BASE, "--creep", "nonlinear", "--strength", "3e4", "--json"], capsys)
+    assert code == 0, err
+    crossings = json.loads(out)["limit_crossings"]
+    assert any(c["limit"] == "strength" and c["output"] == "ID1.disc_clutch.torque"
+               for c in crossings)  # ID1's pre-fault 50.9 kN m is beyond a 30 kN m strength
     assert set(data["wheels"]) == {"ID1.rim12", "ID1.rim14", "ID2.rim12", "ID2.rim14"}
 
 
@@ -68,6 +73,8 @@ def test_tangent_csv_and_json(tmp_path, capsys):
     (["--creep", "nonlinear", "--anti-slip-delay", "0.2"], "needs --anti-slip on"),
     (["--creep", "nonlinear", "--method", "expm"], "--method"),
     (["--creep", "nonlinear", "--outputs", "ID1.rotor.ry"], "unknown output"),
+    (["--strength", "6e4"], "--strength needs"),
+    (["--creep", "nonlinear", "--strength", "-1"], "--strength"),
 ])
 def test_response_bad_input(capsys, extra, message):
     code, out, err = run([*BASE, *extra], capsys)
