@@ -304,9 +304,6 @@ def motor2_force(model: BogieModel) -> np.ndarray:
     return f
 
 
-MOTOR_OUTPUTS = ("ID1.motor.torque", "ID2.motor.torque")
-
-
 def nonlinear_response(model: BogieModel, op: OperatingPoint,
                        excitation: ShortCircuit | None = None, t_end: float = 2.0,
                        fs: float = 10_000.0, creep: str = "nonlinear",

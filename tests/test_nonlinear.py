@@ -31,7 +31,7 @@ from model.nonlinear import (
     motor2_force,
     nonlinear_response,
 )
-from model.operating_point import creep_coefficients, creep_law, damping_matrix
+from model.operating_point import OperatingPoint, creep_coefficients, creep_law, damping_matrix
 from model.response import ShortCircuit, short_circuit_response
 
 
@@ -220,3 +220,20 @@ def test_bad_input(bogie):
         AntiSlip(floor=1.0)
     with pytest.raises(NonlinearError, match="unknown output"):
         nonlinear_response(model, op, outputs=["ID3.rotor.torque"])
+
+
+def test_tangent_at_the_creep_maximum(bogie):
+    """At the creep maximum μ'(s0) = 0: the spins lose their creep damping (the closed form
+    switches to its expm form there); the stepping in the eigenbasis still reproduces it.  The
+    creep-force perturbations of the tangent law vanish there (peaks ~1e-10 N), so only the
+    loads are compared."""
+    parameters, model = bogie
+    s_max, _ = creep_law(parameters).maximum(120 / 3.6)
+    op = OperatingPoint.from_kmh(s_max, 120.0, parameters["wheel_force"],
+                                 parameters["motor_slope"])
+    linear = short_circuit_response(model, op, ShortCircuit(), 1.0, 10_000.0)
+    tangent = nonlinear_response(model, op, ShortCircuit(), 1.0, 10_000.0, creep="tangent")
+    loads = [n for n in linear.outputs if not n.endswith(("creep_force", "adhesion_moment"))]
+    errors = relative_errors(perturbations(tangent), perturbations(linear), loads)
+    worst = max(errors, key=errors.get)
+    assert errors[worst] <= 1e-6, (worst, errors[worst])
