@@ -35,6 +35,7 @@ from model import NoStabilityLimit, OperatingPointError, ParameterError
 from model.parameters import dumps_parameters
 
 from . import compute
+from .nonlinear_view import NonlinearView  # issue 10
 from .plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
 from .sensitivity_view import SensitivityView  # issue 12: sensitivity tornado
 from .serve import limit_blas_threads
@@ -194,6 +195,7 @@ class BogieDashboard(pn.viewable.Viewer):
             rail,
             "### Short circuit M_C(t)", sliders["M0"], sliders["f"], sliders["D"], dt_auto,
             sliders["dt"], sliders["t_end"],
+            *self.nonlinear.controls,  # issue 10
             "### Downloads", *downloads, width=300)
 
     def _published_case(self, s0: float, _event=None) -> None:
@@ -207,6 +209,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.creep_plot = CreepPlot()
         self.response_plots = ResponsePlots()
         self.mode_plot = ModeShapePlot(m.positions, m.parameters["wheel_radius"])
+        self.nonlinear = NonlinearView(self)  # issue 10: creep model, anti-slip, overlays
         html_pane = partial(pn.pane.HTML, sizing_mode="stretch_width", stylesheets=[CSS])
         self.status = html_pane("", css_classes=["stability-status"])
         self.details = html_pane("")
@@ -233,8 +236,9 @@ class BogieDashboard(pn.viewable.Viewer):
         self.sensitivity = SensitivityView()  # issue 12: sensitivity tornado
         schematic = ASSETS / "schematic.svg"
         self.main = pn.Column(
-            self.notice,
-            pn.Row(pn.Column(self.status, self.busy, self.details, width=330),
+            self.notice, self.nonlinear.notice,  # issue 10
+            pn.Row(pn.Column(self.status, self.busy, self.details, self.nonlinear.status,
+                             width=330),
                    pn.Column(pn.Row(locus_choice, zoom), bokeh_pane(self.locus_plot.figure),
                              sizing_mode="stretch_width"),
                    sizing_mode="stretch_width"),
@@ -456,6 +460,8 @@ class BogieDashboard(pn.viewable.Viewer):
         self._on_mode()
         self.locus_plot.zoom(self.zoom == "low")
         self.sensitivity.request(self, state)  # issue 12: sensitivity tornado (when ready)
+
+        self.nonlinear.on_fast(state)  # issue 10: the nonlinear result follows
 
     def _apply_slow(self, state: State, slow) -> None:
         limit, locus = slow

@@ -302,6 +302,10 @@ from .sensitivity_cli import register as _register_sensitivity  # noqa: E402  (i
 
 EXTRA_COMMANDS.append(_register_sensitivity)
 
+from .nonlinear_cli import register as _register_antislip  # noqa: E402
+
+EXTRA_COMMANDS.append(_register_antislip)  # issue 10: bogie antislip
+
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits

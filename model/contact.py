@@ -109,6 +109,12 @@ class PolachLaw:
     ``μ_f(w) = μ0 [(1 − A) e^(−B w) + A]`` with slip velocity ``w = s v``,
     ``ε = slope · s / μ_f`` where ``slope = G π a b C11 / (4 N)`` is kept as its own parameter,
     ``μ = (2 μ_f / π) [kA ε / (1 + (kA ε)²) + arctan(kS ε)]``.
+
+    Defined for every creepage: the friction falls with the slip *speed* ``|w| = |s| v`` (a
+    speed, whatever the direction of slip), so μ is odd in s (braking creepage gives the
+    mirrored force) and bounded by μ_f ≤ μ0 at any slip (slip velocities of metres per second:
+    μ_f → μ0 A).  At s = 0 the kink of |s| enters μ only at order s⁴ (ε ∝ s/μ_f and F is odd), so
+    μ and ∂μ/∂s are continuous there.
     """
 
     mu0: float  # [-]
@@ -121,9 +127,12 @@ class PolachLaw:
     def _parts(self, s, v):
         s = np.asarray(s)
         s = s.astype(complex if np.iscomplexobj(s) else float)  # complex step (model.sensitivity)
-        decay = np.exp(-self.B * s * v)
+        # friction falls with the slip speed |s v|; for a complex step (about s ≠ 0) |s| is
+        # continued analytically as sign(Re s)·s
+        sign = np.sign(s.real)
+        decay = np.exp(-self.B * sign * s * v)
         mu_f = self.mu0 * ((1 - self.A) * decay + self.A)
-        dmu_f = self.mu0 * (1 - self.A) * decay * (-self.B * v)
+        dmu_f = self.mu0 * (1 - self.A) * decay * (-self.B * v) * sign
         eps = self.slope * s / mu_f
         deps = self.slope / mu_f - self.slope * s * dmu_f / mu_f**2
         a, k = self.kA * eps, self.kS * eps

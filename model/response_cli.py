@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .cli import UsageError, add_operating_point, emit, load_model, number
+from .nonlinear_cli import add_creep_arguments, check_creep_arguments, cmd_nonlinear_response
 
 MIN_SAMPLES_PER_PERIOD = 2.5  # fs must exceed 2.5 × the highest excited frequency
 
@@ -50,6 +51,7 @@ def register(subparsers) -> None:
     p.add_argument("--method", choices=("auto", "modal", "expm"), default="auto",
                    help="evaluation of the closed form (default %(default)s)")
     p.add_argument("--out", default=None, help="write .npz, .csv or .json")
+    add_creep_arguments(p)  # issue 10: --creep, --anti-slip …
     p.set_defaults(func=cmd_response)
 
 
@@ -69,6 +71,7 @@ def cmd_response(args: argparse.Namespace) -> None:
     from .response import ShortCircuit, short_circuit_response
 
     out = _check_out(args.out)
+    check_creep_arguments(args)
     defaults = ShortCircuit()
     excitation = ShortCircuit(
         M0=defaults.M0 if args.m0 is None else args.m0,
@@ -84,6 +87,9 @@ def cmd_response(args: argparse.Namespace) -> None:
                          "most 2000000")
     names = None if args.outputs is None else [s.strip() for s in args.outputs.split(",")
                                                 if s.strip()]
+    if args.creep != "linear":
+        cmd_nonlinear_response(args, excitation, names, out)
+        return
     model, op, _ = load_model(args)
     result = short_circuit_response(model, op, excitation, args.t_end, args.fs, names,
                                     method=args.method)

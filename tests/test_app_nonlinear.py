@@ -1,0 +1,113 @@
+"""Dashboard part of issue 10 without a browser: the creep-model switch, the anti-slip controls,
+the overlays, the creepage paths and the required reaction time in the status.
+
+Expectations come from model/ (the dashboard must show what the model computes).  Tests that
+build a dashboard are slow (it computes the stability limit and a root locus)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from app import compute
+from app.nonlinear_view import REACTION_DELAYS, anti_slip_key, nonlinear_histories, reaction
+from model.antislip import required_reaction_time
+from model.nonlinear import AntiSlip, NonlinearError, nonlinear_response
+from model.response import ShortCircuit
+
+
+def test_anti_slip_key_validates():
+    assert anti_slip_key(True, 0.1, 0.3, 10.0) == (True, 0.1, 0.3, 10.0)
+    for bad in ((True, -0.1, 0.3, 10.0), (True, 0.1, 0.0, 10.0), (True, 0.1, 0.3, -1.0)):
+        with pytest.raises(NonlinearError):
+            anti_slip_key(*bad)
+
+
+def test_histories_are_the_model_result():
+    key = ("", "calibrated", 0.014, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None, 1.0,
+           (True, 0.1, 0.3, 10.0))
+    shown = nonlinear_histories(*key)
+    m = compute.model("", "calibrated")
+    op = compute.operating_point("", "calibrated", 0.014, 120.0, 100.0, 3000.0)
+    r = nonlinear_response(m, op, ShortCircuit(), 1.0, compute.RESPONSE_FS,
+                           anti_slip=AntiSlip(True, 0.1, 0.3, 10.0))
+    for name in compute.RESPONSE_OUTPUTS:
+        assert shown.peaks[name] == pytest.approx(r.peaks[name], rel=1e-12)
+        _, y = shown.plot[name]
+        assert np.abs(y).max() == pytest.approx(abs(r.peaks[name]), rel=1e-6)  # float32
+    assert shown.detection_time == pytest.approx(r.detection_time)
+    assert set(shown.paths) == set(r.creepage)
+
+
+@pytest.fixture(scope="module")
+def dash():
+    from app.dashboard import BogieDashboard
+
+    return BogieDashboard()
+
+
+@pytest.mark.slow
+def test_creep_switch_overlays_and_paths(dash):
+    view = dash.nonlinear
+    dash.param.update(s0=0.005, v=120.0)
+    assert len(view.sources["ID2.disc_clutch.torque"].data["t"]) == 0  # linear: nothing extra
+    view.creep.value = "nonlinear"
+    t, y = view.sources["ID2.disc_clutch.torque"].data["t"], view.sources[
+        "ID2.disc_clutch.torque"].data["y"]
+    assert len(t) > 100
+    assert np.abs(y).max() == pytest.approx(abs(view.histories.peaks["ID2.disc_clutch.torque"]),
+                                            rel=1e-6)
+    assert len(view.paths["ID2.rim12"].data["s"]) > 100
+    assert "nonlinear creep shown" in view.status.object
+    # the linear result is still there beside it
+    assert len(dash.response_plots.sources["ID2.disc_clutch.torque"].data["t"]) > 100
+    view.creep.value = "linear"
+    assert len(view.sources["ID2.disc_clutch.torque"].data["t"]) == 0
+
+
+@pytest.mark.slow
+def test_bad_anti_slip_input_shows_a_notice_and_keeps_the_state(dash):
+    view = dash.nonlinear
+    view.creep.value = "nonlinear"
+    view.anti_slip.value = True
+    before_key, before = view.valid, view.histories
+    view.threshold.value = 0.0
+    assert view.notice.visible
+    assert "threshold" in view.notice.object
+    assert view.valid == before_key
+    assert view.histories is before
+    view.threshold.value = 0.3
+    assert not view.notice.visible
+    view.delay.value = -1.0
+    assert view.notice.visible
+    assert "delay" in view.notice.object
+    view.delay.value = 0.1
+    assert not view.notice.visible
+    view.anti_slip.value = False
+    view.creep.value = "linear"
+
+
+@pytest.mark.slow
+def test_unstable_point_shows_the_required_reaction_time(dash):
+    dash.param.update(s0=0.014, v=120.0)
+    assert not dash.point.stable
+    status = dash.nonlinear.status.object
+    assert "required anti-slip reaction time" in status
+    m = compute.model("", "calibrated")
+    op = compute.operating_point("", "calibrated", 0.014, 120.0, dash.N0, dash.b_M)
+    expected = required_reaction_time(m, op, delays=REACTION_DELAYS, t_end=2.0,
+                                      fs=compute.RESPONSE_FS / 2)
+    shown = dash.nonlinear.reaction
+    assert shown.reason == expected.reason
+    if expected.required_delay is not None:
+        assert shown.required_delay == pytest.approx(expected.required_delay, abs=1e-9)
+        assert f"{expected.required_delay:.2f} s" in status
+    dash.param.update(s0=0.005)
+    assert "reaction time" not in dash.nonlinear.status.object
+
+
+def test_reaction_is_cached_plain_data():
+    key = ("", "calibrated", 0.014, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None, 0.3, 10.0)
+    first = reaction(*key)
+    assert reaction(*key) is first
+    assert first.limit > 0
