@@ -1,37 +1,88 @@
-"""Compiled step loop of :mod:`model.nonlinear` (numba, cached on disk; it releases the GIL, so
-the dashboard's sessions step side by side).
+"""Step loop of :mod:`model.nonlinear` in numpy and scipy (see that module's docstring for the
+scheme): the creep remainders of a whole block of steps are solved together.
 
-Kept apart so that importing :mod:`model.nonlinear` does not import numba; see that module's
-docstring for the scheme.  One loop step: propagate the modal state exactly, solve the channels
-z = zp + D1 r(z) by Newton (the four contact velocities and ID2's slope torque: 5 x 5, partial
-pivoting), add the remainder's end-of-step input, detect slip on ID2's wheelset.
+Within a block of ``L`` steps (``L ≤ SUB_STEPS``), the channel values (the four contact
+velocities and ID2's slope torque) are linear in the block's unknown remainders r:
+
+    z = a + T r(z),        a_i = Re(W ζ⁻_i) without the block's remainders,
+                           T = block lower-triangular Toeplitz:  D1 on the diagonal,
+                               Re(W E^(l−1) Q) l steps below (Q = diag(E) P1 + P0),
+
+because the modal state obeys ``ζ⁻_{i+1} = E ζ⁻_i + F_i + Q r_i`` (the end-of-step input of step
+i folded into step i+1; ``ζ_i = ζ⁻_i + P1 r_i``).  The 5L equations are solved by Newton with the
+Jacobian ``T diag(r') − I`` less the within-step coupling between channels (≈ 10⁻⁸ of the
+diagonal, measured; the residual keeps it, so the solution is that of the coupled equations):
+that Jacobian is lower triangular, one ``solve_triangular`` per iteration, and the creep law is
+evaluated on all 4L contact values at once.  What stays per step in Python are two vectorised
+O(modes) recurrences (the block's forced state, then the state with the remainders).
+
+A block that does not converge is halved (down to one step, the plain one-step implicit
+scheme); a block in which the anti-slip protection trips is cut where the torque reduction
+starts (it depends on the detection time) and the next block starts there.
 """
 
 from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+from scipy.linalg import get_lapack_funcs
+
+SUB_STEPS = 32  # steps solved together
+TOLERANCE = 1e-12  # relative change of the channel values at which Newton stops
+MAX_ITERATIONS = 40  # per block before it is halved
 
 
-@numba.njit(cache=True, fastmath={"reassoc", "contract", "nsz", "arcp"}, nogil=True)
-def law(s, v, mu0, A, B, kA, kS, slope):
-    """Polach's μ(s, v) and ∂μ/∂s (as :class:`model.contact.PolachLaw`)."""
-    w = abs(s) * v
-    decay = math.exp(-B * w)
+def polach(s: np.ndarray, v: float, mu0: float, A: float, B: float, kA: float, kS: float,
+           slope: float) -> tuple[np.ndarray, np.ndarray]:
+    """Polach's μ(s, v) [-] and ∂μ/∂s [-] (as :class:`model.contact.PolachLaw`: odd in s,
+    friction falling with the slip velocity |s|·v [m/s])."""
+    decay = np.exp(-B * v * np.abs(s))
     mu_f = mu0 * ((1.0 - A) * decay + A)
-    sgn = 1.0 if s > 0 else (-1.0 if s < 0 else 0.0)
-    dmu_f = -mu0 * (1.0 - A) * decay * B * v * sgn
+    dmu_f = -mu0 * (1.0 - A) * B * v * np.sign(s) * decay
     eps = slope * s / mu_f
-    deps = slope / mu_f - slope * s * dmu_f / (mu_f * mu_f)
+    deps = slope / mu_f - eps * dmu_f / mu_f
     a = kA * eps
     k = kS * eps
-    F = a / (1.0 + a * a) + math.atan(k)
-    dF = kA * (1.0 - a * a) / ((1.0 + a * a) ** 2) + kS / (1.0 + k * k)
-    return 2.0 / math.pi * mu_f * F, 2.0 / math.pi * (dmu_f * F + mu_f * dF * deps)
+    aa = 1.0 + a * a
+    F = a / aa + np.arctan(k)
+    dF = kA * (1.0 - a * a) / (aa * aa) + kS / (1.0 + k * k)
+    return (2.0 / math.pi) * mu_f * F, (2.0 / math.pi) * (dmu_f * F + mu_f * dF * deps)
 
-@numba.njit(cache=True, fastmath={"reassoc", "contract", "nsz", "arcp"}, nogil=True)
+
+def _toeplitz(W: np.ndarray, E: np.ndarray, Q: np.ndarray, D1: np.ndarray, L: int) -> np.ndarray:
+    """T (L·nc x L·nc): row block i, column block j holds D1 (i = j) or Re(W E^(i−j−1) Q)."""
+    nc = W.shape[0]
+    powers = E[None, :] ** np.arange(L - 1)[:, None]  # (L−1) x m
+    lags = np.einsum("cm,lm,md->lcd", W, powers, Q).real  # (L−1) x nc x nc
+    T = np.zeros((L, nc, L, nc))
+    for i in range(L):
+        T[i, :, i, :] = D1
+        for j in range(i):
+            T[i, :, j, :] = lags[i - j - 1]
+    return T.reshape(L * nc, L * nc)
+
+
+class _Blocks:
+    """The Toeplitz matrices of one step loop (per block length, built on first use)."""
+
+    def __init__(self, W, E, Q, D1):
+        self.W, self.E, self.Q, self.D1 = W, E, Q, D1
+        self.full = _toeplitz(W, E, Q, D1, SUB_STEPS)
+        nc = W.shape[0]
+        # the Newton matrix's part: T without the within-step coupling between channels
+        self.triangular = np.tril(self.full)
+        for i in range(SUB_STEPS):
+            block = self.triangular[i * nc:(i + 1) * nc, i * nc:(i + 1) * nc]
+            block[np.triu_indices(nc, 1)] = 0.0  # np.tril kept the lower part of D1 only
+            block[np.tril_indices(nc, -1)] = 0.0
+
+    def matrices(self, L: int) -> tuple[np.ndarray, np.ndarray]:
+        """(T, its triangular part) of the first L steps (a leading block of the longest)."""
+        n = L * self.W.shape[0]
+        return self.full[:n, :n], self.triangular[:n, :n]
+
+
 def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, P1, p0_2,
           p1_2, W, D1, contact_scale, law_params, s0, v, N0, mu_s0, dmu_s0, tangent,
           detect_rows, threshold, det_state, M_step, delay, rate, floor, Z_out, z_out,
@@ -40,133 +91,154 @@ def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, 
     contact velocities, remainder forces and ΔM_2 of steps k0+1 … k1 into rows 0 … of the
     outputs; updates zeta, phi, z, u2_now, det_state in place.  Returns 0, or the step at
     which Newton failed (negative)."""
-    m = zeta.shape[0]
     nc = z.shape[0]
-    mu0, A, B, kA, kS, slope = law_params[0], law_params[1], law_params[2], \
-        law_params[3], law_params[4], law_params[5]
-    g = g0 * (g_step ** k0)
-    zp = np.empty(nc)
-    znew = np.empty(nc)
-    rhs = np.empty(nc)
-    J = np.empty((nc, nc))
-    r = np.empty(nc)
-    dr = np.empty(nc)
-    for k in range(k0, k1):
-        t1 = (k + 1) * h
-        # ΔM_2 at the end of the step (the detection is known up to step k)
-        reduction = 0.0  # 1 − ρ: the share of ID2's motor torque taken away at the end of the step
-        if det_state[0] >= 0.0:
-            t_act = det_state[0] + delay
-            if t1 > t_act:
-                reduction = (1.0 - floor) * min(1.0, rate * (t1 - t_act))
-        u2_next = -M_step * reduction
-        gc = g.conjugate()
-        for j in range(m):
-            acc = E[j] * zeta[j] + inc_step[j] + cp[j] * g + cm[j] * gc \
-                + p0_2[j] * u2_now + p1_2[j] * u2_next
-            for i in range(nc):
-                acc += P0[j, i] * phi[i]
-            zeta[j] = acc
-        g = g * g_step
-        for i in range(nc):
-            s = 0.0
-            for j in range(m):
-                w = W[i, j]
-                zj = zeta[j]
-                s += w.real * zj.real - w.imag * zj.imag
-            zp[i] = s
-            znew[i] = z[i]
-        # Newton on z = zp + D1 r(z)
-        it = 0
-        while True:
-            for i in range(nc):
-                if i >= n_creep:  # ID2's motor slope torque, scaled by ρ with the rest
-                    r[i] = -reduction * znew[i]
-                    dr[i] = -reduction
-                elif tangent:
-                    mu_t = mu_s0 + dmu_s0 * (znew[i] / v)
-                    r[i] = N0 * (mu_t - mu_s0) - N0 * dmu_s0 * znew[i] / v
-                    dr[i] = 0.0
-                else:
-                    mu_v, dmu_v = law(s0 + znew[i] / v, v, mu0, A, B, kA, kS, slope)
-                    r[i] = N0 * (mu_v - mu_s0) - N0 * dmu_s0 * znew[i] / v
-                    dr[i] = N0 * (dmu_v - dmu_s0) / v
-            for i in range(nc):
-                s = zp[i] - znew[i]
-                for ll in range(nc):
-                    s += D1[i, ll] * r[ll]
-                    J[i, ll] = D1[i, ll] * dr[ll]
-                J[i, i] -= 1.0
-                rhs[i] = s
-            # J dz = rhs with J = D1 diag(r') − I  (Gaussian elimination, partial pivoting)
-            for c in range(nc):
-                p = c
-                for ll in range(c + 1, nc):
-                    if abs(J[ll, c]) > abs(J[p, c]):
-                        p = ll
-                if p != c:
-                    for ll in range(nc):
-                        J[c, ll], J[p, ll] = J[p, ll], J[c, ll]
-                    rhs[c], rhs[p] = rhs[p], rhs[c]
-                for ll in range(c + 1, nc):
-                    f = J[ll, c] / J[c, c]
-                    for q in range(c, nc):
-                        J[ll, q] -= f * J[c, q]
-                    rhs[ll] -= f * rhs[c]
-            change = 0.0
-            for c in range(nc - 1, -1, -1):
-                s = rhs[c]
-                for q in range(c + 1, nc):
-                    s -= J[c, q] * rhs[q]
-                rhs[c] = s / J[c, c]
-            # J dz = R with the residual R = zp + D1 r(z) − z  →  z_new = z − dz
-            for i in range(nc):
-                znew[i] -= rhs[i]
-                change = max(change, abs(rhs[i]) / (abs(znew[i]) + contact_scale))
-            it += 1
-            if change <= 1e-12 or it >= 60:
-                break
-        if not change <= 1e-12 or not math.isfinite(change):
-            return -(k + 1)
-        iterations[0] += it
-        # final remainder at the converged z
-        for i in range(nc):
-            if i >= n_creep:
-                r[i] = -reduction * znew[i]
-            elif tangent:
-                mu_t = mu_s0 + dmu_s0 * (znew[i] / v)
-                r[i] = N0 * (mu_t - mu_s0) - N0 * dmu_s0 * znew[i] / v
-            else:
-                mu_v, dmu_v = law(s0 + znew[i] / v, v, mu0, A, B, kA, kS, slope)
-                r[i] = N0 * (mu_v - mu_s0) - N0 * dmu_s0 * znew[i] / v
-        for j in range(m):
-            acc = zeta[j]
-            for i in range(nc):
-                acc += P1[j, i] * r[i]
-            zeta[j] = acc
-        row = k - k0
-        for j in range(m):
-            Z_out[row, j] = zeta[j]
-        slip_before = 0.0
-        for i in range(nc):
-            slip_before += detect_rows[i] * z[i]
-        for i in range(nc):
-            phi[i] = r[i]
-            z[i] = znew[i]
-            z_out[row, i] = znew[i]
-            phi_out[row, i] = r[i]
-        u2_now = u2_next
-        u2_out[row] = u2_next
-        # detection on ID2's wheelset slip velocity (mean of its wheels)
-        if det_state[0] < 0.0:
-            slip = 0.0
-            for i in range(nc):
-                slip += detect_rows[i] * znew[i]
-            if abs(slip) > threshold:
-                # the crossing time interpolated within the step (a detection time on the grid
-                # would make the result only first-order accurate in h)
-                before = abs(slip_before)
-                fraction = (threshold - before) / (abs(slip) - before) if before < threshold else 0.0
-                det_state[0] = t1 - h + h * min(1.0, max(0.0, fraction))
+    Q = E[:, None] * P1 + P0
+    blocks = _Blocks(W, E, Q, D1)
+    law = tuple(float(x) for x in law_params)
+    creep = np.arange(nc) < n_creep
+    detect = np.asarray(detect_rows, dtype=float)
+    scale = float(contact_scale)
+    slope = np.zeros(nc)  # r'(z) of the given step (Newton's start of the first block)
+    if not tangent:
+        slope[creep] = N0 / v * (polach(s0 + z[creep] / v, v, *law)[1] - dmu_s0)
+    state = _LoopState(zeta.copy(), phi.copy(), z.copy(), float(u2_now), float(det_state[0]),
+                       slope)
+    row, L = 0, SUB_STEPS
+    while row < k1 - k0:
+        L = min(L, k1 - k0 - row)
+        done = _block(state, k0 + row, L, row, h, blocks, E, inc_step, cp, cm, g_step, g0, P0,
+                      P1, p0_2, p1_2, W, law, s0, v, N0, mu_s0, dmu_s0, tangent, creep, detect,
+                      threshold, M_step, delay, rate, floor, scale, Z_out, z_out, phi_out,
+                      u2_out, iterations)
+        if done == 0:
+            if L == 1:
+                return -(k0 + row + 1)
+            L = max(1, L // 2)  # not converged: a shorter block
+            continue
+        row += done
+        L = SUB_STEPS
+    zeta[:], phi[:], z[:] = state.zeta, state.phi, state.z
+    det_state[0] = state.detection
     return 0
 
+
+def _recurrence(E: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """x_i = E x_(i−1) + f_i (x_(−1) = 0) for all rows i of f at once: a doubling scan (after the
+    round with shift d, row i holds the sum over f_(i−2d+1 … i)), log2(rows) vectorised rounds
+    instead of a Python step per row."""
+    x = f.copy()
+    power, d = E.copy(), 1
+    while d < len(x):
+        x[d:] += power * x[:-d]
+        power = power * power
+        d *= 2
+    return x
+
+
+class _LoopState:
+    """What carries over from one block to the next (the last accepted step)."""
+
+    def __init__(self, zeta, phi, z, u2, detection, slope):
+        self.zeta = zeta  # modal state ζ (after the step's end input)
+        self.phi = phi  # remainders r of the step [N] / slope torque change [N m]
+        self.z = z  # channel values of the step
+        self.u2 = u2  # ΔM_2 at the step [N m]
+        self.detection = detection  # detection time [s], < 0: not yet
+        self.slope = slope  # r'(z) of the creep channels at the step [N s/m]
+
+
+def _block(state, kb, L, row0, h, blocks, E, inc_step, cp, cm, g_step, g0, P0, P1, p0_2, p1_2,
+           W, law, s0, v, N0, mu_s0, dmu_s0, tangent, creep, detect, threshold, M_step, delay,
+           rate, floor, scale, Z_out, z_out, phi_out, u2_out, iterations) -> int:
+    """Solve steps kb+1 … kb+L from ``state``; returns the number of accepted steps (0: Newton
+    did not converge) and advances ``state`` to the last of them."""
+    nc = state.z.shape[0]
+    t1 = (kb + 1 + np.arange(L)) * h  # ends of the steps
+    # ΔM_2 and the slope channel's scaling ρ at the end of each step (detection known so far)
+    reduction = np.zeros(L)
+    if state.detection >= 0.0:
+        reduction = (1.0 - floor) * np.clip(rate * (t1 - state.detection - delay), 0.0, 1.0)
+    u2 = -M_step * reduction
+    u2_before = np.concatenate([[state.u2], u2[:-1]])
+    # forced modal states without the block's remainders: b_0 = E ζ + F + P0 φ, b_(i+1) = E b_i + …
+    g = g0 * np.power(complex(g_step), np.arange(kb, kb + L))
+    forcing = (inc_step[None, :] + g[:, None] * cp[None, :] + np.conj(g)[:, None] * cm[None, :]
+               + u2_before[:, None] * p0_2[None, :] + u2[:, None] * p1_2[None, :])
+    forcing[0] += E * state.zeta + P0 @ state.phi
+    forced = _recurrence(E, forcing)
+    a = (forced @ W.T).real.reshape(-1)  # L·nc
+    T, T_newton = blocks.matrices(L)
+    is_creep = np.tile(creep, L)
+    slope_scale = -np.repeat(reduction, nc)[~is_creep]
+    dr = np.zeros(L * nc)
+    dr[~is_creep] = slope_scale
+    tangent_slope = N0 * dmu_s0 / v
+    trtrs = get_lapack_funcs("trtrs", (T_newton,))
+    # Newton's start: the block solved with the remainders linearized about the last step,
+    # r ≈ r_last + r'_last (z − z_last) (one triangular solve, no evaluation of the law)
+    dr[is_creep] = np.tile(state.slope[creep], L)
+    offset = np.tile(state.phi - state.slope * state.z, L)
+    offset[~is_creep] = 0.0
+    J = T_newton * dr[None, :]
+    J.flat[::L * nc + 1] -= 1.0
+    zf, info = trtrs(J, -(a + T @ offset), lower=1)
+    if info != 0:
+        return 0
+    r = np.empty(L * nc)
+    count = 0
+    while True:
+        zc = zf[is_creep]
+        if tangent:
+            r[is_creep] = N0 * ((mu_s0 + dmu_s0 * (zc / v)) - mu_s0) - tangent_slope * zc
+        else:
+            mu_v, dmu_v = polach(s0 + zc / v, v, *law)
+            r[is_creep] = N0 * (mu_v - mu_s0) - tangent_slope * zc
+            dr[is_creep] = N0 / v * (dmu_v - dmu_s0)
+        r[~is_creep] = slope_scale * zf[~is_creep]
+        residual = a + T @ r - zf
+        J = T_newton * dr[None, :]
+        J.flat[::L * nc + 1] -= 1.0
+        step, info = trtrs(J, residual, lower=1)
+        if info != 0:
+            return 0
+        zf = zf - step
+        r = r - dr * step  # the remainders at the new values to first order (O(step²) ≈ 1e-24)
+        count += 1
+        change = float(np.max(np.abs(step) / (np.abs(zf) + scale)))
+        if not math.isfinite(change):
+            return 0
+        if change <= TOLERANCE:
+            break
+        if count >= MAX_ITERATIONS:
+            return 0
+    zb = zf.reshape(L, nc)
+    rb = r.reshape(L, nc)
+    # detection on ID2's wheelset slip velocity (mean of its wheels); the block is cut where the
+    # torque reduction that follows from it starts
+    accepted = L
+    if state.detection < 0.0:
+        slip = zb @ detect
+        over = np.flatnonzero(np.abs(slip) > threshold)
+        if len(over):
+            i = int(over[0])
+            before = abs(float(state.z @ detect)) if i == 0 else abs(float(slip[i - 1]))
+            fraction = (threshold - before) / (abs(slip[i]) - before) if before < threshold else 0.0
+            state.detection = float(t1[i] - h + h * min(1.0, max(0.0, fraction)))
+            late = np.flatnonzero(t1[i + 1:] > state.detection + delay)
+            if len(late):
+                accepted = i + 1 + int(late[0])
+    # modal states with the remainders: ζ⁻_(i+1) = E ζ⁻_i + forcing + Q r_i, ζ_i = ζ⁻_i + P1 r_i
+    shifted = np.zeros((accepted, len(E)), dtype=complex)
+    shifted[1:] = rb[:accepted - 1] @ (E[:, None] * P1 + P0).T
+    out = Z_out[row0:row0 + accepted]
+    out[:] = forced[:accepted] + _recurrence(E, shifted) + rb[:accepted] @ P1.T
+    z_out[row0:row0 + accepted] = zb[:accepted]
+    phi_out[row0:row0 + accepted] = rb[:accepted]
+    u2_out[row0:row0 + accepted] = u2[:accepted]
+    state.zeta = out[accepted - 1].copy()
+    state.phi = rb[accepted - 1].copy()
+    state.slope = np.where(creep, dr.reshape(L, nc)[accepted - 1], 0.0)
+    state.z = zb[accepted - 1].copy()
+    state.u2 = float(u2[accepted - 1])
+    iterations[0] += count * accepted  # every accepted step took part in `count` iterations
+    return accepted

@@ -41,9 +41,11 @@ only damping (a double zero eigenvalue, a Jordan block the modal basis cannot ho
 part would need its own eigendecomposition, and the whole creep feedback would carry the hold
 error; at the tangent the linear part is exact, the remainder is O(Δs²), and ``creep="tangent"`` (μ
 replaced by its tangent in the *same* loop: the remainder evaluates to rounding) reproduces the
-closed form to rounding. The loop runs compiled (numba; per step O(modes x contacts)); the outputs
-are formed after each block of steps by one matrix product. Every step the anti-slip logic sees the
-contact velocities.
+closed form to rounding. The loop is numpy and scipy (:mod:`model._nonlinear_kernel`): the
+remainders of a block of 32 steps are solved together by Newton with a triangular Jacobian (the
+creep law on all of the block's contact values at once), the block's modal states by a vectorised
+doubling scan; the outputs are formed after each block of steps by one matrix product. Every step
+the anti-slip logic sees the contact velocities (a block is cut where a reduction starts).
 
 Anti-slip protection (:class:`AntiSlip`): detection when the slip velocity of ID2's wheelset
 (mean of its two wheels) departs from its pre-fault value by more than ``threshold``, action
@@ -153,10 +155,10 @@ class AntiSlip:
                 raise NonlinearError(f"{label} = {value} is not allowed: must be {allowed}")
 
 
-# --- compiled kernel ----------------------------------------------------------------------------------
+# --- step loop ---------------------------------------------------------------------------------------
 
 def _kernel():
-    """The compiled step loop (numba, cached on disk; imported on first use)."""
+    """The step loop (:func:`model._nonlinear_kernel.march`)."""
     from ._nonlinear_kernel import march
 
     return march

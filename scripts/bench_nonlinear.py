@@ -12,8 +12,7 @@ excitation, anti-slip off (a plain ODE for Radau), all 20 outputs.
   all post-processing of :func:`model.nonlinear.nonlinear_response`;
 * nonlinear, warm: the same with the decomposition and the set-up cached (what a second run at
   the same point, e.g. another anti-slip delay, costs);
-* first call in this process: the same as cold, plus loading the compiled loop from numba's disk
-  cache (compiled once per installation, ≈ 10 s, not counted);
+* first call in this process: the same as cold, plus the first imports of the step loop;
 * lsim: ``scipy.signal.lsim`` on the *linear* system (eq. 20) with the sampled M_C, as in
   ``bench_response.py`` — the reference the issue's target is stated against;
 * Radau: ``scipy.integrate.Radau`` on the same nonlinear system written out independently here
@@ -162,7 +161,7 @@ def main() -> None:
 
     rows = {"nonlinear, cold (eig + set-up + run + post-processing)": t_cold,
             "nonlinear, warm (cached decomposition and set-up)": t_warm,
-            "nonlinear, first call in the process (numba cache load)": t_first,
+            "nonlinear, first call in the process": t_first,
             "scipy.signal.lsim (linear system)": t_lsim}
     report = {"times": rows}
     print(f"timed: {json.dumps(rows)}", file=sys.stderr, flush=True)
