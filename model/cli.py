@@ -298,6 +298,10 @@ from .response_cli import register as _register_response  # noqa: E402
 
 EXTRA_COMMANDS.append(_register_response)
 
+from .study_cli import register as _register_study  # noqa: E402 - issue 13: bogie study
+
+EXTRA_COMMANDS.append(_register_study)
+
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits
