@@ -76,7 +76,8 @@ class StudyMapPlot:
 
     def __init__(self):
         self.figure = _figure("Stability map: largest real part [1/s]", "speed v [km/h]",
-                              "creepage s0 [-]", height=380)
+                              "creepage s0 [-]")
+        self.figure.height = 380
         self.mapper = LinearColorMapper(palette=list(reversed(RdBu11)), low=-1.0, high=1.0,
                                         nan_color="#eeeeee")
         self.image = ColumnDataSource({"image": [np.full((1, 1), np.nan)], "x": [0.0], "y": [0.0],
@@ -120,32 +121,32 @@ class StudiesView(pn.viewable.Viewer):
         self._outcome: str | None = None  # set by the thread when it ends
         self._stop = threading.Event()
         self._poller = None
-        self.s0_range = pn.widgets.RangeSlider(name="creepage s0 [-]", start=0.0005, end=0.03,
+        self.s0_range = pn.widgets.RangeSlider(label="creepage s0 [-]", start=0.0005, end=0.03,
                                                value=(0.001, 0.02), step=0.0005, format="0.0000",
                                                css_classes=["study-s0"])
-        self.s0_points = pn.widgets.IntInput(name="s0 points", value=40, start=1, end=2000,
+        self.s0_points = pn.widgets.IntInput(label="s0 points", value=40, start=1, end=2000,
                                              css_classes=["study-s0-points"], width=110)
-        self.v_range = pn.widgets.RangeSlider(name="speed v [km/h]", start=10.0, end=250.0,
+        self.v_range = pn.widgets.RangeSlider(label="speed v [km/h]", start=10.0, end=250.0,
                                               value=(40.0, 250.0), step=5.0, format="0",
                                               css_classes=["study-v"])
-        self.v_points = pn.widgets.IntInput(name="v points", value=20, start=1, end=2000,
+        self.v_points = pn.widgets.IntInput(label="v points", value=20, start=1, end=2000,
                                             css_classes=["study-v-points"], width=110)
-        self.where = pn.widgets.Select(name="run on", options=list(WHERE),
+        self.where = pn.widgets.Select(label="run on", options=list(WHERE),
                                        value=("Dask cluster at the address"
                                               if os.environ.get("DASK_SCHEDULER_ADDRESS")
                                               else "local Dask cluster"),
                                        css_classes=["study-where"], width=230)
-        self.address = pn.widgets.TextInput(name="scheduler address",
+        self.address = pn.widgets.TextInput(label="scheduler address",
                                             value=os.environ.get("DASK_SCHEDULER_ADDRESS", ""),
                                             placeholder="tcp://host:8786",
                                             css_classes=["study-address"], width=230)
-        self.start_button = pn.widgets.Button(name="Start map", button_type="primary",
+        self.start_button = pn.widgets.Button(label="Start map", color="primary",
                                               css_classes=["study-start"], width=120)
-        self.stop_button = pn.widgets.Button(name="Stop", css_classes=["study-stop"], width=80,
+        self.stop_button = pn.widgets.Button(label="Stop", css_classes=["study-stop"], width=80,
                                              disabled=True)
-        self.store_path = pn.widgets.TextInput(name="store (.zarr)", placeholder="/path/map.zarr",
+        self.store_path = pn.widgets.TextInput(label="store (.zarr)", placeholder="/path/map.zarr",
                                                css_classes=["study-store"], width=360)
-        self.open_button = pn.widgets.Button(name="Open store", css_classes=["study-open"],
+        self.open_button = pn.widgets.Button(label="Open store", css_classes=["study-open"],
                                              width=120)
         self.progress = pn.indicators.Progress(value=0, max=1, css_classes=["study-progress"],
                                                width=360, visible=False)
