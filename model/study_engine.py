@@ -28,6 +28,8 @@ from __future__ import annotations
 
 import logging
 import os
+import signal
+import threading
 from collections.abc import Callable, Iterable, Iterator
 from functools import partial
 
@@ -102,9 +104,18 @@ class StudyEngine:
                                         f"within {self.connect_timeout:g} s: {reason}") from None
             return
         os.environ.update(BLAS_ENVIRONMENT)  # inherited by the worker processes
-        self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
-                                    dashboard_address=None, silence_logs=logging.ERROR,
-                                    env=dict(BLAS_ENVIRONMENT))
+        # the worker processes inherit an ignored SIGINT: a Ctrl-C in the terminal reaches the
+        # whole process group, and only this (client) process should handle it, by closing the
+        # cluster cleanly (the workers would print KeyboardInterrupt tracebacks otherwise)
+        main = threading.current_thread() is threading.main_thread()
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+        try:
+            self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
+                                        processes=True, dashboard_address=None,
+                                        silence_logs=logging.ERROR, env=dict(BLAS_ENVIRONMENT))
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGINT, previous)
         self.client = Client(self.cluster, set_as_default=False)
 
     def close(self) -> None:

@@ -30,8 +30,9 @@ def setup():
     return parameters, build_model(parameters)
 
 
-@pytest.mark.parametrize(("v_kmh", "n0_factor", "b_M"), [(50.0, 1.0, None), (160.0, 1.0, None),
-                                                        (240.0, 0.6, 0.0)])
+@pytest.mark.parametrize(("v_kmh", "n0_factor", "b_M"), [
+    pytest.param(50.0, 1.0, None, marks=pytest.mark.slow), (160.0, 1.0, None),
+    pytest.param(240.0, 0.6, 0.0, marks=pytest.mark.slow)])
 def test_line_equals_dense_reference(setup, v_kmh, n0_factor, b_M):
     """Every point of an s0-line (largest real part, flutter pairs, divergent reals, verdict) as a
     full eigen-analysis gives it, across the stability limit; s0* as on the dense grid."""

@@ -159,3 +159,33 @@ def test_interrupt_then_resume_recomputes_nothing_finished(cluster, study_and_re
     for path, stamp in {**markers, **lines}.items():  # finished chunks were not rewritten
         assert path.stat().st_mtime_ns == stamp
     _assert_equal_to_reference(out, reference)
+
+
+def test_ctrl_c_with_the_local_cluster_stops_everything_cleanly(tmp_path):
+    """Ctrl-C in a terminal reaches the whole process group (the client and its local worker
+    processes): exit 130, one message and no traceback, no process of the group left; the
+    resume on the default local cluster finishes the rest."""
+    out = tmp_path / "c.zarr"
+    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:6", "--v", "50:240:6",
+            "--out", str(out), "--json"]
+    process = subprocess.Popen(argv, cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and process.poll() is None:
+        if (out / "chunk_done" / "zarr.json").exists() and finished_chunks(out):
+            break
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGINT)  # the group started here (a new session)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130, err
+    assert "Traceback" not in err
+    assert "continue with --resume" in err
+    time.sleep(2)
+    left = subprocess.run(["ps", "-o", "pid=", "-g", str(process.pid)], capture_output=True,
+                          text=True).stdout.split()
+    assert left == []
+    finished = len(finished_chunks(out))
+    resumed = subprocess.run([*argv, "--resume"], cwd=ROOT, env=ENV, capture_output=True,
+                             text=True, timeout=600)
+    assert resumed.returncode == 0, resumed.stderr
+    assert json.loads(resumed.stdout)["computed_chunks"] == 6 - finished
