@@ -4,12 +4,14 @@ and the stability limit s0*(v) for lists of N0 and b_M.
 The unit of work is a **line**: all creepages s0 of the map at one (v, N0, b_M).  Along a line
 only the longitudinal creep coefficient b11 = N0 μ'(s0)/v changes (b22, b23, b33 depend on v and
 N0 only), so the line reuses one reduced model (:class:`model.locus._Reduced`, the root locus's
-Galerkin projection on the exact eigenvectors of both ends) and costs two dense eigen-analyses
-plus one small eigenproblem per point.
+Galerkin projection on exact eigenvectors at a few *anchor* creepages) and costs two or three
+dense eigen-analyses plus one small eigenproblem per point.  The anchors are both ends and the
+grid creepage of the most negative b11 (the steepest falling creep slope, the most
+destabilizing point), when it lies inside the line.
 
 What a point reports is a property of **all** eigenvalues, not only of tracked branches:
 
-* The basis holds, at both ends, the exact eigenvectors of every eigenvalue inside the disc
+* The basis holds, at every anchor, the exact eigenvectors of every eigenvalue inside the disc
   |λ| < 2π·``max_frequency_hz`` and of every eigenvalue less damped than Re λ > −5 1/s
   (``SELECTION_MARGIN``) whatever its frequency (e.g. the ≈ 50 Hz longitudinal rim modes that
   the falling creep branch destabilizes).  All Ritz values of the reduced model are summarized,
@@ -20,10 +22,13 @@ What a point reports is a property of **all** eigenvalues, not only of tracked b
   first-order error from the full-model residual (as in the root locus) must be below
   ``rtol``·max(|λ|, 1 1/s), else it is refined by Newton's method on the full model; if more than
   a few need it, the point is solved densely (exact).
-* The eigenvalues outside the basis are damped by more than 5 1/s at both ends (by the
-  selection); each line records their largest real part at the ends
-  (``outside_max_real_part``).  That they stay below the top in between is an assumption,
-  checked against the dense reference point by point in the tests and ``scripts/bench_study.py``.
+* The eigenvalues outside the basis are damped by more than 5 1/s at every anchor (by the
+  selection); each line records their largest real part there (``outside_max_real_part``).
+  That they stay below the top in between is an **assumption**, not a theorem: a real part is
+  not monotone in b11 (modes interact).  With a margin of 2 1/s instead of 5 it failed (at
+  40 km/h modes damped by 2–5 1/s at the anchors turn unstable between s0 = 0.0137 and 0.0144,
+  and the flutter count came out 2 low); with 5 it holds on every line checked against the
+  dense reference point by point (the tests; ``scripts/bench_study.py --check-lines``).
 
 The reference is :func:`dense_line` (a full eigen-analysis at every point); the tests compare
 both on a grid, point by point.  Units: SI (s0 [-], v [m/s], N0 [N], b_M [N m s/rad],
@@ -94,7 +99,7 @@ class LineResult:
     s0_limit: float  # smallest s0* in [s0[0], s0[-1]] where the bogie turns unstable [-]; nan: none
     dense_points: np.ndarray  # (n,) bool: solved by a full eigen-analysis
     newton_refinements: int  # Ritz values refined by Newton's method on the full model
-    outside_max_real_part: float  # largest Re outside the basis disc at the two ends [1/s]
+    outside_max_real_part: float  # largest Re outside the basis at the anchors [1/s]
     basis_size: int  # columns of the reduction basis (0: the line was solved densely)
 
     @property
@@ -152,7 +157,7 @@ def _line_limit(model, line_model, s0_values, growth, v, N0, b_M, xtol) -> float
 class _LineModel:
     """The reduced model of one line and its error-controlled point evaluation."""
 
-    def __init__(self, model: BogieModel, v: float, N0: float, b_M: float, first, last,
+    def __init__(self, model: BogieModel, v: float, N0: float, b_M: float, anchors,
                  max_frequency_hz: float, rtol: float):
         self.model, self.v, self.N0, self.b_M, self.rtol = model, v, N0, b_M, rtol
         self.radius = 2 * np.pi * max_frequency_hz
@@ -165,11 +170,10 @@ class _LineModel:
             return [q.real, q.imag]
 
         patterns = creep_patterns(model)
-        U, sigma, _ = np.linalg.svd(np.hstack([model.rigid_body_modes, *modes(first),
-                                               *modes(last)]), full_matrices=False)
+        vectors = [model.rigid_body_modes] + [part for r in anchors for part in modes(r)]
+        U, sigma, _ = np.linalg.svd(np.hstack(vectors), full_matrices=False)
         basis = U[:, sigma > BASIS_CUTOFF * sigma[0]]
-        self.reduced = _Reduced(model, OperatingPoint(first.operating_point.s0, v, N0, b_M),
-                                patterns, [basis])
+        self.reduced = _Reduced(model, anchors[0].operating_point, patterns, [basis])
         self.newton = 0
         self.n_rigid = model.rigid_body_modes.shape[1]
         r = self.reduced.size
@@ -207,7 +211,7 @@ class _LineModel:
         # and first-order errors (from the full residual) are computed.  Beyond the controlled
         # disc a Ritz value whose estimate exceeds SPURIOUS·|λ| approximates no eigenvalue (its
         # vector is not in the basis): dropped; the eigenvalues there are the ones checked at the
-        # ends (outside_max_real_part).
+        # anchors (outside_max_real_part).
         checked = np.zeros(len(lam), dtype=bool)
         error = np.full(len(lam), np.inf)
         vectors = np.zeros((r, len(lam)), dtype=complex)  # of the checked Ritz values
@@ -259,28 +263,34 @@ def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
     (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
     [N m s/rad]; and s0* inside the line's range by Brent's method on the same evaluation.
 
-    ``max_frequency_hz``: the reduction basis holds the exact eigenvectors with |λ| < 2π·f at
-    both ends (see the module docstring for what guarantees the eigenvalues outside it).
+    ``max_frequency_hz``: the reduction basis holds the exact eigenvectors with |λ| < 2π·f (and
+    those with Re λ > −5 1/s) at the anchors (see the module docstring for what is assumed of
+    the eigenvalues outside it).
     """
     s0_values = _check_s0(s0_values)
     n = len(s0_values)
-    ends = (OperatingPoint(float(s0_values[0]), v, N0, b_M),
-            OperatingPoint(float(s0_values[-1]), v, N0, b_M))
-    first, last = (_dense_point(model, op, vectors=True) for op in ends)
+    points = [OperatingPoint(float(s), v, N0, b_M) for s in s0_values]
+    # anchors (solved densely, their eigenvectors span the basis): both ends and the creepage of
+    # the most negative b11 (the steepest falling creep slope: the most destabilizing point)
+    b11 = np.array([_coefficients(model, op)[0] for op in points])
+    anchor_index = sorted({0, int(np.argmin(b11)), n - 1})
+    anchors = {i: _dense_point(model, points[i], vectors=True) for i in anchor_index}
     radius = 2 * np.pi * max_frequency_hz
     outside = max(float(r.eigenvalues.real[~basis_modes(r.eigenvalues, radius)].max(
-        initial=-np.inf)) for r in (first, last))
+        initial=-np.inf)) for r in anchors.values())
     if n < 3:
         line = dense_line(model, s0_values, v, N0, b_M, s0_limit_xtol)
         return LineResult(**{**line.__dict__, "outside_max_real_part": outside})
-    line_model = _LineModel(model, v, N0, b_M, first, last, max_frequency_hz, rtol)
-    rows = [spectrum_summary(first.eigenvalues)]
+    line_model = _LineModel(model, v, N0, b_M, list(anchors.values()), max_frequency_hz, rtol)
+    rows = []
     dense = np.zeros(n, dtype=bool)
-    dense[[0, -1]] = True
-    for i in range(1, n - 1):
-        summary, dense[i] = line_model.point(s0_values[i])
-        rows.append(summary)
-    rows.append(spectrum_summary(last.eigenvalues))
+    for i in range(n):
+        if i in anchors:
+            rows.append(spectrum_summary(anchors[i].eigenvalues))
+            dense[i] = True
+        else:
+            summary, dense[i] = line_model.point(s0_values[i])
+            rows.append(summary)
     growth = np.array([r[0] for r in rows])
     limit = _line_limit(model, line_model, s0_values, growth, v, N0, b_M, s0_limit_xtol)
     return LineResult(s0_values, v, N0, b_M, growth, np.array([r[1] for r in rows]),

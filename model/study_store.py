@@ -55,7 +55,7 @@ DESCRIPTIONS = {
     "s0_limit": "stability limit s0*: smallest creepage where the bogie turns unstable "
                 "(nan: none in the searched range)",
     "outside_max_real_part": "largest real part of the eigenvalues outside the reduction basis "
-                             "at the two ends of the s0-line",
+                             "at the anchors of the s0-line (its ends, the steepest falling creep slope)",
     "evaluations": "eigen-analyses used by the limit search",
     "chunk_done": "1 when the chunk (s0-line or limit point) is completely written",
 }
