@@ -35,6 +35,13 @@ from functools import partial
 
 BLAS_ENVIRONMENT = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 SCHEDULER_VARIABLE = "DASK_SCHEDULER_ADDRESS"
+# Dask's nanny starts workers with MALLOC_TRIM_THRESHOLD_=65536 (to return memory to the OS).
+# Setting it disables glibc's dynamic mmap threshold, so every array above 128 KiB (the 193 x 193
+# and 384 x 384 matrices of an eigen-analysis) is mmap-ed, page-faulted and unmapped again: a
+# chunk cost 1.6-1.8x the CPU time in a worker that it costs in a plain process (measured).
+# Unset for the local cluster; for ``dask worker`` set the environment variable
+# DASK_DISTRIBUTED__NANNY__PRE_SPAWN_ENVIRON__MALLOC_TRIM_THRESHOLD_=None (docs/cluster.md).
+WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
 
 
 class EngineUnavailable(RuntimeError):
@@ -92,6 +99,7 @@ class StudyEngine:
         return f"local cluster of {self.workers} worker process(es), one thread each"
 
     def start(self) -> None:
+        import dask
         from distributed import Client, LocalCluster
 
         if self.scheduler:
@@ -110,9 +118,11 @@ class StudyEngine:
         main = threading.current_thread() is threading.main_thread()
         previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
         try:
-            self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
-                                        processes=True, dashboard_address=None,
-                                        silence_logs=logging.ERROR, env=dict(BLAS_ENVIRONMENT))
+            with dask.config.set(WORKER_CONFIG):
+                self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
+                                            processes=True, dashboard_address=None,
+                                            silence_logs=logging.ERROR,
+                                            env=dict(BLAS_ENVIRONMENT))
         finally:
             if previous is not None:
                 signal.signal(signal.SIGINT, previous)
