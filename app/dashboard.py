@@ -259,6 +259,11 @@ class BogieDashboard(pn.viewable.Viewer):
             pn.pane.SVG(schematic, width=640)
             if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*"),
             sizing_mode="stretch_width")
+        # issue 13: the "Studies" view (stability map over s0 × v) lives in app/studies_view.py
+        from .studies_view import StudiesView
+
+        self.studies = StudiesView(self)
+        self.main.extend(["### Studies: stability map over s0 × v", self.studies])
         self.layout = pn.Row(
             self._controls(), self.main, sizing_mode="stretch_width",
             stylesheets=[CSS])

@@ -306,6 +306,10 @@ from .nonlinear_cli import register as _register_antislip  # noqa: E402
 
 EXTRA_COMMANDS.append(_register_antislip)  # issue 10: bogie antislip
 
+from .study_cli import register as _register_study  # noqa: E402 - issue 13: bogie study
+
+EXTRA_COMMANDS.append(_register_study)
+
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits

@@ -8,6 +8,8 @@ single list of what the model needs; unknown or missing names are errors.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 import tomllib
 from collections.abc import Mapping
@@ -144,6 +146,16 @@ class Parameters:
         for name, value in changes.items():
             values[name] = _check_value(name, value)
         return Parameters(values, self.notes, self.source)
+
+
+def parameter_hash(parameters: Parameters) -> str:
+    """SHA-256 (hex) of the values of a parameter set: names in schema order, each value as the
+    shortest decimal that round-trips (``repr``).  Notes and the source file do not count: two
+    sets with equal values have equal hashes.  Results of studies carry it, and a stored study
+    is resumed only with the same hash."""
+    canonical = json.dumps([[name, repr(float(parameters.values[name]))] for name in SCHEMA],
+                           separators=(",", ":"))
+    return hashlib.sha256(canonical.encode("utf-8")).hexdigest()
 
 
 def _check_value(name: str, value: object) -> float:

@@ -1,0 +1,437 @@
+"""Parameter studies as pure functions (numpy/scipy only): stability maps over (s0, v, N0, b_M)
+and the stability limit s0*(v) for lists of N0 and b_M.
+
+The unit of work is a **line**: all creepages s0 of the map at one (v, N0, b_M).  Along a line
+only the longitudinal creep coefficient b11 = N0 μ'(s0)/v changes (b22, b23, b33 depend on v and
+N0 only), so the line reuses one reduced model (:class:`model.locus._Reduced`, the root locus's
+Galerkin projection on exact eigenvectors at a few *anchor* creepages) and costs two or three
+dense eigen-analyses plus one small eigenproblem per point.  The anchors are both ends and the
+grid creepage of the most negative b11 (the steepest falling creep slope, the most
+destabilizing point), when it lies inside the line.
+
+What a point reports is a property of **all** eigenvalues, not only of tracked branches:
+
+* The basis holds, at every anchor, the exact eigenvectors of every eigenvalue inside the disc
+  |λ| < 2π·``max_frequency_hz`` and of every eigenvalue less damped than Re λ > −5 1/s
+  (``SELECTION_MARGIN``) whatever its frequency (e.g. the ≈ 50 Hz longitudinal rim modes that
+  the falling creep branch destabilizes).  All Ritz values of the reduced model are summarized,
+  except the rigid-body zeros and, outside the controlled disc (1.5 × the basis disc), Ritz
+  values whose error estimate exceeds 10⁻³·|λ| (they approximate no eigenvalue).
+* Every Ritz value that can decide the result (the largest real part; any whose estimated error
+  could change the sign of its real part or lift it to the top) is error-controlled: its
+  first-order error from the full-model residual (as in the root locus) must be below
+  ``rtol``·max(|λ|, 1 1/s), else it is refined by Newton's method on the full model; if more than
+  a few need it, the point is solved densely (exact).
+* The eigenvalues outside the basis are damped by more than 5 1/s at every anchor (by the
+  selection); each line records their largest real part there (``outside_max_real_part``).
+  That they stay below the top in between is an **assumption**, not a theorem: a real part is
+  not monotone in b11 (modes interact).  With a margin of 2 1/s instead of 5 it failed (at
+  40 km/h modes damped by 2–5 1/s at the anchors turn unstable between s0 = 0.0137 and 0.0144,
+  and the flutter count came out 2 low); with 5 it holds on every line checked against the
+  dense reference point by point (the tests; ``scripts/bench_study.py --check-lines``).
+
+The reference is :func:`dense_line` (a full eigen-analysis at every point); the tests compare
+both on a grid, point by point.  Units: SI (s0 [-], v [m/s], N0 [N], b_M [N m s/rad],
+real parts [1/s]).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import threading
+from dataclasses import dataclass, field
+from functools import partial
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import brentq
+
+from .assembly import BogieModel, build_model
+from .eigen import eigen_analysis
+from .locus import _coefficients, _newton, _Reduced, creep_patterns
+from .operating_point import OperatingPoint, damping_matrix
+from .parameters import Parameters, parameter_hash
+from .stability import NoStabilityLimit, stability_limit
+
+SELECTION_MARGIN = 5.0  # modes with Re λ > −this [1/s] at an end join the basis, at any |λ|
+BAND = 1.0  # Ritz values with Re λ ≥ min(top, 0) − BAND [1/s] are checked (the others cannot
+# decide the largest real part or a sign)
+BASIS_CUTOFF = 1e-12  # singular values of the basis vectors below this (relative) are dropped;
+# 1e-8 halves the basis but loses one of the near-twin ID1/ID2 pairs near 50 Hz (flutter counts
+# off by 2 against the dense reference: measured), so the root locus's cut-off is kept
+SPURIOUS = 1e-3  # relative error estimate above which a Ritz value outside the disc is dropped
+MAX_NEWTON = 4  # more Ritz values failing the tolerance at a point: solve the point densely
+IMAG_TOL = 1e-9  # |Im λ| ≤ IMAG_TOL·|λ|: a real eigenvalue
+
+
+# --- spectral summary -----------------------------------------------------------------------------
+
+def spectrum_summary(eigenvalues: np.ndarray) -> tuple[float, int, int]:
+    """(largest real part [1/s], unstable complex pairs, positive real eigenvalues) of a set of
+    eigenvalues closed under conjugation (a pair counted once)."""
+    lam = np.asarray(eigenvalues)
+    is_real = np.abs(lam.imag) <= IMAG_TOL * np.abs(lam)
+    unstable = lam.real > 0
+    return (float(lam.real.max()), int(np.count_nonzero(unstable & ~is_real & (lam.imag > 0))),
+            int(np.count_nonzero(unstable & is_real)))
+
+
+def basis_modes(eigenvalues: np.ndarray, radius: float) -> np.ndarray:
+    """Which eigenvalues' vectors (at an end of a line) enter the reduction basis (bool): those
+    inside the disc |λ| < ``radius`` [1/s] and those less damped than ``SELECTION_MARGIN``."""
+    return (np.abs(eigenvalues) < radius) | (eigenvalues.real > -SELECTION_MARGIN)
+
+
+# --- one s0-line --------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class LineResult:
+    """The stability quantities along s0 at one (v, N0, b_M)."""
+
+    s0: np.ndarray  # (n,) creepages [-]
+    v: float  # speed [m/s]
+    N0: float  # wheel force [N]
+    b_M: float  # motor slope [N m s/rad]
+    largest_real_part: np.ndarray  # (n,) largest real part of all non-rigid eigenvalues [1/s]
+    flutter_pairs: np.ndarray  # (n,) int: complex pairs with Re > 0
+    divergent_real: np.ndarray  # (n,) int: real eigenvalues > 0
+    s0_limit: float  # smallest s0* in [s0[0], s0[-1]] where the bogie turns unstable [-]; nan: none
+    dense_points: np.ndarray  # (n,) bool: solved by a full eigen-analysis
+    newton_refinements: int  # Ritz values refined by Newton's method on the full model
+    outside_max_real_part: float  # largest Re outside the basis at the anchors [1/s]
+    basis_size: int  # columns of the reduction basis (0: the line was solved densely)
+
+    @property
+    def stable(self) -> np.ndarray:
+        """(n,) bool: all non-rigid eigenvalues in the closed left half-plane."""
+        return self.largest_real_part <= 0.0
+
+
+def _dense_point(model: BogieModel, op: OperatingPoint, vectors: bool = False):
+    return eigen_analysis(model, op, vectors=vectors)
+
+
+def dense_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
+               s0_limit_xtol: float = 1e-6) -> LineResult:
+    """The reference: a full eigen-analysis at every creepage (and the dense stability limit)."""
+    s0_values = _check_s0(s0_values)
+    rows = [spectrum_summary(_dense_point(model, OperatingPoint(float(s), v, N0, b_M)).eigenvalues)
+            for s in s0_values]
+    growth = np.array([r[0] for r in rows])
+    limit = _limit_on_grid(s0_values, growth, lambda s: _dense_point(
+        model, OperatingPoint(s, v, N0, b_M)).max_real_part, s0_limit_xtol)
+    n = len(s0_values)
+    return LineResult(s0_values, v, N0, b_M, growth, np.array([r[1] for r in rows]),
+                      np.array([r[2] for r in rows]), limit, np.ones(n, dtype=bool), 0, np.nan, 0)
+
+
+def _check_s0(s0_values) -> np.ndarray:
+    s0_values = np.asarray(s0_values, dtype=float)
+    if s0_values.ndim != 1 or len(s0_values) < 1 or not np.all(np.isfinite(s0_values)):
+        raise ValueError("s0 values must be a non-empty list of finite creepages")
+    if len(s0_values) > 1 and np.any(np.diff(s0_values) <= 0):
+        raise ValueError("s0 values must increase")
+    return s0_values
+
+
+def _limit_on_grid(s0_values, growth, function, xtol: float) -> float:
+    """s0* by Brent between the first two grid points where ``growth`` turns from ≤ 0 to > 0."""
+    unstable = np.flatnonzero(growth > 0)
+    if len(unstable) == 0 or unstable[0] == 0:
+        return float("nan")
+    i = unstable[0]
+    return float(brentq(function, s0_values[i - 1], s0_values[i], xtol=xtol, rtol=1e-12))
+
+
+def _line_limit(model, line_model, s0_values, growth, v, N0, b_M, xtol) -> float:
+    """s0* on the reduced evaluation; the dense one if the reduced evaluation at the bracket's
+    ends (solved densely on the grid) does not change sign."""
+    try:
+        return _limit_on_grid(s0_values, growth, lambda s: line_model.point(s)[0][0], xtol)
+    except ValueError:
+        return _limit_on_grid(s0_values, growth, lambda s: _dense_point(
+            model, OperatingPoint(s, v, N0, b_M)).max_real_part, xtol)
+
+
+class _LineModel:
+    """The reduced model of one line and its error-controlled point evaluation."""
+
+    def __init__(self, model: BogieModel, v: float, N0: float, b_M: float, anchors,
+                 max_frequency_hz: float, rtol: float):
+        self.model, self.v, self.N0, self.b_M, self.rtol = model, v, N0, b_M, rtol
+        self.radius = 2 * np.pi * max_frequency_hz
+        n = model.n
+        in_basis = partial(basis_modes, radius=self.radius)
+
+        def modes(result):
+            lam = result.eigenvalues
+            q = result.vectors[:n, in_basis(lam)]
+            return [q.real, q.imag]
+
+        patterns = creep_patterns(model)
+        vectors = [model.rigid_body_modes] + [part for r in anchors for part in modes(r)]
+        U, sigma, _ = np.linalg.svd(np.hstack(vectors), full_matrices=False)
+        basis = U[:, sigma > BASIS_CUTOFF * sigma[0]]
+        self.reduced = _Reduced(model, anchors[0].operating_point, patterns, [basis])
+        self.newton = 0
+        self.n_rigid = model.rigid_body_modes.shape[1]
+        r = self.reduced.size
+        self._A = np.zeros((2 * r, 2 * r))  # first-order reduced matrix; damping block per point
+        self._A[:r, r:] = np.eye(r)
+        self._A[r:, :r] = -self.reduced.K_r
+        self._start = np.random.default_rng(0).standard_normal(r)  # inverse iteration start
+        self._eye = np.eye(r)
+
+    def _ritz_vectors(self, lam: np.ndarray, C: np.ndarray) -> np.ndarray:
+        """Unit displacement vectors (Φ coordinates) of Ritz values ``lam`` of the reduced
+        quadratic problem ``(λ² I + λ C + K_r) y = 0`` by one step of inverse iteration each."""
+        red = self.reduced
+        shift = lam * (1 + 1e-13)  # never an exactly singular matrix
+        T = ((shift * shift)[:, None, None] * self._eye + shift[:, None, None] * C
+             + red.K_r)
+        X = np.linalg.solve(T, np.broadcast_to(self._start, (len(lam), len(self._start)))[..., None])
+        X = X[..., 0].T
+        X = red.Linv.T @ X
+        return X / np.linalg.norm(X, axis=0)
+
+    def point(self, s0: float) -> tuple[tuple[float, int, int], bool]:
+        """(summary, solved densely) at creepage s0."""
+        op = OperatingPoint(float(s0), self.v, self.N0, self.b_M)
+        c = _coefficients(self.model, op)
+        red, r = self.reduced, self.reduced.size
+        C = red.C0_r + sum(ck * Pk for ck, Pk in zip(c, red.P_r, strict=True))
+        self._A[r:, r:] = -C
+        lam = sla.eigvals(self._A, check_finite=False)  # eigenvalues only: no vectors
+        # the basis holds the rigid-body modes: their exact zeros (K r = 0) are the n_rigid
+        # Ritz values closest to 0 (a spin eigenvalue closer to 0 than them is 0 too)
+        lam = lam[np.argsort(np.abs(lam), kind="stable")[self.n_rigid:]]
+        lam = lam[lam.imag >= -IMAG_TOL * np.abs(lam)]  # one of each pair, and the reals
+        # Only Ritz values with Re λ ≥ min(top, 0) − BAND can decide the summary; their vectors
+        # and first-order errors (from the full residual) are computed.  Beyond the controlled
+        # disc a Ritz value whose estimate exceeds SPURIOUS·|λ| approximates no eigenvalue (its
+        # vector is not in the basis): dropped; the eigenvalues there are the ones checked at the
+        # anchors (outside_max_real_part).
+        checked = np.zeros(len(lam), dtype=bool)
+        error = np.full(len(lam), np.inf)
+        vectors = np.zeros((r, len(lam)), dtype=complex)  # of the checked Ritz values
+        while True:
+            candidates = np.flatnonzero(~checked & (lam.real >= min(lam.real.max(), 0.0) - BAND))
+            if len(candidates) == 0:
+                break
+            try:
+                X = self._ritz_vectors(lam[candidates], C)
+            except np.linalg.LinAlgError:  # a Ritz value exact to the last bit: no inverse step
+                return spectrum_summary(_dense_point(self.model, op).eigenvalues), True
+            relative = red.error_estimate(c, lam[candidates], X)
+            checked[candidates] = True
+            error[candidates] = relative * np.abs(lam[candidates])
+            vectors[:, candidates] = X
+            spurious = candidates[(np.abs(lam[candidates]) >= 1.5 * self.radius)
+                                  & (relative >= SPURIOUS)]
+            if len(spurious) == 0:
+                break
+            keep = np.setdiff1d(np.arange(len(lam)), spurious)
+            lam, checked, error, vectors = lam[keep], checked[keep], error[keep], vectors[:, keep]
+        top = int(np.argmax(lam.real))
+        # refined: the largest real part unless within rtol·max(|λ|, 1 1/s), and any Ritz value
+        # whose estimate could change the sign of its real part or lift it to the top
+        needs = ((lam.real + error > 0) & (lam.real - error <= 0)) | (
+            lam.real + error >= lam.real[top] - error[top])
+        needs[top] = error[top] > self.rtol * max(abs(lam[top]), 1.0)
+        needs &= checked & (error > self.rtol * np.maximum(np.abs(lam), 1.0))
+        failing = np.flatnonzero(needs)
+        if len(failing) > MAX_NEWTON:
+            return spectrum_summary(_dense_point(self.model, op).eigenvalues), True
+        if len(failing):
+            C_full = damping_matrix(self.model, op)
+            lam = lam.copy()
+            for b in failing:
+                value, _, step = _newton(self.model.M, C_full, self.model.K, lam[b],
+                                         red.Phi @ vectors[:, b], self.rtol)
+                if not step <= self.rtol:
+                    return spectrum_summary(_dense_point(self.model, op).eigenvalues), True
+                lam[b] = value
+            self.newton += len(failing)
+        return spectrum_summary(np.concatenate([lam, lam[lam.imag > 0].conj()])), False
+
+
+def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
+            max_frequency_hz: float = 10.0, rtol: float = 1e-6,
+            s0_limit_xtol: float = 1e-6) -> LineResult:
+    """Largest real part, flutter pairs and divergent reals at every creepage of ``s0_values``
+    (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
+    [N m s/rad]; and s0* inside the line's range by Brent's method on the same evaluation.
+
+    ``max_frequency_hz``: the reduction basis holds the exact eigenvectors with |λ| < 2π·f (and
+    those with Re λ > −5 1/s) at the anchors (see the module docstring for what is assumed of
+    the eigenvalues outside it).
+    """
+    s0_values = _check_s0(s0_values)
+    n = len(s0_values)
+    points = [OperatingPoint(float(s), v, N0, b_M) for s in s0_values]
+    # anchors (solved densely, their eigenvectors span the basis): both ends and the creepage of
+    # the most negative b11 (the steepest falling creep slope: the most destabilizing point)
+    b11 = np.array([_coefficients(model, op)[0] for op in points])
+    anchor_index = sorted({0, int(np.argmin(b11)), n - 1})
+    anchors = {i: _dense_point(model, points[i], vectors=True) for i in anchor_index}
+    radius = 2 * np.pi * max_frequency_hz
+    outside = max(float(r.eigenvalues.real[~basis_modes(r.eigenvalues, radius)].max(
+        initial=-np.inf)) for r in anchors.values())
+    if n < 3:
+        line = dense_line(model, s0_values, v, N0, b_M, s0_limit_xtol)
+        return LineResult(**{**line.__dict__, "outside_max_real_part": outside})
+    line_model = _LineModel(model, v, N0, b_M, list(anchors.values()), max_frequency_hz, rtol)
+    rows = []
+    dense = np.zeros(n, dtype=bool)
+    for i in range(n):
+        if i in anchors:
+            rows.append(spectrum_summary(anchors[i].eigenvalues))
+            dense[i] = True
+        else:
+            summary, dense[i] = line_model.point(s0_values[i])
+            rows.append(summary)
+    growth = np.array([r[0] for r in rows])
+    limit = _line_limit(model, line_model, s0_values, growth, v, N0, b_M, s0_limit_xtol)
+    return LineResult(s0_values, v, N0, b_M, growth, np.array([r[1] for r in rows]),
+                      np.array([r[2] for r in rows]), limit, dense, line_model.newton, outside,
+                      line_model.reduced.size)
+
+
+# --- studies: pure descriptions and their chunks --------------------------------------------
+
+_MODELS: dict[str, BogieModel] = {}
+_MODELS_LOCK = threading.Lock()
+
+
+def cached_model(parameters: Parameters) -> BogieModel:
+    """The assembled model of a parameter set, kept per process by the set's hash (a worker
+    process assembles it once per study, not once per chunk)."""
+    key = parameter_hash(parameters)
+    with _MODELS_LOCK:
+        if key not in _MODELS:
+            if len(_MODELS) >= 4:
+                _MODELS.pop(next(iter(_MODELS)))
+            _MODELS[key] = build_model(parameters)
+        return _MODELS[key]
+
+
+def _grid(values, label: str) -> tuple[float, ...]:
+    values = tuple(float(x) for x in np.atleast_1d(np.asarray(values, dtype=float)))
+    if not values:
+        raise ValueError(f"{label}: empty list")
+    if not all(np.isfinite(values)):
+        raise ValueError(f"{label}: values must be finite")
+    return values
+
+
+@dataclass(frozen=True)
+class MapStudy:
+    """A stability map over the grid s0 × v × N0 × b_M (SI).  A chunk is one s0-line."""
+
+    s0: tuple[float, ...]  # creepages [-], increasing
+    v: tuple[float, ...]  # speeds [m/s]
+    N0: tuple[float, ...]  # wheel forces [N]
+    b_M: tuple[float, ...]  # motor slopes [N m s/rad]
+    max_frequency_hz: float = 10.0  # reduction basis disc (see s0_line)
+    rtol: float = 1e-6  # relative accuracy of the decisive eigenvalues
+    kind: str = field(default="map", init=False)
+
+    def __post_init__(self) -> None:
+        for name in ("s0", "v", "N0", "b_M"):
+            object.__setattr__(self, name, _grid(getattr(self, name), name))
+        _check_s0(self.s0)
+        for v in self.v:
+            for n0 in self.N0:
+                for bm in self.b_M:
+                    OperatingPoint(self.s0[0], v, n0, bm)  # validates the ranges
+        OperatingPoint(self.s0[-1], self.v[0], self.N0[0], self.b_M[0])
+
+    @property
+    def shape(self) -> tuple[int, int, int, int]:
+        return len(self.s0), len(self.v), len(self.N0), len(self.b_M)
+
+    def chunks(self) -> list[tuple[int, int, int]]:
+        """Chunk keys (index of v, of N0, of b_M): one s0-line each."""
+        return [(i, j, k) for i in range(len(self.v)) for j in range(len(self.N0))
+                for k in range(len(self.b_M))]
+
+    def arguments(self) -> dict:
+        """The study's arguments (JSON-able; stored with the results, compared on resume)."""
+        return {"kind": self.kind, "s0": list(self.s0), "v": list(self.v), "N0": list(self.N0),
+                "b_M": list(self.b_M), "max_frequency_hz": self.max_frequency_hz,
+                "rtol": self.rtol}
+
+    def run_chunk(self, parameters: Parameters, key: tuple[int, int, int]) -> dict:
+        """The s0-line of chunk ``key`` as plain arrays (what the store writes)."""
+        i, j, k = key
+        line = s0_line(cached_model(parameters), self.s0, self.v[i], self.N0[j], self.b_M[k],
+                       self.max_frequency_hz, self.rtol)
+        return {"largest_real_part": line.largest_real_part, "stable": line.stable,
+                "flutter_pairs": line.flutter_pairs.astype(np.int16),
+                "divergent_real": line.divergent_real.astype(np.int16),
+                "s0_limit": line.s0_limit, "dense_points": line.dense_points,
+                "outside_max_real_part": line.outside_max_real_part}
+
+
+@dataclass(frozen=True)
+class LimitStudy:
+    """The stability limit s0*(v) for lists of N0 and b_M (SI).  A chunk is one point."""
+
+    v: tuple[float, ...]  # speeds [m/s]
+    N0: tuple[float, ...]  # wheel forces [N]
+    b_M: tuple[float, ...]  # motor slopes [N m s/rad]
+    xtol: float = 1e-7  # s0* to this absolute tolerance [-]
+    kind: str = field(default="limit", init=False)
+
+    def __post_init__(self) -> None:
+        for name in ("v", "N0", "b_M"):
+            object.__setattr__(self, name, _grid(getattr(self, name), name))
+        for v in self.v:
+            for n0 in self.N0:
+                for bm in self.b_M:
+                    OperatingPoint(1e-3, v, n0, bm)
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        return len(self.v), len(self.N0), len(self.b_M)
+
+    def chunks(self) -> list[tuple[int, int, int]]:
+        return [(i, j, k) for i in range(len(self.v)) for j in range(len(self.N0))
+                for k in range(len(self.b_M))]
+
+    def arguments(self) -> dict:
+        return {"kind": self.kind, "v": list(self.v), "N0": list(self.N0), "b_M": list(self.b_M),
+                "xtol": self.xtol}
+
+    def run_chunk(self, parameters: Parameters, key: tuple[int, int, int]) -> dict:
+        """s0* at one (v, N0, b_M) (nan when there is none in the searched range)."""
+        i, j, k = key
+        try:
+            limit = stability_limit(cached_model(parameters), self.v[i], self.N0[j], self.b_M[k],
+                                    xtol=self.xtol)
+            return {"s0_limit": limit.s0_limit, "evaluations": limit.evaluations}
+        except NoStabilityLimit:
+            return {"s0_limit": float("nan"), "evaluations": 0}
+
+
+def run_chunk(study, parameters: Parameters, key) -> dict:
+    """Module-level entry of a chunk (what an executor ships to a worker)."""
+    return study.run_chunk(parameters, key)
+
+
+def run_serial(study, parameters: Parameters) -> dict:
+    """All chunks in this process, in order: {key: chunk result} (the reference of the engine)."""
+    return {key: run_chunk(study, parameters, key) for key in study.chunks()}
+
+
+def chunk_function(study, parameters: Parameters):
+    """``key -> chunk result`` for ``map``-like executors."""
+    return partial(run_chunk, study, parameters)
+
+
+def study_fingerprint(study, parameters: Parameters) -> str:
+    """Short hash of the study's arguments and the parameter set (names a store's contents)."""
+    text = json.dumps({"arguments": study.arguments(), "parameters": parameter_hash(parameters)},
+                      sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]

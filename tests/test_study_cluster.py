@@ -1,0 +1,191 @@
+"""Studies on a real Dask cluster started by the test on 127.0.0.1 (no mocks): a ``dask
+scheduler`` and a ``dask worker`` with two worker processes of one thread each, both stopped by
+the process ids started here.
+
+* the map on the cluster equals the serial computation exactly (bitwise);
+* a worker process killed with SIGKILL mid-study: the study completes, results identical;
+* ``bogie study map`` interrupted by SIGINT (Ctrl-C) exits 130 leaving a resumable store; the
+  resume computes exactly the unfinished chunks (counted), rewrites no finished one.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from model import KMH, load_parameters
+from model.study import MapStudy, run_serial
+from model.study_engine import StudyEngine
+from model.study_store import finished_chunks, open_study, run_into_store
+
+pytestmark = pytest.mark.slow
+ROOT = Path(__file__).resolve().parent.parent
+BIN = Path(sys.executable).parent
+ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
+       "DASK_DISTRIBUTED__NANNY__PRE_SPAWN_ENVIRON__MALLOC_TRIM_THRESHOLD_": "None"}
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _stop(process: subprocess.Popen) -> None:
+    """SIGTERM to the process started here, then SIGKILL after 20 s."""
+    if process.poll() is None:
+        process.send_signal(signal.SIGTERM)
+        try:
+            process.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory):
+    """Address of a scheduler with two single-thread worker processes (127.0.0.1 only)."""
+    logs = tmp_path_factory.mktemp("dask")
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    with open(logs / "scheduler.log", "w") as scheduler_log, \
+            open(logs / "worker.log", "w") as worker_log:
+        scheduler = subprocess.Popen(
+            [str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", str(port),
+             "--no-dashboard"], cwd=ROOT, env=ENV, stdout=subprocess.DEVNULL, stderr=scheduler_log)
+        worker = subprocess.Popen(
+            [str(BIN / "dask"), "worker", address, "--nworkers", "2", "--nthreads", "1",
+             "--no-dashboard", "--host", "127.0.0.1"], cwd=ROOT, env=ENV,
+            stdout=subprocess.DEVNULL, stderr=worker_log)
+        try:
+            from distributed import Client
+
+            with Client(address, timeout=60, set_as_default=False) as client:
+                client.wait_for_workers(2, timeout=120)
+            yield address
+        finally:
+            _stop(worker)
+            _stop(scheduler)
+
+
+@pytest.fixture(scope="module")
+def study_and_reference():
+    parameters = load_parameters()
+    study = MapStudy(np.linspace(0.002, 0.016, 8), np.linspace(50, 240, 6) * KMH,
+                     [parameters["wheel_force"]], [parameters["motor_slope"]])
+    return parameters, study, run_serial(study, parameters)
+
+
+def _assert_equal_to_reference(path, reference):
+    dataset = open_study(path)
+    assert (dataset["chunk_done"].values == 1).all()
+    for (i, j, k), result in reference.items():
+        for name in ("largest_real_part", "stable", "flutter_pairs", "divergent_real"):
+            np.testing.assert_array_equal(dataset[name].values[:, i, j, k], result[name])
+        np.testing.assert_array_equal(dataset["s0_limit"].values[i, j, k], result["s0_limit"])
+
+
+def test_cluster_equals_serial(cluster, study_and_reference, tmp_path):
+    parameters, study, reference = study_and_reference
+    with StudyEngine(scheduler=cluster, connect_timeout=30) as engine:
+        run = run_into_store(study, parameters, tmp_path / "m.zarr", engine.map_unordered)
+    assert run.computed == len(reference)
+    _assert_equal_to_reference(tmp_path / "m.zarr", reference)
+
+
+def test_worker_killed_mid_study(cluster, study_and_reference, tmp_path):
+    """SIGKILL to one worker process after the first chunk arrived: Dask reschedules its task
+    on the surviving worker (the nanny restarts the dead one); nothing finished is lost and the
+    results are identical."""
+    parameters, study, reference = study_and_reference
+    killed = []
+    with StudyEngine(scheduler=cluster, connect_timeout=30) as engine:
+        pids = engine.client.run(os.getpid)
+        assert len(pids) == 2
+
+        def progress(finished, total, elapsed):
+            if finished == 1 and not killed:
+                pid = next(iter(pids.values()))
+                os.kill(pid, signal.SIGKILL)  # a worker process of the worker started above
+                killed.append(pid)
+
+        run = run_into_store(study, parameters, tmp_path / "k.zarr", engine.map_unordered,
+                             progress=progress)
+    assert killed
+    assert run.computed == len(reference)
+    _assert_equal_to_reference(tmp_path / "k.zarr", reference)
+
+
+def test_interrupt_then_resume_recomputes_nothing_finished(cluster, study_and_reference,
+                                                            tmp_path):
+    _parameters, _study, reference = study_and_reference
+    out = tmp_path / "r.zarr"
+    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:8", "--v", "50:240:6",
+            "--out", str(out), "--scheduler", cluster, "--connect-timeout", "30", "--json"]
+    process = subprocess.Popen(argv, cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and process.poll() is None:
+        if (out / "chunk_done" / "zarr.json").exists() and finished_chunks(out):
+            break
+        time.sleep(0.05)
+    process.send_signal(signal.SIGINT)  # Ctrl-C
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130, err
+    assert "continue with --resume" in err
+    assert "Traceback" not in err
+    finished = finished_chunks(out)
+    assert 1 <= len(finished) < len(reference), "interrupt came too late to test a resume"
+    markers = {p: p.stat().st_mtime_ns for p in (out / "chunk_done").rglob("*")
+               if p.is_file() and p.name != "zarr.json"}
+    lines = {p: p.stat().st_mtime_ns for p in (out / "largest_real_part").rglob("*")
+             if p.is_file() and p.name != "zarr.json"}
+
+    resumed = subprocess.run([*argv, "--resume"], cwd=ROOT, env=ENV, capture_output=True,
+                             text=True, timeout=600)
+    assert resumed.returncode == 0, resumed.stderr
+    summary = json.loads(resumed.stdout)
+    assert summary["skipped_chunks"] == len(finished)
+    assert summary["computed_chunks"] == len(reference) - len(finished)
+    for path, stamp in {**markers, **lines}.items():  # finished chunks were not rewritten
+        assert path.stat().st_mtime_ns == stamp
+    _assert_equal_to_reference(out, reference)
+
+
+def test_ctrl_c_with_the_local_cluster_stops_everything_cleanly(tmp_path):
+    """Ctrl-C in a terminal reaches the whole process group (the client and its local worker
+    processes): exit 130, one message and no traceback, no process of the group left; the
+    resume on the default local cluster finishes the rest."""
+    out = tmp_path / "c.zarr"
+    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:6", "--v", "50:240:6",
+            "--out", str(out), "--json"]
+    process = subprocess.Popen(argv, cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and process.poll() is None:
+        if (out / "chunk_done" / "zarr.json").exists() and finished_chunks(out):
+            break
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGINT)  # the group started here (a new session)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130, err
+    assert "Traceback" not in err
+    assert "continue with --resume" in err
+    time.sleep(2)
+    left = subprocess.run(["ps", "-o", "pid=", "-g", str(process.pid)], capture_output=True,
+                          text=True).stdout.split()
+    assert left == []
+    finished = len(finished_chunks(out))
+    resumed = subprocess.run([*argv, "--resume"], cwd=ROOT, env=ENV, capture_output=True,
+                             text=True, timeout=600)
+    assert resumed.returncode == 0, resumed.stderr
+    assert json.loads(resumed.stdout)["computed_chunks"] == 6 - finished
