@@ -35,6 +35,7 @@ from model import NoStabilityLimit, OperatingPointError, ParameterError
 from model.parameters import dumps_parameters
 
 from . import compute
+from .fig6 import Fig6Plot
 from .plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
 from .serve import limit_blas_threads
 
@@ -81,6 +82,12 @@ class State:
     def point(self) -> tuple:
         return (self.params_path, self.rail, self.s0, self.v, self.N0, self.b_M)
 
+    @property
+    def locus_key(self) -> tuple:
+        """What the root locus depends on: (set, rail, swept parameter, fixed value, N0, b_M)."""
+        fixed = self.v if self.locus == "s0" else self.s0
+        return (self.params_path, self.rail, self.locus, fixed, self.N0, self.b_M)
+
 
 def _ignore_outcome(future) -> None:
     """A computation whose result is no longer shown: retrieve its outcome when it ends (no
@@ -121,6 +128,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.limit: compute.LimitResult | None = None
         self._limit_for: tuple | None = None  # (rail, v, N0, b_M) of self.limit
         self.locus_result: compute.LocusResult | None = None
+        self._shown_locus: tuple | None = None  # (locus key, dense?) of the locus on screen
         self.response: compute.ResponseView | None = None
         self.error = ""  # last rejection message ("" if the current parameters are valid)
         self._dirty = False
@@ -203,6 +211,7 @@ class BogieDashboard(pn.viewable.Viewer):
     def _build(self) -> None:
         m = compute.model(self._params_path, "calibrated")
         self.locus_plot = RootLocusPlot()
+        self.fig6 = Fig6Plot()
         self.creep_plot = CreepPlot()
         self.response_plots = ResponsePlots()
         self.mode_plot = ModeShapePlot(m.positions, m.parameters["wheel_radius"])
@@ -230,28 +239,42 @@ class BogieDashboard(pn.viewable.Viewer):
             css_classes=["ctl-zoom"])
         bokeh_pane = partial(pn.pane.Bokeh, sizing_mode="stretch_width")
         schematic = ASSETS / "schematic.svg"
+        # the views below the status and the root locus, one tab each; other modules add theirs
+        # with ``self.tabs.append((title, view))``
+        self.tabs = pn.Tabs(
+            ("Short-circuit response", pn.Column(
+                pn.Row(bokeh_pane(self.creep_plot.figure), pn.Column(self.peaks, width=520),
+                       sizing_mode="stretch_width"),
+                pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[:2]),
+                       sizing_mode="stretch_width"),
+                pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[2:]),
+                       sizing_mode="stretch_width"), sizing_mode="stretch_width")),
+            ("Fig. 6: eigenvalues over the sweep", pn.Column(
+                pn.pane.Markdown("Lightly damped complex branches (ζ < 0.3 somewhere on the "
+                                 "sweep) and the real eigenvalues of the root locus above, "
+                                 "against the swept parameter; red dashed: the stability limit "
+                                 "(s0*(v) over s0, the sweep's first unstable speed over v)."),
+                pn.Row(*(bokeh_pane(f) for f in self.fig6.figures[:2]),
+                       sizing_mode="stretch_width"),
+                pn.Row(bokeh_pane(self.fig6.figures[2]), sizing_mode="stretch_width"),
+                sizing_mode="stretch_width")),
+            ("Eigenvalues and modes", pn.Column(
+                "#### Eigenvalues (layout of Table 1) and modes (layout of Table 2)",
+                pn.Row(self.eigen_table, self.mode_table, sizing_mode="stretch_width"),
+                "#### Mode shape",
+                self.mode_select,
+                pn.Row(*(bokeh_pane(f) for f in self.mode_plot.figures),
+                       sizing_mode="stretch_width"), sizing_mode="stretch_width")),
+            ("Schematic", pn.pane.SVG(schematic, width=640)
+             if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*")),
+            dynamic=False, css_classes=["views"], sizing_mode="stretch_width")
         self.main = pn.Column(
             self.notice,
             pn.Row(pn.Column(self.status, self.busy, self.details, width=330),
                    pn.Column(pn.Row(locus_choice, zoom), bokeh_pane(self.locus_plot.figure),
                              sizing_mode="stretch_width"),
                    sizing_mode="stretch_width"),
-            "### Short-circuit response",
-            pn.Row(bokeh_pane(self.creep_plot.figure), pn.Column(self.peaks, width=520),
-                   sizing_mode="stretch_width"),
-            pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[:2]),
-                   sizing_mode="stretch_width"),
-            pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[2:]),
-                   sizing_mode="stretch_width"),
-            "### Eigenvalues (layout of Table 1) and modes (layout of Table 2)",
-            pn.Row(self.eigen_table, self.mode_table, sizing_mode="stretch_width"),
-            "### Mode shape",
-            self.mode_select,
-            pn.Row(*(bokeh_pane(f) for f in self.mode_plot.figures), sizing_mode="stretch_width"),
-            "### Schematic of the bogie (names used in the tables)",
-            pn.pane.SVG(schematic, width=640)
-            if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*"),
-            sizing_mode="stretch_width")
+            self.tabs, sizing_mode="stretch_width")
         self.layout = pn.Row(
             self._controls(), self.main, sizing_mode="stretch_width",
             stylesheets=[CSS])
@@ -285,17 +308,21 @@ class BogieDashboard(pn.viewable.Viewer):
 
     @staticmethod
     def _locus(state: State):
-        fixed = state.v if state.locus == "s0" else state.s0
-        return compute.locus_result(state.params_path, state.rail, state.locus, fixed,
-                                    state.N0, state.b_M)
+        """The coarse root locus (shown first)."""
+        return compute.locus_result(*state.locus_key)
+
+    @staticmethod
+    def _dense_locus(state: State):
+        """The dense root locus (replaces the coarse one)."""
+        return compute.dense_locus_result(*state.locus_key)
 
     def compute_fast(self, state: State):
         """(point result, response result) for a state (raises a MODEL_ERRORS on rejection)."""
         return self._point(state), self._response(state)
 
     def compute_slow(self, state: State):
-        """(stability limit, root locus) for a state."""
-        return self._limit(state), self._locus(state)
+        """(stability limit, dense root locus) for a state."""
+        return self._limit(state), self._dense_locus(state)
 
     def refresh(self, slow: bool = True) -> None:
         """Compute and show everything synchronously (initial view, tests); ``slow=False``
@@ -338,29 +365,39 @@ class BogieDashboard(pn.viewable.Viewer):
             while self._dirty:
                 self._dirty = False
                 state = self.state()
-                # the root locus (≈ 0.3 s on two threads when not cached) starts at once, beside
-                # the fast stage (one thread), and is shown when both are done
-                locus_future = loop.run_in_executor(EXECUTOR, self._locus, state)
+                # the coarse root locus (≈ 0.3 s on two threads when not cached) starts at once,
+                # beside the fast stage (one thread), and is shown when both are done; then the
+                # dense one replaces it when ready.  Nothing to do if the dense locus of this
+                # (set, rail, sweep, fixed value, N0, b_M) is on screen already
+                need_locus = self._shown_locus != (state.locus_key, True)
+                locus_future = (loop.run_in_executor(EXECUTOR, self._locus, state)
+                                if need_locus else None)
                 try:
                     fast = await loop.run_in_executor(EXECUTOR, self.compute_fast, state)
                 except MODEL_ERRORS as error:
                     doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
-                    _ignore_outcome(locus_future)
+                    if locus_future is not None:
+                        _ignore_outcome(locus_future)
                     continue
                 doc.add_next_tick_callback(partial(self._locked, doc, self._apply_fast, state,
                                                    fast))
                 if self._dirty:
-                    _ignore_outcome(locus_future)  # it still fills the cache
+                    if locus_future is not None:
+                        _ignore_outcome(locus_future)  # it still fills the cache
                     continue
-                try:
-                    locus = await locus_future
-                except MODEL_ERRORS as error:
-                    doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
-                    continue
-                if self._dirty:
-                    continue
-                doc.add_next_tick_callback(partial(self._locked, doc, self._apply_locus, state,
-                                                   locus))
+                if locus_future is not None:
+                    try:
+                        locus = await locus_future
+                    except MODEL_ERRORS as error:
+                        doc.add_next_tick_callback(partial(self._locked, doc, self._reject,
+                                                           error))
+                        continue
+                    if self._dirty:
+                        continue
+                    doc.add_next_tick_callback(partial(self._locked, doc, self._apply_locus,
+                                                       state, locus))
+                    dense = loop.run_in_executor(EXECUTOR, self._dense_if_current, state)
+                    dense.add_done_callback(partial(self._dense_done, doc, state))
                 # s0*(v) (≈ 0.7 s) is not waited for: a change arriving meanwhile starts at
                 # once; the limit is shown when ready if it still belongs to the parameters
                 limit = loop.run_in_executor(EXECUTOR, self._limit_if_current, state)
@@ -382,6 +419,24 @@ class BogieDashboard(pn.viewable.Viewer):
         """s0*(v), unless superseded before it started (a speed slider dragged over ten values
         must not queue ten 0.7 s root findings in front of the next change's fast stage)."""
         return self._limit(state) if self._limit_current(state) else None
+
+    def _dense_if_current(self, state: State) -> compute.LocusResult | None:
+        """The dense root locus, unless superseded before it started."""
+        return self._dense_locus(state) if self.state().locus_key == state.locus_key else None
+
+    def _dense_done(self, doc, state: State, future) -> None:
+        if future.cancelled() or self.state().locus_key != state.locus_key:
+            return  # superseded: another sweep is shown
+        error = future.exception()
+        if error is not None:
+            if isinstance(error, MODEL_ERRORS):
+                doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+            else:
+                log.error("dense root locus failed", exc_info=error)
+            return
+        if future.result() is not None:
+            doc.add_next_tick_callback(partial(self._locked, doc, self._apply_locus, state,
+                                               future.result()))
 
     def _limit_done(self, doc, state: State, future) -> None:
         if future.cancelled() or not self._limit_current(state):
@@ -460,11 +515,16 @@ class BogieDashboard(pn.viewable.Viewer):
     def _apply_limit(self, state: State, limit: compute.LimitResult) -> None:
         self.limit, self._limit_for = limit, (state.rail, state.v, state.N0, state.b_M)
         self.creep_plot.update_limit(limit)
+        self.fig6.update_limit(limit.s0_limit)
         self._show_status()
 
     def _apply_locus(self, state: State, locus: compute.LocusResult) -> None:
+        if self.state().locus_key != state.locus_key:
+            return  # a late result of a sweep no longer shown
         self.locus_result = locus
+        self._shown_locus = (state.locus_key, locus.dense)
         self.locus_plot.update_locus(locus)
+        self.fig6.update_locus(locus)
         self.locus_plot.zoom(self.zoom == "low")
 
     def _show_status(self) -> None:

