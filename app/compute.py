@@ -22,7 +22,6 @@ from model import (
     build_model,
     creep_law,
     eigen_analysis,
-    load_parameters,
     mode_character,
 )
 from model.contact import CREEP_PRESETS
@@ -58,9 +57,12 @@ class ModelRejected(ValueError):
 
 @pn.cache(max_items=24)
 def parameters(params_path: str, rail: str):
-    """The parameter set in use: the file (``""``: calibrated default) with the rail's creep
-    law (``"calibrated"`` keeps the file's, ``"dry"``/``"wet"``: Polach's presets)."""
-    p = load_parameters(params_path or None)
+    """The parameter set in use: the file (``""``: calibrated default) or a design variant of
+    it (set key ``"FILE|name:value,…"``, :mod:`app.variants`) with the rail's creep law
+    (``"calibrated"`` keeps the set's, ``"dry"``/``"wet"``: Polach's presets)."""
+    from .variants import parameters_of_key
+
+    p = parameters_of_key(params_path)
     if rail == "calibrated":
         return p
     if rail not in CREEP_PRESETS:

@@ -21,6 +21,7 @@ import io
 import json
 import logging
 import math
+import re
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import partial
@@ -38,6 +39,7 @@ from . import compute
 from .fig6 import Fig6Plot
 from .plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
 from .serve import limit_blas_threads
+from .url_state import make_query, parse_query
 
 log = logging.getLogger(__name__)
 ASSETS = Path(__file__).resolve().parent.parent / "assets"
@@ -113,9 +115,19 @@ class BogieDashboard(pn.viewable.Viewer):
     locus = param.Selector(default="s0", objects=["s0", "v"], doc="root locus over s0 or v")
     zoom = param.Selector(default="all", objects=["all", "low"], doc="root locus view")
     mode = param.Integer(1, bounds=(1, compute.N_COMPLEX_TABLE), doc="mode shown (ν)")
+    variant = param.String("", doc="design variant: differences from the bundled set, "
+                                   "name:value,… in SI units (app.variants)")
 
-    def __init__(self, params_path: str | None = None, **params):
+    def __init__(self, params_path: str | None = None, query=None, **params):
+        """``params_path``: the bundled parameter file (None: the calibrated set); ``query``:
+        URL query arguments to restore (served: the session's, app.url_state); ``params``:
+        parameter values (they win over the query)."""
         limit_blas_threads()
+        if query is None:
+            query = _session_query()
+        values, variant, self._query_tab, query_notices = parse_query(
+            query, type(self).param, None, base=str(params_path or ""))
+        params = {**values, **({"variant": variant} if variant else {}), **params}
         super().__init__(**params)
         self._params_path = str(params_path or "")
         base = compute.parameters(self._params_path, "calibrated")
@@ -135,7 +147,10 @@ class BogieDashboard(pn.viewable.Viewer):
         self._busy = False
         self._build()
         self.param.watch(self._on_change, ["s0", "v", "N0", "b_M", "M0", "f", "D", "dt_auto",
-                                           "dt", "t_end", "rail", "locus"])
+                                           "dt", "t_end", "rail", "locus", "variant"])
+        self._restore_tab(query_notices)
+        self.param.watch(self._share, list(self.param))
+        self.tabs.param.watch(self._share, "active")
         self.param.watch(self._on_mode, ["mode"])
         self.param.watch(lambda e: self.locus_plot.zoom(e.new == "low"), ["zoom"])
         doc = pn.state.curdoc
@@ -225,6 +240,10 @@ class BogieDashboard(pn.viewable.Viewer):
                                  stylesheets=[CSS])
         self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
                                     css_classes=["model-notice"], sizing_mode="stretch_width")
+        # input that was not used (a bad link, file or value): stays until the next such notice
+        self.input_notice = pn.pane.Alert("", alert_type="warning", visible=False,
+                                          css_classes=["input-notice"],
+                                          sizing_mode="stretch_width")
         self.peaks = html_pane("")
         self.eigen_table = html_pane("")
         self.mode_table = html_pane("")
@@ -242,14 +261,14 @@ class BogieDashboard(pn.viewable.Viewer):
         # the views below the status and the root locus, one tab each; other modules add theirs
         # with ``self.tabs.append((title, view))``
         self.tabs = pn.Tabs(
-            ("Short-circuit response", pn.Column(
+            ("Response", pn.Column(
                 pn.Row(bokeh_pane(self.creep_plot.figure), pn.Column(self.peaks, width=520),
                        sizing_mode="stretch_width"),
                 pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[:2]),
                        sizing_mode="stretch_width"),
                 pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[2:]),
                        sizing_mode="stretch_width"), sizing_mode="stretch_width")),
-            ("Fig. 6: eigenvalues over the sweep", pn.Column(
+            ("Fig. 6", pn.Column(
                 pn.pane.Markdown("Lightly damped complex branches (ζ < 0.3 somewhere on the "
                                  "sweep) and the real eigenvalues of the root locus above, "
                                  "against the swept parameter; red dashed: the stability limit "
@@ -258,7 +277,7 @@ class BogieDashboard(pn.viewable.Viewer):
                        sizing_mode="stretch_width"),
                 pn.Row(bokeh_pane(self.fig6.figures[2]), sizing_mode="stretch_width"),
                 sizing_mode="stretch_width")),
-            ("Eigenvalues and modes", pn.Column(
+            ("Modes", pn.Column(
                 "#### Eigenvalues (layout of Table 1) and modes (layout of Table 2)",
                 pn.Row(self.eigen_table, self.mode_table, sizing_mode="stretch_width"),
                 "#### Mode shape",
@@ -269,7 +288,7 @@ class BogieDashboard(pn.viewable.Viewer):
              if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*")),
             dynamic=False, css_classes=["views"], sizing_mode="stretch_width")
         self.main = pn.Column(
-            self.notice,
+            self.notice, self.input_notice,
             pn.Row(pn.Column(self.status, self.busy, self.details, width=330),
                    pn.Column(pn.Row(locus_choice, zoom), bokeh_pane(self.locus_plot.figure),
                              sizing_mode="stretch_width"),
@@ -284,9 +303,49 @@ class BogieDashboard(pn.viewable.Viewer):
 
     # --- state and computations --------------------------------------------------------------
 
+    @property
+    def set_key(self) -> str:
+        """The parameter set in use for app.compute: the bundled file, or a variant of it."""
+        return f"{self._params_path}|{self.variant}" if self.variant else self._params_path
+
+    # --- shareable state (app.url_state) -------------------------------------------------------
+
+    @property
+    def tab_names(self) -> list[str]:
+        """The views' names in the URL (``tab=``): their titles in lower case, words joined
+        by '-'."""
+        return [re.sub(r"[^a-z0-9]+", "-", str(title).lower()).strip("-")
+                for title in self.tabs._names]
+
+    def share_query(self) -> str:
+        """The URL query (without '?') that restores this session's settings."""
+        return make_query(self, self.tab_names[self.tabs.active] if self.tabs.active else None)
+
+    def _restore_tab(self, notices: list[str]) -> None:
+        tab = self._query_tab
+        if tab is not None:
+            if tab in self.tab_names:
+                self.tabs.active = self.tab_names.index(tab)
+            else:
+                notices.append(f"tab = '{tab[:40]}' is not one of {', '.join(self.tab_names)}")
+        if notices:
+            self.warn("Some settings of the link were not used (defaults kept): "
+                      + "; ".join(notices))
+
+    def warn(self, text: str) -> None:
+        """Show a notice about input that was not used (the previous state is kept)."""
+        self.input_notice.object = html.escape(text)
+        self.input_notice.visible = True
+
+    def _share(self, *_events) -> None:
+        """Keep the browser's address (served) equal to the settings: a link to share."""
+        location = pn.state.location if pn.state.curdoc is not None else None
+        if location is not None and pn.state.curdoc.session_context is not None:
+            location.search = "?" + self.share_query()
+
     def state(self) -> State:
         rnd = lambda x, n=6: float(round(x, n))  # noqa: E731 - cache keys without float noise
-        return State(self._params_path, self.rail, rnd(self.s0, 7), rnd(self.v, 3),
+        return State(self.set_key, self.rail, rnd(self.s0, 7), rnd(self.v, 3),
                      rnd(self.N0, 3), rnd(self.b_M, 3), rnd(self.M0, 3), rnd(self.f, 3),
                      rnd(self.D, 5), None if self.dt_auto else rnd(self.dt, 4), rnd(self.t_end, 3),
                      self.locus)
@@ -582,6 +641,14 @@ class BogieDashboard(pn.viewable.Viewer):
                   f"operating point: s0 = {state.s0}, v = {state.v} km/h, N0 = {state.N0} kN, "
                   f"b_M = {state.b_M} N m s/rad")
         return io.StringIO(dumps_parameters(p, header))
+
+
+def _session_query() -> dict:
+    """The URL query arguments of the served session being built ({} without a server)."""
+    doc = pn.state.curdoc
+    if doc is None or doc.session_context is None:
+        return {}
+    return dict(pn.state.session_args or {})
 
 
 # --- tables ------------------------------------------------------------------------------------

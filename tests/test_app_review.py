@@ -27,7 +27,8 @@ def test_refine_grid_is_denser_where_branches_move_fast():
     lam[6:, 1] = 10.0  # one that moves only across the interval [0.5, 0.6]
     grid = compute.refine_grid(values, lam, 200)
     assert len(grid) == 200
-    assert grid[0] == values[0] and grid[-1] == values[-1]
+    assert grid[0] == values[0]
+    assert grid[-1] == values[-1]
     assert np.all(np.diff(grid) > 0)
     inside = np.sum((grid > 0.5) & (grid < 0.6))
     elsewhere = np.sum((grid > 0.1) & (grid < 0.2))
@@ -50,7 +51,9 @@ def test_a_jump_breaks_the_line():
     assert jumps.shape == (49, 1)
     assert np.flatnonzero(jumps[:, 0]).tolist() == [29]
     (re,) = compute.broken_columns(lam.real, jumps)
-    assert len(re) == 51 and np.isnan(re[30]) and np.isfinite(np.delete(re, 30)).all()
+    assert len(re) == 51
+    assert np.isnan(re[30])
+    assert np.isfinite(np.delete(re, 30)).all()
 
 
 def test_a_smooth_branch_has_no_jumps():
@@ -69,9 +72,11 @@ def test_fig6_series_splits_complex_and_real_branches():
     locus = compute.LocusResult("s0", values, lam, lam.real.max(axis=1) <= 0, True,
                                 compute.locus_jumps(values, lam))
     series = fig6_series(locus)
-    assert len(series.x) == 2 and len(series.real_x) == 2
+    assert len(series.x) == 2
+    assert len(series.real_x) == 2
     np.testing.assert_allclose(series.im_hz[0], 4.0)
-    assert np.isnan(series.im_hz[1][10:]).all() and np.isfinite(series.im_hz[1][:10]).all()
+    assert np.isnan(series.im_hz[1][10:]).all()
+    assert np.isfinite(series.im_hz[1][:10]).all()
     assert np.isnan(series.real[1][:10]).all()
     assert series.crossing == pytest.approx(0.015, abs=1e-12)  # linear branch: exact
 
@@ -86,7 +91,8 @@ def test_dense_locus_is_the_models_eigenvalues():
     key = ("", "calibrated", "s0", 120.0, 100.0, 3000.0)
     coarse = compute.locus_result(*key)
     dense = compute.dense_locus_result(*key)
-    assert dense.dense and not coarse.dense
+    assert dense.dense
+    assert not coarse.dense
     assert len(dense.values) == compute.LOCUS_DENSE_POINTS >= 200
     assert np.all(np.isin(coarse.values, dense.values))
     m = compute.model("", "calibrated")
@@ -96,3 +102,87 @@ def test_dense_locus_is_the_models_eigenvalues():
         for lam in dense.eigenvalues[i]:
             if abs(lam) < 1.5 * 2 * math.pi * compute.LOCUS_MAX_HZ:
                 assert np.min(np.abs(exact - lam)) < 1e-5 * max(abs(lam), 1.0), (i, lam)
+
+
+# --- shareable state: URL query ---------------------------------------------------------------------
+
+ISSUE_QUERY = {"s0": "0.014", "v": "200", "n0": "100000", "bm": "3000", "m0": "50000", "f": "90",
+               "decay": "0.04", "t_end": "2"}
+
+
+def _class_params():
+    from app.dashboard import BogieDashboard
+
+    return BogieDashboard.param
+
+
+def test_query_with_the_cli_names_and_units():
+    from app.url_state import parse_query
+
+    values, variant, tab, notices = parse_query(
+        {**ISSUE_QUERY, "phase": "0.002", "rail": "wet", "locus": "v", "mode": "3",
+         "tab": "fig-6", "variant": "gear_ratio:4.5"}, _class_params(), ["response", "fig-6"])
+    assert notices == []
+    assert values["s0"] == 0.014
+    assert values["v"] == 200.0
+    assert values["N0"] == pytest.approx(100.0)  # n0 [N] -> N0 [kN]
+    assert values["M0"] == pytest.approx(50.0)  # m0 [N m] -> M0 [kN m]
+    assert values["dt"] == pytest.approx(2.0)
+    assert values["dt_auto"] is False
+    assert (values["rail"], values["locus"], values["mode"], tab) == ("wet", "v", 3, "fig-6")
+    assert variant == "gear_ratio:4.5"
+
+
+@pytest.mark.parametrize(("name", "text"), [
+    ("s0", "nan"), ("s0", "inf"), ("s0", "-1"), ("v", "1e400"), ("v", "fast"), ("n0", "1e30"),
+    ("t_end", ""), ("rail", "icy"), ("locus", "<script>"), ("mode", "0"), ("mode", "2.5"),
+    ("tab", "nowhere"), ("variant", "gear_ratio:nan"), ("variant", "no_such:1"),
+    ("variant", "gear_ratio"), ("variant", "polach_kS:0.9,polach_kA:0.1"), ("s0", "1" * 500),
+    ("bogus", "1")])
+def test_bad_query_values_give_a_notice_and_the_default(name, text):
+    from app.url_state import parse_query
+
+    values, variant, tab, notices = parse_query({name: text, "f": "100"}, _class_params(),
+                                                ["response"])
+    assert len(notices) == 1
+    assert (name in notices[0] or "variant" in notices[0])
+    assert values == {"f": 100.0}  # the good value is used, the bad one left at its default
+    assert variant == ""
+    assert tab is None
+
+
+def test_variant_text_round_trips():
+    from app import variants
+
+    changes = {"gear_ratio": 4.875, "driving_shaft_stiffness": 1.25e6, "yaw_damping": 0.1 / 3}
+    text = variants.encode(changes)
+    assert text.split(",")[0].startswith("driving_shaft_stiffness:")  # sorted: canonical
+    assert variants.decode(text) == changes  # exact: shortest round-trip repr
+    key = variants.set_key("", changes)
+    assert variants.split_key(key) == ("", changes)
+    assert variants.set_key("", {}) == ""
+    base = variants.base_parameters("")
+    varied = variants.parameters_of_key(key)
+    assert variants.differences(base, varied).keys() == changes.keys()
+    assert variants.set_hash(varied) != variants.set_hash(base)
+
+
+@pytest.mark.slow
+def test_link_restores_the_state_and_the_controls():
+    from app.dashboard import BogieDashboard
+
+    query = {**ISSUE_QUERY, "rail": "dry", "tab": "fig-6", "variant": "gear_ratio:4.5"}
+    dash = BogieDashboard(query=query)
+    assert not dash.input_notice.visible
+    assert (dash.s0, dash.v, dash.N0, dash.M0, dash.rail) == (0.014, 200.0, 100.0, 50.0, "dry")
+    assert dash.sliders["v"].value == 200.0
+    assert dash.sliders["s0"].value == 0.014
+    assert dash.tab_names[dash.tabs.active] == "fig-6"
+    assert dash.set_key == "|gear_ratio:4.5"
+    assert dash.point.key[0] == dash.set_key
+    assert compute.parameters(dash.set_key, "dry")["gear_ratio"] == 4.5
+    # the link of this session restores the same settings
+    from urllib.parse import parse_qsl
+
+    again = dict(parse_qsl(dash.share_query()))
+    assert {k: again[k] for k in query} == query
