@@ -298,6 +298,10 @@ from .response_cli import register as _register_response  # noqa: E402
 
 EXTRA_COMMANDS.append(_register_response)
 
+from .compare_cli import register as _register_compare  # noqa: E402
+
+EXTRA_COMMANDS.append(_register_compare)
+
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits
