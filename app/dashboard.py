@@ -40,6 +40,7 @@ from .fig6 import Fig6Plot
 from .plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
 from .serve import limit_blas_threads
 from .url_state import make_query, parse_query
+from .variant_view import VariantView
 
 log = logging.getLogger(__name__)
 ASSETS = Path(__file__).resolve().parent.parent / "assets"
@@ -258,6 +259,7 @@ class BogieDashboard(pn.viewable.Viewer):
             css_classes=["ctl-zoom"])
         bokeh_pane = partial(pn.pane.Bokeh, sizing_mode="stretch_width")
         schematic = ASSETS / "schematic.svg"
+        self.variant_view = VariantView(self)
         # the views below the status and the root locus, one tab each; other modules add theirs
         # with ``self.tabs.append((title, view))``
         self.tabs = pn.Tabs(
@@ -284,6 +286,7 @@ class BogieDashboard(pn.viewable.Viewer):
                 self.mode_select,
                 pn.Row(*(bokeh_pane(f) for f in self.mode_plot.figures),
                        sizing_mode="stretch_width"), sizing_mode="stretch_width")),
+            ("Variant", self.variant_view),
             ("Schematic", pn.pane.SVG(schematic, width=640)
              if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*")),
             dynamic=False, css_classes=["views"], sizing_mode="stretch_width")

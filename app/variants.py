@@ -28,6 +28,9 @@ from model.parameters import (
 
 MAX_UPLOAD_BYTES = 200_000  # an uploaded TOML set larger than this is refused (a full set: ~15 kB)
 MAX_VARIANT_CHARS = 4_000  # longest variant text accepted from a URL
+REVIEW_FACTOR = 100.0  # a variant's value stays within this factor of the bundled set's value
+# (the schema's bounds only say what is physically meaningful, e.g. a gear ratio > 0; a gear
+# ratio of 1e300 passes them but breaks the numerics: a review changes a design, not its scale)
 
 # what a design review changes, by subsystem (names of model.parameters.SCHEMA)
 EDITABLE: dict[str, tuple[str, ...]] = {
@@ -64,8 +67,19 @@ def base_parameters(base: str) -> Parameters:
 
 
 def apply_variant(base: Parameters, changes: Mapping[str, float]) -> Parameters:
-    """``base`` with ``changes`` applied and the whole set validated (bounds of each value and
-    the constraints between them, as for a file); raises :class:`VariantError`."""
+    """``base`` with ``changes`` applied and the whole set validated: each value within
+    REVIEW_FACTOR of the bundled value (when that is not zero), the schema's bounds and the
+    constraints between values (as for a file); raises :class:`VariantError`."""
+    for name, value in changes.items():
+        reference = base.values.get(name)
+        if reference and isinstance(value, int | float) and math.isfinite(value) and not (
+                abs(reference) / REVIEW_FACTOR <= abs(value) <= abs(reference) * REVIEW_FACTOR
+                and value * reference > 0):
+            unit = SCHEMA[name][0]
+            raise VariantError(
+                f"parameter '{name}' = {value:g} {unit} is outside the review range "
+                f"{reference / REVIEW_FACTOR:g} … {reference * REVIEW_FACTOR:g} {unit} "
+                f"(a factor {REVIEW_FACTOR:g} around the bundled {reference:g})")
     try:
         changed = base.replace(**dict(changes))
         # the constraints between values (kS <= kA, inner < outer radius) are checked by the
@@ -73,6 +87,16 @@ def apply_variant(base: Parameters, changes: Mapping[str, float]) -> Parameters:
         return parse_parameters(_table(changed), source="variant")
     except ParameterError as error:
         raise VariantError(str(error)) from None
+
+
+def review_range(base: Parameters, name: str) -> tuple[float, float]:
+    """(lowest, highest) value of ``name`` a variant may take [SI]: within REVIEW_FACTOR of the
+    bundled value, and within the schema's bounds."""
+    low, high, _ = SCHEMA[name][2]
+    reference = base.values[name]
+    if reference > 0:
+        low, high = max(low, reference / REVIEW_FACTOR), min(high, reference * REVIEW_FACTOR)
+    return low, high
 
 
 def _table(parameters: Parameters) -> dict:

@@ -138,6 +138,7 @@ def test_query_with_the_cli_names_and_units():
     ("t_end", ""), ("rail", "icy"), ("locus", "<script>"), ("mode", "0"), ("mode", "2.5"),
     ("tab", "nowhere"), ("variant", "gear_ratio:nan"), ("variant", "no_such:1"),
     ("variant", "gear_ratio"), ("variant", "polach_kS:0.9,polach_kA:0.1"), ("s0", "1" * 500),
+    ("variant", "gear_ratio:1e300"), ("variant", "x" * 5000),
     ("bogus", "1")])
 def test_bad_query_values_give_a_notice_and_the_default(name, text):
     from app.url_state import parse_query
@@ -154,14 +155,16 @@ def test_bad_query_values_give_a_notice_and_the_default(name, text):
 def test_variant_text_round_trips():
     from app import variants
 
-    changes = {"gear_ratio": 4.875, "driving_shaft_stiffness": 1.25e6, "yaw_damping": 0.1 / 3}
+    base = variants.base_parameters("")
+    changes = {"gear_ratio": base["gear_ratio"] * 1.1,
+               "driving_shaft_stiffness": base["driving_shaft_stiffness"] * 0.7,
+               "yaw_damping": base["yaw_damping"] / 3}
     text = variants.encode(changes)
     assert text.split(",")[0].startswith("driving_shaft_stiffness:")  # sorted: canonical
     assert variants.decode(text) == changes  # exact: shortest round-trip repr
     key = variants.set_key("", changes)
     assert variants.split_key(key) == ("", changes)
     assert variants.set_key("", {}) == ""
-    base = variants.base_parameters("")
     varied = variants.parameters_of_key(key)
     assert variants.differences(base, varied).keys() == changes.keys()
     assert variants.set_hash(varied) != variants.set_hash(base)
@@ -186,3 +189,112 @@ def test_link_restores_the_state_and_the_controls():
 
     again = dict(parse_qsl(dash.share_query()))
     assert {k: again[k] for k in query} == query
+
+
+# --- design variants ---------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def dash():
+    from app.dashboard import BogieDashboard
+
+    return BogieDashboard()
+
+
+def _toml_bytes(**changes) -> bytes:
+    from model.parameters import dumps_parameters, load_parameters
+
+    return dumps_parameters(load_parameters().replace(**changes)).encode()
+
+
+@pytest.mark.slow
+def test_variant_editor_upload_and_comparison(dash):
+    from model import build_model, eigen_analysis
+
+    view = dash.variant_view
+    base_ratio = view.base["gear_ratio"]
+    view.inputs["gear_ratio"].value = base_ratio * 1.15
+    assert view.apply_inputs()
+    assert dash.variant == f"gear_ratio:{base_ratio * 1.15!r}"
+    # the dashboard shows the variant's eigenvalues (the model of the changed set)
+    varied = compute.parameters(dash.set_key, "calibrated")
+    assert varied["gear_ratio"] == base_ratio * 1.15
+    op = compute.operating_point("", "calibrated", dash.s0, dash.v, dash.N0, dash.b_M)
+    expected = eigen_analysis(build_model(varied), op).complex_pairs[0]
+    assert complex(dash.point.modes[0].eigenvalue) == pytest.approx(expected, rel=1e-9)
+    # beside the baseline: both sides computed, the changed set differs in its loads
+    base_side, variant_side = view.comparison
+    assert base_side.key == ""
+    assert variant_side.key == dash.set_key
+    assert base_side.response.peaks != variant_side.response.peaks
+    assert 'class="changed"' in view.table.object
+    assert len(view.limit_sources["variant"].data["v"]) >= 3
+    assert "gear_ratio" in view.summary.object
+    # upload: a whole set, kept as its differences from the bundled one
+    upload = _toml_bytes(silent_block_stiffness_z=view.base["silent_block_stiffness_z"] * 3)
+    view.upload.value = upload
+    assert set(view.changes) == {"silent_block_stiffness_z"}
+    assert view.inputs["gear_ratio"].value == base_ratio  # the editor follows the variant
+    # download: a valid parameter file of the variant
+    import tomllib
+
+    from model.parameters import parse_parameters
+
+    downloaded = parse_parameters(tomllib.loads(view._download().read()))
+    assert downloaded["silent_block_stiffness_z"] == view.base["silent_block_stiffness_z"] * 3
+    view.set_changes({})
+    assert dash.set_key == ""
+
+
+BAD_UPLOADS = {
+    "malformed": b"gear_ratio = { value = ",
+    "not utf-8": b"\xff\xfe\x00bad",
+    "oversized": b"#" * 300_000,
+    "nan": b"",  # filled in below: a full set with NaN
+    "wrong type": b"",
+    "unknown name": b"",
+    "missing names": b'gear_ratio = { value = 4.0, unit = "1" }\n',
+    "out of range": b"",
+}
+
+
+def _bad_upload(kind: str) -> bytes:
+    text = _toml_bytes().decode()
+    line = next(x for x in text.splitlines() if x.startswith("gear_ratio ="))
+    if kind == "nan":
+        return text.replace(line, 'gear_ratio = { value = nan, unit = "1", note = "" }').encode()
+    if kind == "wrong type":
+        return text.replace(line, 'gear_ratio = { value = "4", unit = "1", note = "" }').encode()
+    if kind == "unknown name":
+        return (text + 'warp_drive = { value = 1.0, unit = "1", note = "" }\n').encode()
+    if kind == "out of range":
+        return text.replace(line, 'gear_ratio = { value = -4.0, unit = "1", note = "" }').encode()
+    return BAD_UPLOADS[kind]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", list(BAD_UPLOADS))
+def test_bad_uploads_give_a_notice_and_change_nothing(dash, kind):
+    before = (dash.variant, dash.point, dash.s0)
+    dash.input_notice.visible = False
+    dash.variant_view.upload.value = _bad_upload(kind)
+    assert dash.input_notice.visible, kind
+    assert "not used" in dash.input_notice.object
+    assert (dash.variant, dash.point, dash.s0) == before
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), -1.0, 0.0, 1e300, None, "4"])
+def test_bad_editor_values_give_a_notice_and_change_nothing(dash, value):
+    view = dash.variant_view
+    before = (dash.variant, dash.point)
+    dash.input_notice.visible = False
+    try:
+        view.inputs["gear_ratio"].value = value
+    except ValueError:  # the widget itself refused it (a string): also nothing changed
+        assert (dash.variant, dash.point) == before
+        return
+    finally_ok = view.apply_inputs()
+    assert not finally_ok
+    assert dash.input_notice.visible
+    assert (dash.variant, dash.point) == before
+    view.inputs["gear_ratio"].value = view.base["gear_ratio"]
