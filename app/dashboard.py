@@ -210,6 +210,9 @@ class BogieDashboard(pn.viewable.Viewer):
             pn.widgets.FileDownload(callback=self._toml, filename="parameters.toml",
                                     label="parameter set (TOML)", css_classes=["dl-toml"],
                                     sizing_mode="stretch_width"),
+            pn.widgets.FileDownload(callback=self.report_html, filename="bogie-report.html",
+                                    label="report (HTML, opens offline)",
+                                    css_classes=["dl-report"], sizing_mode="stretch_width"),
         ]
         return pn.Column(
             "### Published cases (120 km/h)", *cases,
@@ -636,6 +639,15 @@ class BogieDashboard(pn.viewable.Viewer):
                           for m in p.modes],
                 "eigenvalues": [{"re": float(x.real), "im": float(x.imag)} for x in lam[order]]}
         return io.StringIO(json.dumps(data, indent=1))
+
+    def report_html(self):
+        """The self-contained HTML report of the current state (app.report)."""
+        from .report import build_report
+
+        state = self.state()
+        return io.StringIO(build_report(state.params_path, state.rail, state.s0, state.v,
+                                        state.N0, state.b_M, state.M0, state.f, state.D,
+                                        state.dt, state.t_end))
 
     def _toml(self):
         state = self.state()

@@ -302,6 +302,10 @@ from .compare_cli import register as _register_compare  # noqa: E402
 
 EXTRA_COMMANDS.append(_register_compare)
 
+from .report_cli import register as _register_report  # noqa: E402
+
+EXTRA_COMMANDS.append(_register_report)
+
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits

@@ -298,3 +298,38 @@ def test_bad_editor_values_give_a_notice_and_change_nothing(dash, value):
     assert dash.input_notice.visible
     assert (dash.variant, dash.point) == before
     view.inputs["gear_ratio"].value = view.base["gear_ratio"]
+
+
+# --- report ----------------------------------------------------------------------------------------
+
+def _assert_self_contained(text: str) -> None:
+    import re
+
+    assert re.search(r"<script[^>]*\bsrc=", text) is None
+    assert re.search(r"<link\b", text) is None
+    assert re.search(r"<img[^>]*\bsrc=[\"']?https?:", text) is None
+    assert "Bokeh" in text  # BokehJS itself is inline
+
+
+@pytest.mark.slow
+def test_report_of_a_variant_is_self_contained_and_complete():
+    from app.report import build_report
+    from app.variants import parameters_of_key, set_hash
+
+    base = compute.parameters("", "calibrated")
+    key = f"|gear_ratio:{base['gear_ratio'] * 1.1!r}"
+    text = build_report(key, "calibrated", 0.014, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None,
+                        0.5)
+    _assert_self_contained(text)
+    point = compute.point_result(key, "calibrated", 0.014, 120.0, 100.0, 3000.0)
+    verdict = "STABLE" if point.stable else "UNSTABLE"
+    assert f'">{verdict}</span>' in text
+    assert set_hash(parameters_of_key(key)) in text
+    assert "gear_ratio" in text  # the difference from the baseline
+    # Table 1 layout ("Eigenvalues at"), Table 2 layout ("Mode shapes"), code version and date
+    for heading in ("Operating point", "Root locus", "Fig. 6", "Eigenvalues at", "Mode shapes",
+                    "Peaks", "code 0.", " UTC", "Differences from the baseline"):
+        assert heading in text, heading
+    for name in ("root-locus", "fig6-im", "fig6-re", "fig6-real"):
+        assert f'"{name}"' in text, name  # the figures, by name, in the embedded document
+    assert f"{point.max_real_part:+.4f}" in text

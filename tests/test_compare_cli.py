@@ -82,3 +82,32 @@ def test_bad_input_is_one_line_and_exit_2(args, capsys):
     assert code == 2
     assert len(err.strip().splitlines()) == 1
     assert "Traceback" not in err
+
+
+@pytest.mark.slow
+def test_report_command_writes_a_self_contained_file(tmp_path, capsys):
+    from test_app_review import _assert_self_contained
+
+    out = tmp_path / "report.html"
+    code, stdout, err = run(["report", "--s0", "0.005", "--v", "120", "--t-end", "0.3",
+                             "--variant", "yaw_damping:1e5", "--out", str(out)], capsys)
+    assert code == 0, err
+    text = out.read_text()
+    _assert_self_contained(text)
+    assert "yaw_damping" in text
+    assert str(out) in stdout
+
+
+@pytest.mark.parametrize("args", [
+    ["report", "--s0", "0.005", "--out", "/no/such/dir/r.html"],
+    ["report", "--s0", "0.005", "--out", "r.txt"],
+    ["report", "--s0", "0.005", "--variant", "gear_ratio:nan", "--out", "r.html"],
+    ["report", "--s0", "0.005", "--variant", "gear_ratio:1e300", "--out", "r.html"],
+    ["report", "--s0", "0.005", "--f", "1e9", "--out", "r.html"],
+])
+def test_report_bad_input_is_one_line_and_exit_2(args, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, _out, err = run(args, capsys)
+    assert code == 2, err
+    assert len(err.strip().splitlines()) == 1
+    assert not list(tmp_path.iterdir())  # nothing written
