@@ -93,6 +93,8 @@ class Mode:
     damping_ratio: float  # −Re λ / |λ| [-]
     description: str  # generated from energy shares (model.modes)
     displacement: dict[str, np.ndarray]  # drawn point -> real translation (x, y, z), unit max
+    kinetic: dict[str, float] = field(default_factory=dict)  # component -> kinetic-energy share
+    strain: dict[str, float] = field(default_factory=dict)  # element group -> strain-energy share
 
 
 @dataclass(frozen=True)
@@ -184,7 +186,8 @@ def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: fl
         lam = complex(result.eigenvalues[i])
         modes.append(Mode(number, lam, lam.imag / (2 * math.pi), character.damping_ratio,
                           character.description,
-                          point_displacements(m, result.mode_shape(int(i)))))
+                          point_displacements(m, result.mode_shape(int(i))),
+                          dict(character.kinetic), dict(character.strain)))
     law = creep_law(m.parameters, op.N0)
     s_max, mu_max = law.maximum(op.v)
     s_grid = np.linspace(0.0, max(0.03, 1.5 * op.s0), 301)
@@ -195,6 +198,24 @@ def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: fl
         real=result.real[:N_REAL_TABLE], creep_s=s_grid, creep_mu=np.asarray(law.mu(s_grid, op.v)),
         mu0=float(law.mu(op.s0, op.v)), s_max=s_max, mu_max=mu_max,
         M_ad=adhesion_moment(m.parameters, op.v, op.N0))
+
+
+@pn.cache(max_items=64)
+def mode_near(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
+              re: float, im: float) -> Mode:
+    """The mode whose eigenvalue is nearest to re + i·im [1/s] at an operating point (a tapped
+    root-locus point): shape, description and energy shares; ``number`` is its rank among the
+    complex pairs by frequency (0 for a real eigenvalue)."""
+    m = model(params_path, rail)
+    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
+    result = eigen_analysis(m, op)
+    index = int(np.argmin(np.abs(result.eigenvalues - complex(re, im))))
+    character = mode_character(m, result, index)
+    lam = complex(result.eigenvalues[index])
+    ranks = {int(i): k for k, i in enumerate(result.complex_index, start=1)}
+    return Mode(ranks.get(index, 0), lam, lam.imag / (2 * math.pi), character.damping_ratio,
+                character.description, point_displacements(m, result.mode_shape(index)),
+                dict(character.kinetic), dict(character.strain))
 
 
 # --- stability limit ---------------------------------------------------------------------------

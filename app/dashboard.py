@@ -37,6 +37,7 @@ from model.parameters import dumps_parameters
 
 from . import compute
 from .fig6 import Fig6Plot
+from .modes_view import ModeClickThrough
 from .plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
 from .serve import limit_blas_threads
 from .url_state import make_query, parse_query
@@ -250,7 +251,6 @@ class BogieDashboard(pn.viewable.Viewer):
                                           sizing_mode="stretch_width")
         self.peaks = html_pane("")
         self.eigen_table = html_pane("")
-        self.mode_table = html_pane("")
         self.mode_select = pn.widgets.Select(label="mode ν", options={}, width=420,
                                              css_classes=["ctl-mode"])
         self.mode_select.link(self, value="mode")
@@ -263,6 +263,7 @@ class BogieDashboard(pn.viewable.Viewer):
         bokeh_pane = partial(pn.pane.Bokeh, sizing_mode="stretch_width")
         schematic = ASSETS / "schematic.svg"
         self.variant_view = VariantView(self)
+        self.click = ModeClickThrough(self)  # tapped locus points and table rows -> mode views
         # the views below the status and the root locus, one tab each; other modules add theirs
         # with ``self.tabs.append((title, view))``
         self.tabs = pn.Tabs(
@@ -284,9 +285,14 @@ class BogieDashboard(pn.viewable.Viewer):
                 sizing_mode="stretch_width")),
             ("Modes", pn.Column(
                 "#### Eigenvalues (layout of Table 1) and modes (layout of Table 2)",
-                pn.Row(self.eigen_table, self.mode_table, sizing_mode="stretch_width"),
+                pn.Row(pn.Column(self.eigen_table, width=420),
+                       pn.Column("**Modes** (dominant motion from kinetic/strain energy "
+                                 "shares; click a row, or a point of the root locus)",
+                                 bokeh_pane(self.click.table.table),
+                                 sizing_mode="stretch_width"),
+                       sizing_mode="stretch_width"),
                 "#### Mode shape",
-                self.mode_select,
+                self.mode_select, self.click.detail,
                 pn.Row(*(bokeh_pane(f) for f in self.mode_plot.figures),
                        sizing_mode="stretch_width"), sizing_mode="stretch_width")),
             ("Variant", self.variant_view),
@@ -552,6 +558,8 @@ class BogieDashboard(pn.viewable.Viewer):
     def _on_mode(self, *_events) -> None:
         if self.point is not None and 1 <= self.mode <= len(self.point.modes):
             self.mode_plot.update(self.point.modes[self.mode - 1].displacement)
+            self.mode_select.value = self.mode
+            self.click.show_point_mode()
 
     # --- showing results -----------------------------------------------------------------------
 
@@ -564,7 +572,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.response_plots.update(response)
         self._show_status()
         self.eigen_table.object = eigen_table_html(point)
-        self.mode_table.object = mode_table_html(point)
+        self.click.table.update(point)
         self.peaks.object = peaks_html(response)
         self.mode_select.options = {f"ν = {m.number}: {m.im_hz:.3f} Hz — {m.description}"[:90]:
                                     m.number for m in point.modes}

@@ -333,3 +333,48 @@ def test_report_of_a_variant_is_self_contained_and_complete():
     for name in ("root-locus", "fig6-im", "fig6-re", "fig6-real"):
         assert f'"{name}"' in text, name  # the figures, by name, in the embedded document
     assert f"{point.max_real_part:+.4f}" in text
+
+
+# --- click-through modes -------------------------------------------------------------------------
+
+@pytest.mark.slow
+def test_clicking_a_table_row_or_a_diamond_shows_that_mode(dash):
+    from model import build_model, eigen_analysis
+    from model.modes import mode_character
+
+    dash.param.update(s0=0.005, v=120.0)
+    click = dash.click
+    click.table.source.selected.indices = [3]  # a click on the fourth row
+    assert dash.mode == 4
+    mode = dash.point.modes[3]
+    assert mode.description in click.detail.object
+    assert "ν = 4" in click.detail.object
+    # the energy shares are the model's (model.modes) for that mode
+    m = build_model(compute.parameters("", "calibrated"))
+    result = eigen_analysis(m, compute.operating_point("", "calibrated", 0.005, 120.0, dash.N0,
+                                                       dash.b_M))
+    character = mode_character(m, result, int(result.complex_index[3]))
+    top = max(character.kinetic, key=character.kinetic.get)
+    assert mode.kinetic[top] == pytest.approx(character.kinetic[top], rel=1e-9)
+    assert f"{character.kinetic[top]:.1%}" in click.detail.object
+    # the shape views show that mode
+    moved = dash.mode_plot.views["side"][3].data["x"]
+    dash.locus_plot.current.selected.indices = [0]  # a tap on the first diamond
+    assert dash.mode == 1
+    assert dash.mode_plot.views["side"][3].data["x"] != moved
+    assert dash.point.modes[0].description in click.detail.object
+
+
+@pytest.mark.slow
+def test_tapping_a_sweep_point_shows_the_mode_there(dash):
+    dash.param.update(s0=0.005, v=120.0, locus="s0")
+    data = dash.locus_plot.points.data
+    index = int(np.argmin(np.abs(np.asarray(data["s0"]) - 0.012)
+                          + 1e3 * (np.asarray(data["y"]) < 0.5)))  # a complex point near 0.012
+    dash.locus_plot.points.selected.indices = [index]
+    shown = dash.click.shown
+    # the mode shown is the model's eigenvalue nearest to the tapped one at that s0
+    tapped = data["x"][index] + 1j * data["y"][index] * 2 * math.pi
+    assert abs(shown.eigenvalue - tapped) < 1e-4 * abs(tapped)
+    assert f"s0 = {data['s0'][index]:.5g}" in dash.click.detail.object
+    assert shown.description in dash.click.detail.object
