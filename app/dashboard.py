@@ -288,7 +288,7 @@ class BogieDashboard(pn.viewable.Viewer):
                 pn.Row(pn.Column(self.eigen_table, width=420),
                        pn.Column("**Modes** (dominant motion from kinetic/strain energy "
                                  "shares; click a row, or a point of the root locus)",
-                                 bokeh_pane(self.click.table.table),
+                                 self.click.table.table,
                                  sizing_mode="stretch_width"),
                        sizing_mode="stretch_width"),
                 "#### Mode shape",

@@ -63,7 +63,7 @@ def fig6_series(locus: LocusResult) -> Fig6Series:
         fraction = -growth[i] / (growth[i + 1] - growth[i])
         crossing = float(locus.values[i] + fraction * (locus.values[i + 1] - locus.values[i]))
     return Fig6Series(locus.parameter, x_c,
-                      pick(complex_branches, lam.imag / (2 * math.pi), ~is_real),
+                      pick(complex_branches, np.abs(lam.imag) / (2 * math.pi), ~is_real),
                       pick(complex_branches, lam.real, ~is_real), x_r,
                       pick(real_branches, lam.real, is_real), crossing)
 

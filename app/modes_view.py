@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import html
 import math
+from typing import ClassVar
 
 import panel as pn
-from bokeh.models import ColumnDataSource, DataTable, HTMLTemplateFormatter, TableColumn
 
 from model.modes import COMPONENT_LABELS, STRAIN_LABELS
 
@@ -51,31 +51,40 @@ def mode_detail_html(mode: compute.Mode, where: str) -> str:
 
 
 class ModeTable:
-    """The modes of the current point in the layout of Table 2 as a Bokeh table whose rows can
-    be clicked (source name ``mode-table``)."""
+    """The modes of the current point in the layout of Table 2 as a table whose rows can be
+    clicked (a Panel Tabulator, CSS class ``mode-table``; Bokeh's own DataTable failed to lay
+    out inside a hidden tab: "Cannot read properties of undefined (reading 'resizeCanvas')")."""
+
+    COLUMNS: ClassVar[dict[str, str]] = {
+        "nu": "ν", "im_hz": "Im λ [Hz]", "re": "Re λ [1/s]", "zeta": "ζ [-]",
+        "description": "dominant motion (click a row)"}
 
     def __init__(self):
-        self.source = ColumnDataSource({"nu": [], "im_hz": [], "re": [], "zeta": [],
-                                        "description": []}, name="mode-table")
-        red = HTMLTemplateFormatter(template='<span style="<%= re > 0 ? \'color:#c0392b;'
-                                             'font-weight:700\' : \'\' %>"><%= value %></span>')
-        self.table = DataTable(source=self.source, columns=[
-            TableColumn(field="nu", title="ν", width=30),
-            TableColumn(field="im_hz", title="Im λ [Hz]", width=80),
-            TableColumn(field="re", title="Re λ [1/s]", width=80, formatter=red),
-            TableColumn(field="zeta", title="ζ [-]", width=70),
-            TableColumn(field="description", title="dominant motion (click a row)", width=560),
-        ], height=290, sizing_mode="stretch_width", index_position=None,
-            selectable=True, name="mode-table-view")
+        self.table = pn.widgets.Tabulator(
+            self._frame([]), titles=self.COLUMNS, show_index=False, disabled=True,
+            selectable=1, layout="fit_data_stretch", sizing_mode="stretch_width", height=300,
+            css_classes=["mode-table"],
+            formatters={"im_hz": {"type": "money", "precision": 3, "thousand": ""},
+                        "re": {"type": "money", "precision": 4, "thousand": ""},
+                        "zeta": {"type": "money", "precision": 4, "thousand": ""}})
+
+    @staticmethod
+    def _frame(modes):
+        import pandas as pd
+
+        return pd.DataFrame({"nu": [m.number for m in modes],
+                             "im_hz": [m.im_hz for m in modes],
+                             "re": [m.eigenvalue.real for m in modes],
+                             "zeta": [m.damping_ratio for m in modes],
+                             "description": [m.description for m in modes]})
+
+    @property
+    def descriptions(self) -> list[str]:
+        return list(self.table.value["description"])
 
     def update(self, point: compute.PointResult) -> None:
-        self.source.selected.indices = []
-        self.source.data = {
-            "nu": [m.number for m in point.modes],
-            "im_hz": [f"{m.im_hz:.3f}" for m in point.modes],
-            "re": [round(m.eigenvalue.real, 4) for m in point.modes],
-            "zeta": [f"{m.damping_ratio:+.4f}" for m in point.modes],
-            "description": [m.description for m in point.modes]}
+        self.table.selection = []
+        self.table.value = self._frame(point.modes)
 
 
 class ModeClickThrough:
@@ -89,15 +98,15 @@ class ModeClickThrough:
         plot = dashboard.locus_plot
         plot.current.selected.on_change("indices", self._on_current)
         plot.points.selected.on_change("indices", self._on_sweep)
-        self.table.source.selected.on_change("indices", self._on_row)
+        self.table.table.param.watch(self._on_row, "selection")
 
     def _on_current(self, _attr, _old, new) -> None:
         if new:
             self.select(int(new[0]) + 1)
 
-    def _on_row(self, _attr, _old, new) -> None:
-        if new:
-            self.select(int(new[0]) + 1)
+    def _on_row(self, event) -> None:
+        if event.new:
+            self.select(int(event.new[0]) + 1)
 
     def select(self, number: int) -> None:
         """Show mode ν = ``number`` of the current operating point."""

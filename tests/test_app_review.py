@@ -344,7 +344,7 @@ def test_clicking_a_table_row_or_a_diamond_shows_that_mode(dash):
 
     dash.param.update(s0=0.005, v=120.0)
     click = dash.click
-    click.table.source.selected.indices = [3]  # a click on the fourth row
+    click.table.table.selection = [3]  # a click on the fourth row
     assert dash.mode == 4
     mode = dash.point.modes[3]
     assert mode.description in click.detail.object
