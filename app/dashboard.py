@@ -523,6 +523,16 @@ class BogieDashboard(pn.viewable.Viewer):
             doc.add_next_tick_callback(partial(self._locked, doc, self._apply_limit, state,
                                                future.result()))
 
+    def run_locked(self, function, *args) -> None:
+        """Run ``function(*args)`` with the session's document lock: served, on the next tick
+        (a Panel widget callback may run without the lock; changing Bokeh models there raised
+        "_pending_writes should be non-None"); otherwise at once."""
+        doc = pn.state.curdoc
+        if doc is None or doc.session_context is None:
+            function(*args)
+        else:
+            doc.add_next_tick_callback(partial(self._locked, doc, function, *args))
+
     @staticmethod
     def _locked(doc, function, *args) -> None:
         from panel.io.state import set_curdoc

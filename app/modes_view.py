@@ -102,11 +102,11 @@ class ModeClickThrough:
 
     def _on_current(self, _attr, _old, new) -> None:
         if new:
-            self.select(int(new[0]) + 1)
+            self.dashboard.run_locked(self.select, int(new[0]) + 1)
 
     def _on_row(self, event) -> None:
         if event.new:
-            self.select(int(event.new[0]) + 1)
+            self.dashboard.run_locked(self.select, int(event.new[0]) + 1)
 
     def select(self, number: int) -> None:
         """Show mode ν = ``number`` of the current operating point."""
@@ -128,7 +128,7 @@ class ModeClickThrough:
 
     def _on_sweep(self, _attr, _old, new) -> None:
         if new:
-            self.select_sweep_point(int(new[0]))
+            self.dashboard.run_locked(self.select_sweep_point, int(new[0]))
 
     def select_sweep_point(self, index: int) -> None:
         """Show the mode of the root-locus point ``index`` (of the points source): the mode
