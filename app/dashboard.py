@@ -153,6 +153,8 @@ class BogieDashboard(pn.viewable.Viewer):
         self._restore_tab(query_notices)
         self.param.watch(self._share, list(self.param))
         self.tabs.param.watch(self._share, "active")
+        self.tabs.param.watch(self._tab_shown, "active")
+        self._tab_shown()
         self.param.watch(self._on_mode, ["mode"])
         self.param.watch(lambda e: self.locus_plot.zoom(e.new == "low"), ["zoom"])
         doc = pn.state.curdoc
@@ -170,9 +172,18 @@ class BogieDashboard(pn.viewable.Viewer):
         widget = pn.widgets.FloatSlider(label=label, start=p.bounds[0], end=p.bounds[1],
                                         step=step, value=getattr(self, name), format=fmt,
                                         css_classes=[f"ctl-{name}"], sizing_mode="stretch_width")
-        widget.param.watch(lambda event: setattr(self, name, event.new), "value_throttled")
+        widget.param.watch(partial(self._set_control, name), "value_throttled")
         self.param.watch(lambda event: setattr(widget, "value", event.new), name)
         return widget
+
+    def _set_control(self, name: str, event) -> None:
+        """A slider's released value into the parameter; a value the parameter refuses (out
+        of its bounds, NaN, not a number: only a doctored client sends one) gives a notice and
+        changes nothing."""
+        try:
+            setattr(self, name, event.new)
+        except (ValueError, TypeError) as error:
+            self.warn(f"{name}: value {str(event.new)[:40]} not used: {str(error)[:200]}")
 
     def _controls(self):
         sliders = {
@@ -344,6 +355,10 @@ class BogieDashboard(pn.viewable.Viewer):
             self.warn("Some settings of the link were not used (defaults kept): "
                       + "; ".join(notices))
 
+    def _tab_shown(self, *_events) -> None:
+        """Views that compute only while shown (the variant comparison) learn it here."""
+        self.variant_view.on_shown(self.tab_names[self.tabs.active] == "variant")
+
     def warn(self, text: str) -> None:
         """Show a notice about input that was not used (the previous state is kept)."""
         self.input_notice.object = html.escape(text)
@@ -446,12 +461,12 @@ class BogieDashboard(pn.viewable.Viewer):
                 try:
                     fast = await loop.run_in_executor(EXECUTOR, self.compute_fast, state)
                 except MODEL_ERRORS as error:
-                    doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+                    self._post(doc, self._reject, error)
                     if locus_future is not None:
                         _ignore_outcome(locus_future)
                     continue
-                doc.add_next_tick_callback(partial(self._locked, doc, self._apply_fast, state,
-                                                   fast))
+                self._post(doc, self._apply_fast, state,
+                                                   fast)
                 if self._dirty:
                     if locus_future is not None:
                         _ignore_outcome(locus_future)  # it still fills the cache
@@ -460,13 +475,13 @@ class BogieDashboard(pn.viewable.Viewer):
                     try:
                         locus = await locus_future
                     except MODEL_ERRORS as error:
-                        doc.add_next_tick_callback(partial(self._locked, doc, self._reject,
-                                                           error))
+                        self._post(doc, self._reject,
+                                                           error)
                         continue
                     if self._dirty:
                         continue
-                    doc.add_next_tick_callback(partial(self._locked, doc, self._apply_locus,
-                                                       state, locus))
+                    self._post(doc, self._apply_locus,
+                                                       state, locus)
                     dense = loop.run_in_executor(EXECUTOR, self._dense_if_current, state)
                     dense.add_done_callback(partial(self._dense_done, doc, state))
                 # s0*(v) (≈ 0.7 s) is not waited for: a change arriving meanwhile starts at
@@ -475,10 +490,10 @@ class BogieDashboard(pn.viewable.Viewer):
                 limit.add_done_callback(partial(self._limit_done, doc, state))
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")
-            doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+            self._post(doc, self._reject, error)
         finally:
             self._busy = False
-            doc.add_next_tick_callback(partial(self._locked, doc, self._done))
+            self._post(doc, self._done)
 
     def _limit_current(self, state: State) -> bool:
         """Whether s0*(v) for ``state`` is still the one to show (same v, N0, b_M, rail)."""
@@ -501,13 +516,13 @@ class BogieDashboard(pn.viewable.Viewer):
         error = future.exception()
         if error is not None:
             if isinstance(error, MODEL_ERRORS):
-                doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+                self._post(doc, self._reject, error)
             else:
                 log.error("dense root locus failed", exc_info=error)
             return
         if future.result() is not None:
-            doc.add_next_tick_callback(partial(self._locked, doc, self._apply_locus, state,
-                                               future.result()))
+            self._post(doc, self._apply_locus, state,
+                                               future.result())
 
     def _limit_done(self, doc, state: State, future) -> None:
         if future.cancelled() or not self._limit_current(state):
@@ -515,13 +530,13 @@ class BogieDashboard(pn.viewable.Viewer):
         error = future.exception()
         if error is not None:
             if isinstance(error, MODEL_ERRORS):
-                doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+                self._post(doc, self._reject, error)
             else:
                 log.error("stability limit failed", exc_info=error)
             return
         if future.result() is not None:
-            doc.add_next_tick_callback(partial(self._locked, doc, self._apply_limit, state,
-                                               future.result()))
+            self._post(doc, self._apply_limit, state,
+                                               future.result())
 
     def run_locked(self, function, *args) -> None:
         """Run ``function(*args)`` with the session's document lock: served, on the next tick
@@ -531,7 +546,18 @@ class BogieDashboard(pn.viewable.Viewer):
         if doc is None or doc.session_context is None:
             function(*args)
         else:
+            self._post(doc, function, *args)
+
+    def _post(self, doc, function, *args) -> None:
+        """``function(*args)`` on the session's next tick, with its document lock; nothing if the
+        session has ended meanwhile (a closed browser tab: its document is destroyed, and
+        Bokeh raised AttributeError on scheduling into it)."""
+        if doc.session_context is None or getattr(doc.session_context, "destroyed", False):
+            return
+        try:
             doc.add_next_tick_callback(partial(self._locked, doc, function, *args))
+        except (AttributeError, RuntimeError):
+            log.debug("session ended: result not shown")
 
     @staticmethod
     def _locked(doc, function, *args) -> None:

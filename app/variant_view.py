@@ -164,6 +164,10 @@ class VariantView(pn.viewable.Viewer):
             self.limit_sources[label] = source
         self.limits_figure.legend.location = "top_left"
         self.comparison: tuple[Side, Side] | None = None
+        # the comparison (s0*(v) at five speeds for both sets: seconds) is computed when the
+        # view is shown or asked for, not for every session opened with a variant in its link
+        self.shown = False
+        self._stale = False
         self._layout = pn.Row(
             pn.Column("#### Parameters of the variant (SI units)", *cards,
                       pn.Row(apply, reset),
@@ -248,7 +252,12 @@ class VariantView(pn.viewable.Viewer):
             + (f"<ul style='font-size:12px'>{listed}</ul>" if diff else
                "<div style='font-size:12px'>no differences from the baseline</div>"))
         if diff:
-            self.compare()
+            self._stale = True
+            if self.shown:
+                self.compare()
+            else:
+                self.table.object = ("<i>Open this tab or press “Compare with the baseline” to "
+                                     "compute the comparison.</i>")
         else:
             self.table.object = ""
             for source in self.limit_sources.values():
@@ -256,9 +265,16 @@ class VariantView(pn.viewable.Viewer):
 
     # --- comparison ------------------------------------------------------------------------------
 
+    def on_shown(self, shown: bool) -> None:
+        """The dashboard opened (or left) this view's tab: compare if a variant awaits it."""
+        self.shown = shown
+        if shown and self._stale and self.dashboard.variant:
+            self.compare()
+
     def compare(self) -> None:
         """Compute both sides at the current operating point and show them (served: on a worker
         thread, shown when ready; otherwise at once)."""
+        self._stale = False
         state = self.dashboard.state()
         base_key = set_key(self.base_name, {})
         doc = pn.state.curdoc
@@ -287,7 +303,7 @@ class VariantView(pn.viewable.Viewer):
                 self.dashboard.warn(f"Comparison failed: {error}")
             elif self.dashboard.state() == state:
                 self._show(state, future.result())
-        doc.add_next_tick_callback(partial(self.dashboard._locked, doc, show))
+        self.dashboard._post(doc, show)
 
     def _show(self, state, sides: tuple[Side, Side]) -> None:
         self.comparison = sides

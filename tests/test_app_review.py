@@ -211,6 +211,7 @@ def test_variant_editor_upload_and_comparison(dash):
     from model import build_model, eigen_analysis
 
     view = dash.variant_view
+    dash.tabs.active = dash.tab_names.index("variant")  # the comparison runs while shown
     base_ratio = view.base["gear_ratio"]
     view.inputs["gear_ratio"].value = base_ratio * 1.15
     assert view.apply_inputs()
