@@ -159,13 +159,11 @@ def protocol_clients(url: str, count: int) -> None:
     stdin/stdout: prints ``ready`` once every client has its own N0 and its results, presses
     after ``go`` until ``stop``, then prints the latencies [s] as one JSON line."""
     import importlib
+    import pkgutil
     import threading
 
-    from bokeh.client import pull_session
-
-    import pkgutil
-
     import panel.models
+    from bokeh.client import pull_session
 
     # registers all of Panel's Bokeh models (to deserialize the document: it holds e.g. the
     # mode table's DataTabulator)
