@@ -22,7 +22,6 @@ from model import (
     build_model,
     creep_law,
     eigen_analysis,
-    load_parameters,
     mode_character,
 )
 from model.contact import CREEP_PRESETS
@@ -32,7 +31,11 @@ RAIL_CONDITIONS = ("calibrated", "dry", "wet")  # "calibrated": the creep law of
 N_COMPLEX_TABLE = 10  # complex pairs in the eigenvalue / mode tables (Table 1 and 2 layout)
 N_REAL_TABLE = 10  # real eigenvalues in the eigenvalue table
 LOCUS_MAX_HZ = 20.0  # branches tracked up to this frequency [Hz]
-LOCUS_POINTS = 12  # points of a root-locus sweep
+LOCUS_POINTS = 25  # points of the coarse root-locus sweep (shown first, brackets s0*)
+LOCUS_DENSE_POINTS = 200  # points of the dense sweep that replaces it
+LOCUS_UNIFORM_SHARE = 0.3  # share of the dense points spread evenly (the rest follow the motion)
+LOCUS_JUMP_FACTOR = 2.5  # a step this many times as fast as both neighbouring steps is a jump
+LOCUS_JUMP_MIN = 0.5  # ... and longer than this in plot units (Re [1/s], Im [Hz]): line broken
 LOCUS_S0 = (0.001, 0.02)  # s0 range of the creepage sweep [-]
 LIMIT_XTOL = 1e-6  # s0*(v) to 1e-6 (shown with 5 decimals)
 LOCUS_V_KMH = (40.0, 200.0)  # speed range of the speed sweep [km/h]
@@ -52,11 +55,14 @@ class ModelRejected(ValueError):
 
 # --- model -----------------------------------------------------------------------------------
 
-@pn.cache(max_items=4)
+@pn.cache(max_items=24)
 def parameters(params_path: str, rail: str):
-    """The parameter set in use: the file (``""``: calibrated default) with the rail's creep
-    law (``"calibrated"`` keeps the file's, ``"dry"``/``"wet"``: Polach's presets)."""
-    p = load_parameters(params_path or None)
+    """The parameter set in use: the file (``""``: calibrated default) or a design variant of
+    it (set key ``"FILE|name:value,…"``, :mod:`app.variants`) with the rail's creep law
+    (``"calibrated"`` keeps the set's, ``"dry"``/``"wet"``: Polach's presets)."""
+    from .variants import parameters_of_key
+
+    p = parameters_of_key(params_path)
     if rail == "calibrated":
         return p
     if rail not in CREEP_PRESETS:
@@ -64,7 +70,7 @@ def parameters(params_path: str, rail: str):
     return p.replace(**CREEP_PRESETS[rail])
 
 
-@pn.cache(max_items=4)
+@pn.cache(max_items=24)
 def model(params_path: str, rail: str):
     """The assembled model (shared read-only between sessions)."""
     return build_model(parameters(params_path, rail))
@@ -87,6 +93,8 @@ class Mode:
     damping_ratio: float  # −Re λ / |λ| [-]
     description: str  # generated from energy shares (model.modes)
     displacement: dict[str, np.ndarray]  # drawn point -> real translation (x, y, z), unit max
+    kinetic: dict[str, float] = field(default_factory=dict)  # component -> kinetic-energy share
+    strain: dict[str, float] = field(default_factory=dict)  # element group -> strain-energy share
 
 
 @dataclass(frozen=True)
@@ -178,7 +186,8 @@ def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: fl
         lam = complex(result.eigenvalues[i])
         modes.append(Mode(number, lam, lam.imag / (2 * math.pi), character.damping_ratio,
                           character.description,
-                          point_displacements(m, result.mode_shape(int(i)))))
+                          point_displacements(m, result.mode_shape(int(i))),
+                          dict(character.kinetic), dict(character.strain)))
     law = creep_law(m.parameters, op.N0)
     s_max, mu_max = law.maximum(op.v)
     s_grid = np.linspace(0.0, max(0.03, 1.5 * op.s0), 301)
@@ -189,6 +198,24 @@ def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: fl
         real=result.real[:N_REAL_TABLE], creep_s=s_grid, creep_mu=np.asarray(law.mu(s_grid, op.v)),
         mu0=float(law.mu(op.s0, op.v)), s_max=s_max, mu_max=mu_max,
         M_ad=adhesion_moment(m.parameters, op.v, op.N0))
+
+
+@pn.cache(max_items=64)
+def mode_near(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
+              re: float, im: float) -> Mode:
+    """The mode whose eigenvalue is nearest to re + i·im [1/s] at an operating point (a tapped
+    root-locus point): shape, description and energy shares; ``number`` is its rank among the
+    complex pairs by frequency (0 for a real eigenvalue)."""
+    m = model(params_path, rail)
+    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
+    result = eigen_analysis(m, op)
+    index = int(np.argmin(np.abs(result.eigenvalues - complex(re, im))))
+    character = mode_character(m, result, index)
+    lam = complex(result.eigenvalues[index])
+    ranks = {int(i): k for k, i in enumerate(result.complex_index, start=1)}
+    return Mode(ranks.get(index, 0), lam, lam.imag / (2 * math.pi), character.damping_ratio,
+                character.description, point_displacements(m, result.mode_shape(index)),
+                dict(character.kinetic), dict(character.strain))
 
 
 # --- stability limit ---------------------------------------------------------------------------
@@ -229,28 +256,108 @@ class LocusResult:
     values: np.ndarray  # (n_points,) in display units ([-] or [km/h])
     eigenvalues: np.ndarray  # (n_points, n_branches) upper branches [1/s]
     stable: np.ndarray  # (n_points,) bool
+    dense: bool = False  # the dense sweep (else the coarse one shown first)
+    # (n_points - 1, n_branches) bool: the step from point i to i + 1 is a jump (a branch that
+    # meets another one, or moves faster than the grid resolves): the line is broken there
+    jumps: np.ndarray | None = field(default=None, repr=False)
+
+
+def _sweep_range(parameter: str) -> tuple[float, float]:
+    if parameter == "s0":
+        return LOCUS_S0
+    if parameter == "v":
+        return LOCUS_V_KMH
+    raise ModelRejected(f"root locus parameter must be 's0' or 'v', got '{parameter}'")
+
+
+def _sweep(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float, b_M: float,
+           shown: np.ndarray, dense: bool) -> LocusResult:
+    """Root locus over ``shown`` (display units) at the fixed quantities."""
+    from model.locus import root_locus
+
+    m = model(params_path, rail)
+    if parameter == "s0":
+        op = operating_point(params_path, rail, float(shown[0]), fixed, N0_kN, b_M)
+        locus = root_locus(m, op, "s0", shown, max_frequency_hz=LOCUS_MAX_HZ)
+    else:
+        op = operating_point(params_path, rail, fixed, float(shown[0]), N0_kN, b_M)
+        locus = root_locus(m, op, "v", shown * KMH, max_frequency_hz=LOCUS_MAX_HZ)
+    upper = np.flatnonzero(locus.eigenvalues[0].imag >= 0)
+    lam = locus.eigenvalues[:, upper]
+    return LocusResult(parameter, shown, lam, np.asarray(locus.stable), dense, locus_jumps(shown, lam))
 
 
 @pn.cache(max_items=64)
 def locus_result(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
                  b_M: float) -> LocusResult:
-    """Tracked branches over s0 (at speed ``fixed`` [km/h]) or over v (at creepage ``fixed``)."""
-    from model.locus import root_locus
+    """The coarse sweep (LOCUS_POINTS evenly spaced): tracked branches over s0 (at speed
+    ``fixed`` [km/h]) or over v (at creepage ``fixed``).  Shown first; brackets s0*(v)."""
+    shown = np.linspace(*_sweep_range(parameter), LOCUS_POINTS)
+    return _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=False)
 
-    m = model(params_path, rail)
-    if parameter == "s0":
-        op = operating_point(params_path, rail, LOCUS_S0[0], fixed, N0_kN, b_M)
-        values = np.linspace(*LOCUS_S0, LOCUS_POINTS)
-        locus = root_locus(m, op, "s0", values, max_frequency_hz=LOCUS_MAX_HZ)
-        shown = values
-    elif parameter == "v":
-        op = operating_point(params_path, rail, fixed, LOCUS_V_KMH[0], N0_kN, b_M)
-        shown = np.linspace(*LOCUS_V_KMH, LOCUS_POINTS)
-        locus = root_locus(m, op, "v", shown * KMH, max_frequency_hz=LOCUS_MAX_HZ)
+
+@pn.cache(max_items=64)
+def dense_locus_result(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
+                       b_M: float) -> LocusResult:
+    """The dense sweep (LOCUS_DENSE_POINTS), denser where the coarse sweep's branches move fast
+    (:func:`refine_grid`); replaces the coarse one on screen."""
+    coarse = locus_result(params_path, rail, parameter, fixed, N0_kN, b_M)
+    shown = refine_grid(coarse.values, coarse.eigenvalues, LOCUS_DENSE_POINTS)
+    return _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=True)
+
+
+def _plot_steps(eigenvalues: np.ndarray) -> np.ndarray:
+    """(n_points - 1, n_branches) step lengths in plot units (Re [1/s], Im [Hz])."""
+    steps = np.diff(eigenvalues, axis=0)
+    return np.hypot(steps.real, steps.imag / (2 * math.pi))
+
+
+def refine_grid(values: np.ndarray, eigenvalues: np.ndarray, n_points: int) -> np.ndarray:
+    """``n_points`` parameter values from values[0] to values[-1], denser where the branches of
+    a coarse sweep (``eigenvalues`` at ``values``) move fast: each coarse interval gets a share
+    LOCUS_UNIFORM_SHARE / intervals of the points plus a share of the rest proportional to the
+    largest distance any branch travels across it on the plot (Re [1/s], Im [Hz])."""
+    values = np.asarray(values, dtype=float)
+    intervals = len(values) - 1
+    motion = np.nan_to_num(_plot_steps(eigenvalues).max(axis=1)) if eigenvalues.size else \
+        np.zeros(intervals)
+    weight = np.full(intervals, LOCUS_UNIFORM_SHARE / intervals)
+    if motion.sum() > 0:
+        weight += (1.0 - LOCUS_UNIFORM_SHARE) * motion / motion.sum()
     else:
-        raise ModelRejected(f"root locus parameter must be 's0' or 'v', got '{parameter}'")
-    upper = np.flatnonzero(locus.eigenvalues[0].imag >= 0)
-    return LocusResult(parameter, shown, locus.eigenvalues[:, upper], np.asarray(locus.stable))
+        weight = np.full(intervals, 1.0 / intervals)
+    steps = np.maximum(1, np.floor(weight / weight.sum() * (n_points - 1)).astype(int))
+    while steps.sum() < n_points - 1:  # hand the rounding remainder to the busiest intervals
+        steps[np.argmax(weight / steps)] += 1
+    pieces = [np.linspace(values[i], values[i + 1], steps[i] + 1)[:-1] for i in range(intervals)]
+    return np.concatenate([*pieces, values[-1:]])
+
+
+def locus_jumps(values: np.ndarray, eigenvalues: np.ndarray) -> np.ndarray:
+    """Steps that are jumps (a branch meeting another one and turning, or moving faster than the
+    grid resolves): per unit of the swept parameter, more than LOCUS_JUMP_FACTOR times as fast
+    as in both neighbouring steps of the same branch, and longer than LOCUS_JUMP_MIN plot units
+    (Re [1/s], Im [Hz]).  The plots break the line there instead of drawing a straight segment
+    across the plane."""
+    steps = _plot_steps(eigenvalues)
+    if len(steps) < 3:
+        return np.zeros(steps.shape, dtype=bool)
+    rate = steps / np.diff(np.asarray(values, dtype=float))[:, None]
+    before = np.vstack([rate[1:2], rate[:-1]])  # the first / last step: their only neighbour
+    after = np.vstack([rate[1:], rate[-2:-1]])
+    return (rate > LOCUS_JUMP_FACTOR * np.maximum(before, after)) & (steps > LOCUS_JUMP_MIN)
+
+
+def broken_columns(series: np.ndarray, jumps: np.ndarray | None) -> list[np.ndarray]:
+    """One float array per branch (column of ``series``, (n_points, n_branches) real) with NaN
+    inserted at its jumps: Bokeh breaks a line at NaN."""
+    out = []
+    for b in range(series.shape[1]):
+        y = np.asarray(series[:, b], dtype=float)
+        if jumps is not None and jumps[:, b].any():
+            y = np.insert(y, np.flatnonzero(jumps[:, b]) + 1, np.nan)
+        out.append(np.ascontiguousarray(y))
+    return out
 
 
 # --- short-circuit response --------------------------------------------------------------------

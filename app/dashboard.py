@@ -21,6 +21,7 @@ import io
 import json
 import logging
 import math
+import re
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import partial
@@ -35,10 +36,14 @@ from model import NoStabilityLimit, OperatingPointError, ParameterError
 from model.parameters import dumps_parameters
 
 from . import compute
+from .fig6 import Fig6Plot
+from .modes_view import ModeClickThrough
 from .nonlinear_view import NonlinearView  # issue 10
 from .plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
 from .sensitivity_view import SensitivityView  # issue 12: sensitivity tornado
 from .serve import limit_blas_threads
+from .url_state import make_query, parse_query
+from .variant_view import VariantView
 
 log = logging.getLogger(__name__)
 ASSETS = Path(__file__).resolve().parent.parent / "assets"
@@ -83,6 +88,12 @@ class State:
     def point(self) -> tuple:
         return (self.params_path, self.rail, self.s0, self.v, self.N0, self.b_M)
 
+    @property
+    def locus_key(self) -> tuple:
+        """What the root locus depends on: (set, rail, swept parameter, fixed value, N0, b_M)."""
+        fixed = self.v if self.locus == "s0" else self.s0
+        return (self.params_path, self.rail, self.locus, fixed, self.N0, self.b_M)
+
 
 def _ignore_outcome(future) -> None:
     """A computation whose result is no longer shown: retrieve its outcome when it ends (no
@@ -108,9 +119,19 @@ class BogieDashboard(pn.viewable.Viewer):
     locus = param.Selector(default="s0", objects=["s0", "v"], doc="root locus over s0 or v")
     zoom = param.Selector(default="all", objects=["all", "low"], doc="root locus view")
     mode = param.Integer(1, bounds=(1, compute.N_COMPLEX_TABLE), doc="mode shown (ν)")
+    variant = param.String("", doc="design variant: differences from the bundled set, "
+                                   "name:value,… in SI units (app.variants)")
 
-    def __init__(self, params_path: str | None = None, **params):
+    def __init__(self, params_path: str | None = None, query=None, **params):
+        """``params_path``: the bundled parameter file (None: the calibrated set); ``query``:
+        URL query arguments to restore (served: the session's, app.url_state); ``params``:
+        parameter values (they win over the query)."""
         limit_blas_threads()
+        if query is None:
+            query = _session_query()
+        values, variant, self._query_tab, query_notices = parse_query(
+            query, type(self).param, None, base=str(params_path or ""))
+        params = {**values, **({"variant": variant} if variant else {}), **params}
         super().__init__(**params)
         self._params_path = str(params_path or "")
         base = compute.parameters(self._params_path, "calibrated")
@@ -123,13 +144,19 @@ class BogieDashboard(pn.viewable.Viewer):
         self.limit: compute.LimitResult | None = None
         self._limit_for: tuple | None = None  # (rail, v, N0, b_M) of self.limit
         self.locus_result: compute.LocusResult | None = None
+        self._shown_locus: tuple | None = None  # (locus key, dense?) of the locus on screen
         self.response: compute.ResponseView | None = None
         self.error = ""  # last rejection message ("" if the current parameters are valid)
         self._dirty = False
         self._busy = False
         self._build()
         self.param.watch(self._on_change, ["s0", "v", "N0", "b_M", "M0", "f", "D", "dt_auto",
-                                           "dt", "t_end", "rail", "locus"])
+                                           "dt", "t_end", "rail", "locus", "variant"])
+        self._restore_tab(query_notices)
+        self.param.watch(self._share, list(self.param))
+        self.tabs.param.watch(self._share, "active")
+        self.tabs.param.watch(self._tab_shown, "active")
+        self._tab_shown()
         self.param.watch(self._on_mode, ["mode"])
         self.param.watch(lambda e: self.locus_plot.zoom(e.new == "low"), ["zoom"])
         doc = pn.state.curdoc
@@ -147,9 +174,18 @@ class BogieDashboard(pn.viewable.Viewer):
         widget = pn.widgets.FloatSlider(label=label, start=p.bounds[0], end=p.bounds[1],
                                         step=step, value=getattr(self, name), format=fmt,
                                         css_classes=[f"ctl-{name}"], sizing_mode="stretch_width")
-        widget.param.watch(lambda event: setattr(self, name, event.new), "value_throttled")
+        widget.param.watch(partial(self._set_control, name), "value_throttled")
         self.param.watch(lambda event: setattr(widget, "value", event.new), name)
         return widget
+
+    def _set_control(self, name: str, event) -> None:
+        """A slider's released value into the parameter; a value the parameter refuses (out
+        of its bounds, NaN, not a number: only a doctored client sends one) gives a notice and
+        changes nothing."""
+        try:
+            setattr(self, name, event.new)
+        except (ValueError, TypeError) as error:
+            self.warn(f"{name}: value {str(event.new)[:40]} not used: {str(error)[:200]}")
 
     def _controls(self):
         sliders = {
@@ -188,6 +224,9 @@ class BogieDashboard(pn.viewable.Viewer):
             pn.widgets.FileDownload(callback=self._toml, filename="parameters.toml",
                                     label="parameter set (TOML)", css_classes=["dl-toml"],
                                     sizing_mode="stretch_width"),
+            pn.widgets.FileDownload(callback=self.report_html, filename="bogie-report.html",
+                                    label="report (HTML, opens offline)",
+                                    css_classes=["dl-report"], sizing_mode="stretch_width"),
         ]
         return pn.Column(
             "### Published cases (120 km/h)", *cases,
@@ -206,6 +245,7 @@ class BogieDashboard(pn.viewable.Viewer):
     def _build(self) -> None:
         m = compute.model(self._params_path, "calibrated")
         self.locus_plot = RootLocusPlot()
+        self.fig6 = Fig6Plot()
         self.creep_plot = CreepPlot()
         self.response_plots = ResponsePlots()
         self.mode_plot = ModeShapePlot(m.positions, m.parameters["wheel_radius"])
@@ -220,9 +260,12 @@ class BogieDashboard(pn.viewable.Viewer):
                                  stylesheets=[CSS])
         self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
                                     css_classes=["model-notice"], sizing_mode="stretch_width")
+        # input that was not used (a bad link, file or value): stays until the next such notice
+        self.input_notice = pn.pane.Alert("", alert_type="warning", visible=False,
+                                          css_classes=["input-notice"],
+                                          sizing_mode="stretch_width")
         self.peaks = html_pane("")
         self.eigen_table = html_pane("")
-        self.mode_table = html_pane("")
         self.mode_select = pn.widgets.Select(label="mode ν", options={}, width=420,
                                              css_classes=["ctl-mode"])
         self.mode_select.link(self, value="mode")
@@ -235,35 +278,58 @@ class BogieDashboard(pn.viewable.Viewer):
         bokeh_pane = partial(pn.pane.Bokeh, sizing_mode="stretch_width")
         self.sensitivity = SensitivityView()  # issue 12: sensitivity tornado
         schematic = ASSETS / "schematic.svg"
+        self.variant_view = VariantView(self)
+        self.click = ModeClickThrough(self)  # tapped locus points and table rows -> mode views
+        # the views below the status and the root locus, one tab each; other modules add theirs
+        # with ``self.tabs.append((title, view))``
+        self.tabs = pn.Tabs(
+            ("Response", pn.Column(
+                pn.Row(bokeh_pane(self.creep_plot.figure), pn.Column(self.peaks, width=520),
+                       sizing_mode="stretch_width"),
+                pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[:2]),
+                       sizing_mode="stretch_width"),
+                pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[2:]),
+                       sizing_mode="stretch_width"), sizing_mode="stretch_width")),
+            ("Fig. 6", pn.Column(
+                pn.pane.Markdown("Lightly damped complex branches (ζ < 0.3 somewhere on the "
+                                 "sweep) and the real eigenvalues of the root locus above, "
+                                 "against the swept parameter; red dashed: the stability limit "
+                                 "(s0*(v) over s0, the sweep's first unstable speed over v)."),
+                pn.Row(*(bokeh_pane(f) for f in self.fig6.figures[:2]),
+                       sizing_mode="stretch_width"),
+                pn.Row(bokeh_pane(self.fig6.figures[2]), sizing_mode="stretch_width"),
+                sizing_mode="stretch_width")),
+            ("Modes", pn.Column(
+                "#### Eigenvalues (layout of Table 1) and modes (layout of Table 2)",
+                pn.Row(pn.Column(self.eigen_table, width=420),
+                       pn.Column("**Modes** (dominant motion from kinetic/strain energy "
+                                 "shares; click a row, or a point of the root locus)",
+                                 self.click.table.table,
+                                 sizing_mode="stretch_width"),
+                       sizing_mode="stretch_width"),
+                "#### Mode shape",
+                self.mode_select, self.click.detail,
+                pn.Row(*(bokeh_pane(f) for f in self.mode_plot.figures),
+                       sizing_mode="stretch_width"), sizing_mode="stretch_width")),
+            ("Variant", self.variant_view),
+            ("Schematic", pn.pane.SVG(schematic, width=640)
+             if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*")),
+            dynamic=False, css_classes=["views"], sizing_mode="stretch_width")
         self.main = pn.Column(
-            self.notice, self.nonlinear.notice,  # issue 10
+            self.notice, self.input_notice, self.nonlinear.notice,  # issue 10
             pn.Row(pn.Column(self.status, self.busy, self.details, self.nonlinear.status,
                              width=330),
                    pn.Column(pn.Row(locus_choice, zoom), bokeh_pane(self.locus_plot.figure),
                              sizing_mode="stretch_width"),
                    sizing_mode="stretch_width"),
-            "### Short-circuit response",
-            pn.Row(bokeh_pane(self.creep_plot.figure), pn.Column(self.peaks, width=520),
-                   sizing_mode="stretch_width"),
-            pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[:2]),
-                   sizing_mode="stretch_width"),
-            pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[2:]),
-                   sizing_mode="stretch_width"),
-            "### Eigenvalues (layout of Table 1) and modes (layout of Table 2)",
-            pn.Row(self.eigen_table, self.mode_table, sizing_mode="stretch_width"),
-            "### Mode shape",
-            self.mode_select,
-            pn.Row(*(bokeh_pane(f) for f in self.mode_plot.figures), sizing_mode="stretch_width"),
-            self.sensitivity.panel,  # issue 12: sensitivity tornado
-            "### Schematic of the bogie (names used in the tables)",
-            pn.pane.SVG(schematic, width=640)
-            if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*"),
-            sizing_mode="stretch_width")
+            self.tabs, sizing_mode="stretch_width")
+        self.tabs.append(("Sensitivity", self.sensitivity.panel))  # issue 12: sensitivity tornado
         # issue 13: the "Studies" view (stability map over s0 × v) lives in app/studies_view.py
         from .studies_view import StudiesView
 
         self.studies = StudiesView(self)
-        self.main.extend(["### Studies: stability map over s0 × v", self.studies])
+        self.tabs.append(("Studies", pn.Column("### Studies: stability map over s0 × v",
+                                                self.studies, sizing_mode="stretch_width")))
         self.layout = pn.Row(
             self._controls(), self.main, sizing_mode="stretch_width",
             stylesheets=[CSS])
@@ -273,9 +339,53 @@ class BogieDashboard(pn.viewable.Viewer):
 
     # --- state and computations --------------------------------------------------------------
 
+    @property
+    def set_key(self) -> str:
+        """The parameter set in use for app.compute: the bundled file, or a variant of it."""
+        return f"{self._params_path}|{self.variant}" if self.variant else self._params_path
+
+    # --- shareable state (app.url_state) -------------------------------------------------------
+
+    @property
+    def tab_names(self) -> list[str]:
+        """The views' names in the URL (``tab=``): their titles in lower case, words joined
+        by '-'."""
+        return [re.sub(r"[^a-z0-9]+", "-", str(title).lower()).strip("-")
+                for title in self.tabs._names]
+
+    def share_query(self) -> str:
+        """The URL query (without '?') that restores this session's settings."""
+        return make_query(self, self.tab_names[self.tabs.active] if self.tabs.active else None)
+
+    def _restore_tab(self, notices: list[str]) -> None:
+        tab = self._query_tab
+        if tab is not None:
+            if tab in self.tab_names:
+                self.tabs.active = self.tab_names.index(tab)
+            else:
+                notices.append(f"tab = '{tab[:40]}' is not one of {', '.join(self.tab_names)}")
+        if notices:
+            self.warn("Some settings of the link were not used (defaults kept): "
+                      + "; ".join(notices))
+
+    def _tab_shown(self, *_events) -> None:
+        """Views that compute only while shown (the variant comparison) learn it here."""
+        self.variant_view.on_shown(self.tab_names[self.tabs.active] == "variant")
+
+    def warn(self, text: str) -> None:
+        """Show a notice about input that was not used (the previous state is kept)."""
+        self.input_notice.object = html.escape(text)
+        self.input_notice.visible = True
+
+    def _share(self, *_events) -> None:
+        """Keep the browser's address (served) equal to the settings: a link to share."""
+        location = pn.state.location if pn.state.curdoc is not None else None
+        if location is not None and pn.state.curdoc.session_context is not None:
+            location.search = "?" + self.share_query()
+
     def state(self) -> State:
         rnd = lambda x, n=6: float(round(x, n))  # noqa: E731 - cache keys without float noise
-        return State(self._params_path, self.rail, rnd(self.s0, 7), rnd(self.v, 3),
+        return State(self.set_key, self.rail, rnd(self.s0, 7), rnd(self.v, 3),
                      rnd(self.N0, 3), rnd(self.b_M, 3), rnd(self.M0, 3), rnd(self.f, 3),
                      rnd(self.D, 5), None if self.dt_auto else rnd(self.dt, 4), rnd(self.t_end, 3),
                      self.locus)
@@ -297,17 +407,21 @@ class BogieDashboard(pn.viewable.Viewer):
 
     @staticmethod
     def _locus(state: State):
-        fixed = state.v if state.locus == "s0" else state.s0
-        return compute.locus_result(state.params_path, state.rail, state.locus, fixed,
-                                    state.N0, state.b_M)
+        """The coarse root locus (shown first)."""
+        return compute.locus_result(*state.locus_key)
+
+    @staticmethod
+    def _dense_locus(state: State):
+        """The dense root locus (replaces the coarse one)."""
+        return compute.dense_locus_result(*state.locus_key)
 
     def compute_fast(self, state: State):
         """(point result, response result) for a state (raises a MODEL_ERRORS on rejection)."""
         return self._point(state), self._response(state)
 
     def compute_slow(self, state: State):
-        """(stability limit, root locus) for a state."""
-        return self._limit(state), self._locus(state)
+        """(stability limit, dense root locus) for a state."""
+        return self._limit(state), self._dense_locus(state)
 
     def refresh(self, slow: bool = True) -> None:
         """Compute and show everything synchronously (initial view, tests); ``slow=False``
@@ -350,39 +464,49 @@ class BogieDashboard(pn.viewable.Viewer):
             while self._dirty:
                 self._dirty = False
                 state = self.state()
-                # the root locus (≈ 0.3 s on two threads when not cached) starts at once, beside
-                # the fast stage (one thread), and is shown when both are done
-                locus_future = loop.run_in_executor(EXECUTOR, self._locus, state)
+                # the coarse root locus (≈ 0.3 s on two threads when not cached) starts at once,
+                # beside the fast stage (one thread), and is shown when both are done; then the
+                # dense one replaces it when ready.  Nothing to do if the dense locus of this
+                # (set, rail, sweep, fixed value, N0, b_M) is on screen already
+                need_locus = self._shown_locus != (state.locus_key, True)
+                locus_future = (loop.run_in_executor(EXECUTOR, self._locus, state)
+                                if need_locus else None)
                 try:
                     fast = await loop.run_in_executor(EXECUTOR, self.compute_fast, state)
                 except MODEL_ERRORS as error:
-                    doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
-                    _ignore_outcome(locus_future)
+                    self._post(doc, self._reject, error)
+                    if locus_future is not None:
+                        _ignore_outcome(locus_future)
                     continue
-                doc.add_next_tick_callback(partial(self._locked, doc, self._apply_fast, state,
-                                                   fast))
+                self._post(doc, self._apply_fast, state,
+                                                   fast)
                 if self._dirty:
-                    _ignore_outcome(locus_future)  # it still fills the cache
+                    if locus_future is not None:
+                        _ignore_outcome(locus_future)  # it still fills the cache
                     continue
-                try:
-                    locus = await locus_future
-                except MODEL_ERRORS as error:
-                    doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
-                    continue
-                if self._dirty:
-                    continue
-                doc.add_next_tick_callback(partial(self._locked, doc, self._apply_locus, state,
-                                                   locus))
+                if locus_future is not None:
+                    try:
+                        locus = await locus_future
+                    except MODEL_ERRORS as error:
+                        self._post(doc, self._reject,
+                                                           error)
+                        continue
+                    if self._dirty:
+                        continue
+                    self._post(doc, self._apply_locus,
+                                                       state, locus)
+                    dense = loop.run_in_executor(EXECUTOR, self._dense_if_current, state)
+                    dense.add_done_callback(partial(self._dense_done, doc, state))
                 # s0*(v) (≈ 0.7 s) is not waited for: a change arriving meanwhile starts at
                 # once; the limit is shown when ready if it still belongs to the parameters
                 limit = loop.run_in_executor(EXECUTOR, self._limit_if_current, state)
                 limit.add_done_callback(partial(self._limit_done, doc, state))
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")
-            doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+            self._post(doc, self._reject, error)
         finally:
             self._busy = False
-            doc.add_next_tick_callback(partial(self._locked, doc, self._done))
+            self._post(doc, self._done)
 
     def _limit_current(self, state: State) -> bool:
         """Whether s0*(v) for ``state`` is still the one to show (same v, N0, b_M, rail)."""
@@ -395,19 +519,58 @@ class BogieDashboard(pn.viewable.Viewer):
         must not queue ten 0.7 s root findings in front of the next change's fast stage)."""
         return self._limit(state) if self._limit_current(state) else None
 
+    def _dense_if_current(self, state: State) -> compute.LocusResult | None:
+        """The dense root locus, unless superseded before it started."""
+        return self._dense_locus(state) if self.state().locus_key == state.locus_key else None
+
+    def _dense_done(self, doc, state: State, future) -> None:
+        if future.cancelled() or self.state().locus_key != state.locus_key:
+            return  # superseded: another sweep is shown
+        error = future.exception()
+        if error is not None:
+            if isinstance(error, MODEL_ERRORS):
+                self._post(doc, self._reject, error)
+            else:
+                log.error("dense root locus failed", exc_info=error)
+            return
+        if future.result() is not None:
+            self._post(doc, self._apply_locus, state,
+                                               future.result())
+
     def _limit_done(self, doc, state: State, future) -> None:
         if future.cancelled() or not self._limit_current(state):
             return  # superseded: another speed, wheel force, motor slope or rail is shown
         error = future.exception()
         if error is not None:
             if isinstance(error, MODEL_ERRORS):
-                doc.add_next_tick_callback(partial(self._locked, doc, self._reject, error))
+                self._post(doc, self._reject, error)
             else:
                 log.error("stability limit failed", exc_info=error)
             return
         if future.result() is not None:
-            doc.add_next_tick_callback(partial(self._locked, doc, self._apply_limit, state,
-                                               future.result()))
+            self._post(doc, self._apply_limit, state,
+                                               future.result())
+
+    def run_locked(self, function, *args) -> None:
+        """Run ``function(*args)`` with the session's document lock: served, on the next tick
+        (a Panel widget callback may run without the lock; changing Bokeh models there raised
+        "_pending_writes should be non-None"); otherwise at once."""
+        doc = pn.state.curdoc
+        if doc is None or doc.session_context is None:
+            function(*args)
+        else:
+            self._post(doc, function, *args)
+
+    def _post(self, doc, function, *args) -> None:
+        """``function(*args)`` on the session's next tick, with its document lock; nothing if the
+        session has ended meanwhile (a closed browser tab: its document is destroyed, and
+        Bokeh raised AttributeError on scheduling into it)."""
+        if doc.session_context is None or getattr(doc.session_context, "destroyed", False):
+            return
+        try:
+            doc.add_next_tick_callback(partial(self._locked, doc, function, *args))
+        except (AttributeError, RuntimeError):
+            log.debug("session ended: result not shown")
 
     @staticmethod
     def _locked(doc, function, *args) -> None:
@@ -444,6 +607,8 @@ class BogieDashboard(pn.viewable.Viewer):
     def _on_mode(self, *_events) -> None:
         if self.point is not None and 1 <= self.mode <= len(self.point.modes):
             self.mode_plot.update(self.point.modes[self.mode - 1].displacement)
+            self.mode_select.value = self.mode
+            self.click.show_point_mode()
             self.sensitivity.show(mode=self.mode)  # issue 12: sensitivity tornado
 
     # --- showing results -----------------------------------------------------------------------
@@ -457,7 +622,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.response_plots.update(response)
         self._show_status()
         self.eigen_table.object = eigen_table_html(point)
-        self.mode_table.object = mode_table_html(point)
+        self.click.table.update(point)
         self.peaks.object = peaks_html(response)
         self.mode_select.options = {f"ν = {m.number}: {m.im_hz:.3f} Hz — {m.description}"[:90]:
                                     m.number for m in point.modes}
@@ -476,11 +641,16 @@ class BogieDashboard(pn.viewable.Viewer):
     def _apply_limit(self, state: State, limit: compute.LimitResult) -> None:
         self.limit, self._limit_for = limit, (state.rail, state.v, state.N0, state.b_M)
         self.creep_plot.update_limit(limit)
+        self.fig6.update_limit(limit.s0_limit)
         self._show_status()
 
     def _apply_locus(self, state: State, locus: compute.LocusResult) -> None:
+        if self.state().locus_key != state.locus_key:
+            return  # a late result of a sweep no longer shown
         self.locus_result = locus
+        self._shown_locus = (state.locus_key, locus.dense)
         self.locus_plot.update_locus(locus)
+        self.fig6.update_locus(locus)
         self.locus_plot.zoom(self.zoom == "low")
 
     def _show_status(self) -> None:
@@ -531,6 +701,15 @@ class BogieDashboard(pn.viewable.Viewer):
                 "eigenvalues": [{"re": float(x.real), "im": float(x.imag)} for x in lam[order]]}
         return io.StringIO(json.dumps(data, indent=1))
 
+    def report_html(self):
+        """The self-contained HTML report of the current state (app.report)."""
+        from .report import build_report
+
+        state = self.state()
+        return io.StringIO(build_report(state.params_path, state.rail, state.s0, state.v,
+                                        state.N0, state.b_M, state.M0, state.f, state.D,
+                                        state.dt, state.t_end))
+
     def _toml(self):
         state = self.state()
         p = compute.parameters(state.params_path, state.rail)
@@ -538,6 +717,14 @@ class BogieDashboard(pn.viewable.Viewer):
                   f"operating point: s0 = {state.s0}, v = {state.v} km/h, N0 = {state.N0} kN, "
                   f"b_M = {state.b_M} N m s/rad")
         return io.StringIO(dumps_parameters(p, header))
+
+
+def _session_query() -> dict:
+    """The URL query arguments of the served session being built ({} without a server)."""
+    doc = pn.state.curdoc
+    if doc is None or doc.session_context is None:
+        return {}
+    return dict(pn.state.session_args or {})
 
 
 # --- tables ------------------------------------------------------------------------------------

@@ -20,6 +20,7 @@ from bokeh.models import (
     LinearColorMapper,
     Range1d,
     Span,
+    TapTool,
 )
 from bokeh.palettes import Category10_10, Viridis256
 from bokeh.plotting import figure
@@ -32,6 +33,7 @@ from .compute import (
     LocusResult,
     PointResult,
     ResponseView,
+    broken_columns,
 )
 
 UNSTABLE = "#c0392b"
@@ -53,6 +55,7 @@ class RootLocusPlot:
     def __init__(self):
         self.figure = _figure("Root locus", "Re λ [1/s]", "Im λ [Hz]",
                               x_range=Range1d(-6.0, 2.5), y_range=Range1d(0.0, 14.0))
+        self.figure.name = "root-locus"
         fig = self.figure
         fig.add_layout(BoxAnnotation(left=0.0, fill_color=UNSTABLE, fill_alpha=0.08,
                                      line_alpha=0.0))
@@ -81,6 +84,8 @@ class RootLocusPlot:
         self.sweep_hover = HoverTool(renderers=[sweep], tooltips=[
             ("s0", "@value{0.0000}"), ("λ", "@x{0.000} ± i @y{0.000} Hz"), ("ζ", "@zeta{0.0000}")])
         fig.add_tools(self.sweep_hover)
+        # click-through: a tapped diamond or sweep point selects that mode (app.modes_view)
+        fig.add_tools(TapTool(renderers=[now, sweep]))
 
     def zoom(self, low_modes: bool) -> None:
         """Fit the view: all tracked eigenvalues, or only the low, lightly damped modes."""
@@ -106,20 +111,26 @@ class RootLocusPlot:
         x, y = lam.real, lam.imag / (2 * math.pi)
         value = np.repeat(locus.values[:, None], lam.shape[1], axis=1)
         zeta = -lam.real / np.maximum(np.abs(lam), 1e-300)
-        # numpy arrays travel to the browser as binary buffers (lists as JSON text: 10x slower)
-        self.lines.data = {"xs": [np.ascontiguousarray(col) for col in x.T],
-                           "ys": [np.ascontiguousarray(col) for col in y.T]}
+        # numpy arrays travel to the browser as binary buffers (lists as JSON text: 10x slower);
+        # lines are broken (NaN) where a branch jumps instead of crossing the plane straight
+        self.lines.data = {"xs": broken_columns(x, locus.jumps),
+                           "ys": broken_columns(y, locus.jumps)}
+        # "value" colours the points; the column named after the swept parameter ("s0" or "v")
+        # carries the same numbers for readers of the data (tests, scripts)
+        self.points.selected.indices = []
         self.points.data = {"x": x.ravel(), "y": y.ravel(), "value": value.ravel(),
-                            "zeta": zeta.ravel()}
+                            locus.parameter: value.ravel(), "zeta": zeta.ravel()}
         self.mapper.low, self.mapper.high = float(locus.values[0]), float(locus.values[-1])
         label = "s0 [-]" if locus.parameter == "s0" else "v [km/h]"
         self.colorbar.title = label
         self.sweep_hover.tooltips = [(label, "@value{0.0000}" if locus.parameter == "s0"
                                       else "@value{0}"),
                                      ("λ", "@x{0.000} ± i @y{0.000} Hz"), ("ζ", "@zeta{0.0000}")]
-        self.figure.title.text = ("Root locus over creepage s0 (current speed)"
+        sweep = (f"{len(locus.values)} points" if locus.dense
+                 else f"{len(locus.values)} points, dense sweep computing…")
+        self.figure.title.text = (f"Root locus over creepage s0 (current speed; {sweep})"
                                   if locus.parameter == "s0"
-                                  else "Root locus over speed v (current creepage)")
+                                  else f"Root locus over speed v (current creepage; {sweep})")
 
 
 class CreepPlot:

@@ -310,6 +310,14 @@ from .study_cli import register as _register_study  # noqa: E402 - issue 13: bog
 
 EXTRA_COMMANDS.append(_register_study)
 
+from .compare_cli import register as _register_compare  # noqa: E402
+
+EXTRA_COMMANDS.append(_register_compare)
+
+from .report_cli import register as _register_report  # noqa: E402
+
+EXTRA_COMMANDS.append(_register_report)
+
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits

@@ -8,7 +8,9 @@ Starts ``bogie serve`` on a free port (a separate process, as users run it), the
    hit); latency = key press → the browser holds new eigenvalues (root-locus current point)
    *and* new time histories (both must have changed; the status is sent with the eigenvalues);
 2. root-locus refresh: keyboard steps on the speed slider (new v → new s0*(v) and a new locus
-   over s0); latency = key press → new locus branches in the browser;
+   over s0); latency = key press → new (coarse, 25-point) locus branches in the browser, and
+   key press → the dense 200-point locus has replaced it (its title no longer says
+   "computing");
 3. ``--sessions`` pages at once, each with its own wheel force N0 (so no session profits from
    another's cache), pressing s0 steps at random moments (0.3–1.5 s apart);
 4. the same number of sessions, but only one of them a Chromium page (measured as in 3) and the
@@ -47,6 +49,7 @@ DATA = """(name, col) => { const d = Bokeh.documents[0].get_model_by_name(name).
   const v = d instanceof Map ? d.get(col) : d[col]; return Array.from(v).slice(0, 60).join(','); }"""
 FAST = f"() => ({DATA})('locus_current', 'x') + '|' + ({DATA})('response:ID1.disc_clutch.torque', 'y')"
 SLOW = f"() => ({DATA})('locus_points', 'x')"
+LOCUS_TITLE = "() => Bokeh.documents[0].get_model_by_name('root-locus').title.text"
 
 
 def log(message: str) -> None:
@@ -124,6 +127,22 @@ async def step(page, control: str, key: str, probe: str, timeout: float = 120_00
     return time.perf_counter() - t0
 
 
+async def speed_step(page) -> tuple[float, float]:
+    """A speed step: seconds from the key press until the coarse root locus is in the browser,
+    and until the dense one has replaced it (its title no longer says "computing")."""
+    before = await page.evaluate(SLOW)
+    handle = page.locator(".ctl-v .noUi-handle")
+    await handle.focus()
+    t0 = time.perf_counter()
+    await handle.press("ArrowRight")
+    await page.wait_for_function(f"() => ({SLOW})() !== {json.dumps(before)}", polling=5,
+                                 timeout=300_000)
+    coarse = time.perf_counter() - t0
+    await page.wait_for_function(f"() => !({LOCUS_TITLE})().includes('computing')", polling=5,
+                                 timeout=300_000)
+    return coarse, time.perf_counter() - t0
+
+
 async def wait_idle(page) -> None:
     """Let the session's background stage (s0*, root locus) finish."""
     await page.wait_for_function(f"() => ({SLOW})().length > 0", timeout=300_000)
@@ -140,12 +159,19 @@ def protocol_clients(url: str, count: int) -> None:
     stdin/stdout: prints ``ready`` once every client has its own N0 and its results, presses
     after ``go`` until ``stop``, then prints the latencies [s] as one JSON line."""
     import importlib
+    import pkgutil
     import threading
 
+    import panel.models
     from bokeh.client import pull_session
 
-    for module in ("layout", "markup", "widgets"):  # registers Panel's Bokeh models (to
-        importlib.import_module(f"panel.models.{module}")  # deserialize the document)
+    # registers all of Panel's Bokeh models (to deserialize the document: it holds e.g. the
+    # mode table's DataTabulator)
+    for module in pkgutil.iter_modules(panel.models.__path__):
+        try:
+            importlib.import_module(f"panel.models.{module.name}")
+        except ImportError:  # optional extras
+            pass
     go, stop = threading.Event(), threading.Event()
     ready = threading.Barrier(count + 1)
     latencies: list[float] = []
@@ -271,10 +297,10 @@ async def run(args) -> dict:
             await settle_n0(page, 1)
             log("single session: s0 steps, then speed steps")  # own N0 = 99 kN: nothing cached from earlier runs
             fast = [await step(page, "ctl-s0", "ArrowRight", FAST) for _ in range(args.presses)]
-            slow = [await step(page, "ctl-v", "ArrowRight", SLOW)
-                    for _ in range(args.locus_presses)]
+            speeds = [await speed_step(page) for _ in range(args.locus_presses)]
             results["single_fast_s"] = fast
-            results["locus_refresh_s"] = slow
+            results["locus_refresh_s"] = [coarse for coarse, _ in speeds]
+            results["dense_locus_s"] = [dense for _, dense in speeds]
             results["errors_single"] = list(page.errors)
             await page.close()
             # 3: concurrent sessions, each with its own N0 (no shared cache hits)
@@ -390,6 +416,9 @@ def main() -> None:
           f"(n = {len(results['single_fast_s'])}, max {max(results['single_fast_s']) * 1e3:.0f})")
     print(f"root-locus refresh (new speed): median {locus * 1e3:.0f} ms "
           f"(n = {len(results['locus_refresh_s'])}, max {max(results['locus_refresh_s']) * 1e3:.0f})")
+    dense = results["dense_locus_s"]
+    print(f"dense root locus (200 points) after a speed change: median "
+          f"{statistics.median(dense) * 1e3:.0f} ms (n = {len(dense)}, max {max(dense) * 1e3:.0f})")
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1))
     errors = results["errors_single"] + results.get("errors_mixed", [])

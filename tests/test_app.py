@@ -106,8 +106,7 @@ def test_views_show_the_current_point(dash):
     assert values.min() == pytest.approx(compute.LOCUS_S0[0])
     assert len(dash.locus_plot.lines.data["xs"]) == dash.locus_result.eigenvalues.shape[1]
     # tables: one row per complex pair / real eigenvalue, in Table 1 / Table 2 layout
-    for mode in dash.point.modes:
-        assert mode.description in dash.mode_table.object
+    assert dash.click.table.descriptions == [mode.description for mode in dash.point.modes]
     assert f"{result.real[0]:+.4g}" in dash.eigen_table.object
 
 
@@ -227,7 +226,10 @@ def test_render_whole_layout(dash):
         assert f"ctl-{name}" in classes, name
     assert "stability-status" in classes
     plots = [model for model in models if isinstance(model, Plot)]
-    assert len(plots) == 8  # locus, creep, 2 torques, forces, M_C, side and top view
+    # locus, creep, 2 torques, forces, M_C, side and top view, Fig. 6 (Im, Re, real), variant s0*
+    assert len(plots) == 12
+    assert {"root-locus", "fig6-im", "fig6-re", "fig6-real", "variant-limits"} <= {
+        p.name for p in plots}
     titled = {model.title for model in models if getattr(model, "css_classes", None)
               and "ctl-s0" in model.css_classes}
     assert titled == {"creepage s0 [-]"}

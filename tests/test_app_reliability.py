@@ -1,0 +1,55 @@
+"""Reliability of the served dashboard, short versions of ``scripts/reliability_app.py``
+(the long runs: 20 sessions, a 10-minute soak, 200 query strings; numbers in BENCHMARKS.md).
+
+Through Bokeh's protocol client (the messages a browser sends, no rendering): concurrent
+sessions with different design variants each see their own results; bad query strings, bad
+slider values and bad uploads give notices only, the session keeps working and the server stays
+alive; a short soak reports the server's memory (it is in this process here).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.slow
+
+SCRIPT = Path(__file__).resolve().parent.parent / "scripts" / "reliability_app.py"
+
+
+@pytest.fixture(scope="module")
+def reliability():
+    spec = importlib.util.spec_from_file_location("reliability_app", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_concurrent_sessions_with_different_variants_see_their_own(app_server, reliability):
+    result = reliability.isolation(app_server, sessions=4)
+    assert result["failures"] == []
+    assert result["own_results"] == result["answered"] == 4
+    assert result["distinct"] == 4
+
+
+def test_fuzz_of_queries_values_and_uploads(app_server, reliability):
+    queries = reliability.fuzz_queries(app_server, count=15)
+    assert queries["statuses"] == {200: 15}, queries["failures"]
+    assert queries["alive_after"]
+    session = reliability.fuzz_session(app_server)
+    assert session["bad_inputs_sent"] > 10
+    assert session["session_still_working"]
+    assert session["alive_after"]
+
+
+def test_short_soak_memory(app_server, reliability):
+    """20 s of a control changed every second (the 10-minute run is the script's).  Bound:
+    the process (server and tests) grows by less than 200 MB — caches are bounded
+    (pn.cache max_items), so a leak per change would show as steady growth long before that
+    in the long run; here the check is that nothing explodes and the changes are answered."""
+    result = reliability.soak(app_server, None, minutes=20 / 60, sample_every=5.0)
+    assert result["changes"] >= 10
+    assert result["timeouts"] == 0
+    assert result["rss_end_mb"] - result["samples"][0][1] < 200
