@@ -328,8 +328,7 @@ class BogieDashboard(pn.viewable.Viewer):
         from .studies_view import StudiesView
 
         self.studies = StudiesView(self)
-        self.tabs.append(("Studies", pn.Column("### Studies: stability map over s0 × v",
-                                                self.studies, sizing_mode="stretch_width")))
+        self.tabs.append(("Studies", self.studies.layout))
         self.layout = pn.Row(
             self._controls(), self.main, sizing_mode="stretch_width",
             stylesheets=[CSS])

@@ -33,7 +33,7 @@ def _small(view, where="this process (no Dask)"):
 
 def test_map_at_the_dashboards_point_equals_serial_study(dash):
     view = dash.studies
-    assert any(o is view.layout for o in dash.main.objects)  # hooked into the dashboard
+    assert any(o is view.layout for o in dash.tabs.objects)  # hooked into the dashboard's tabs
     with param.parameterized.discard_events(dash):  # no dashboard recomputation needed here
         dash.N0, dash.b_M, dash.rail = 90.0, 2500.0, "wet"
     _small(view)
