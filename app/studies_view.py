@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import panel as pn
 from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
-from bokeh.palettes import RdBu11
+from bokeh.palettes import RdBu10
 
 from model.operating_point import KMH
 
@@ -78,7 +78,9 @@ class StudyMapPlot:
         self.figure = _figure("Stability map: largest real part [1/s]", "speed v [km/h]",
                               "creepage s0 [-]")
         self.figure.height = 380
-        self.mapper = LinearColorMapper(palette=list(reversed(RdBu11)), low=-1.0, high=1.0,
+        # an even number of colours on a range symmetric about 0: the blue/red boundary is
+        # exactly Re λ = 0 (stable blue, unstable red)
+        self.mapper = LinearColorMapper(palette=list(RdBu10), low=-1.0, high=1.0,
                                         nan_color="#eeeeee")
         self.image = ColumnDataSource({"image": [np.full((1, 1), np.nan)], "x": [0.0], "y": [0.0],
                                        "dw": [1.0], "dh": [1.0]})

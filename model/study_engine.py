@@ -121,7 +121,7 @@ class StudyEngine:
             with dask.config.set(WORKER_CONFIG):
                 self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
                                             processes=True, dashboard_address=None,
-                                            silence_logs=logging.ERROR,
+                                            silence_logs=logging.CRITICAL,  # shutdown races log heartbeat errors
                                             env=dict(BLAS_ENVIRONMENT))
         finally:
             if previous is not None:

@@ -149,7 +149,7 @@ def main() -> None:
                                  and np.array_equal(line.divergent_real, reference.divergent_real))
     print(f"accuracy on {args.check_lines} lines x {args.s0_points} points against a full "
           f"eigen-analysis: max |d largest real part| {worst:.2e} 1/s, flutter/divergent counts "
-          f"identical: {counts_equal}; outside-basis eigenvalues at the line ends <= "
+          f"identical: {counts_equal}; outside-basis eigenvalues at the anchors <= "
           f"{float(serial['outside_max_real_part'].max()):.3f} 1/s")
 
     sobol = args.sobol_samples * (args.sobol_parameters + 2)
