@@ -3,6 +3,8 @@
     bogie study map   --s0 A:B:N --v A:B:N [--n0 LIST] [--bm LIST] [--params FILE] [--rail R]
                       --out X.zarr [--scheduler tcp://HOST:PORT] [--workers N] [--resume]
     bogie study limit --v A:B:N [--n0 LIST] [--bm LIST] … --out X.zarr …
+    bogie study uncertainty --samples N [--seed S] [--params FILE] --out U.json
+                      [--scheduler tcp://HOST:PORT] [--workers N] [--serial]
 
 ``A:B:N`` is N values from A to B (N = 1: A alone); a LIST is comma-separated values or A:B:N.
 Speeds in km/h on the command line (m/s in the store).  Results: an xarray Dataset in a Zarr
@@ -77,6 +79,11 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="X.zarr", help="Zarr store to write")
     p.add_argument("--resume", action="store_true",
                    help="continue the study in --out (same parameters and arguments only)")
+    _engine_options(p)
+    p.add_argument("--json", action="store_true", help="a JSON summary on stdout")
+
+
+def _engine_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                    help="attach to a running Dask scheduler (default: $DASK_SCHEDULER_ADDRESS, "
                         "else a local cluster)")
@@ -87,7 +94,6 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--connect-timeout", type=number("--connect-timeout (s)", 0, 600,
                                                     allowed="must be in (0, 600) s"),
                    default=10.0, help="seconds to reach the scheduler (default %(default)s)")
-    p.add_argument("--json", action="store_true", help="a JSON summary on stdout")
 
 
 def register(subparsers) -> None:
@@ -105,6 +111,19 @@ def register(subparsers) -> None:
     limit.add_argument("--v", required=True, metavar="A:B:N", help="speeds [km/h]")
     _common(limit)
     limit.set_defaults(func=cmd_limit)
+    u = sub.add_parser("uncertainty", help="the Monte-Carlo/Sobol study of `bogie uncertainty` "
+                       "(docs/sensitivity.md) on the same engine")
+    u.add_argument("--samples", type=positive_int("--samples"), required=True,
+                   help="base sample count n (a power of 2 >= 2); model runs: n (d + 2)")
+    u.add_argument("--seed", type=int, default=12, help="seed of the scrambled Sobol' sequence")
+    u.add_argument("--params", default=None, metavar="FILE",
+                   help="parameter file (TOML; default: the calibrated set)")
+    u.add_argument("--out", required=True, metavar="U.json", help="JSON result to write")
+    u.add_argument("--chunk-size", type=positive_int("--chunk-size"), default=4,
+                   help="model runs per task (default %(default)s)")
+    _engine_options(u)
+    u.add_argument("--json", action="store_true", help="the result as JSON on stdout")
+    u.set_defaults(func=cmd_uncertainty)
 
 
 def _parameters(args):
@@ -149,8 +168,8 @@ class ProgressBar:
     """``[#####-----] 5/10 chunks, 12 s elapsed, ~12 s left`` on stderr (redrawn in place on a
     terminal; otherwise a line at most every 2 s and at the end)."""
 
-    def __init__(self, label: str, stream=None, width: int = 30):
-        self.label, self.stream, self.width = label, stream or sys.stderr, width
+    def __init__(self, label: str, stream=None, width: int = 30, unit: str = "chunks"):
+        self.label, self.stream, self.width, self.unit = label, stream or sys.stderr, width, unit
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
         self.first: tuple[int, float] | None = None
         self.last_print = -math.inf
@@ -165,7 +184,7 @@ class ProgressBar:
             left = ""
         filled = int(self.width * finished / max(total, 1))
         text = (f"{self.label}: [{'#' * filled}{'-' * (self.width - filled)}] {finished}/{total} "
-                f"chunks, {elapsed:.0f} s elapsed{left}")
+                f"{self.unit}, {elapsed:.0f} s elapsed{left}")
         now = time.monotonic()
         if self.tty:
             self.stream.write("\r" + text.ljust(100) + ("\n" if finished == total else ""))
@@ -177,8 +196,61 @@ class ProgressBar:
         self.stream.flush()
 
 
-def _run(args: argparse.Namespace, study, parameters) -> None:
+def _start_engine(args: argparse.Namespace):
+    """(engine or None, map_unordered, where) for --serial / --scheduler / a local cluster."""
     from .study_engine import EngineUnavailable, StudyEngine, serial_map_unordered
+
+    if args.serial:
+        return None, serial_map_unordered, "this process (serial)"
+    engine = StudyEngine(args.scheduler, args.workers, args.connect_timeout)
+    try:
+        engine.start()
+    except EngineUnavailable as error:
+        raise UsageError(str(error)) from None
+    return engine, engine.map_unordered, engine.description
+
+
+def cmd_uncertainty(args: argparse.Namespace) -> None:
+    from pathlib import Path
+
+    from .parameters import load_parameters
+    from .study_engine import in_order
+    from .uncertainty import UncertaintyError, run_uncertainty
+
+    n = args.samples
+    if n < 2 or n & (n - 1):
+        raise UsageError(f"--samples = {n} is not allowed: must be a power of 2 >= 2 "
+                         "(balance of the Sobol' sequence)")
+    out = Path(args.out)
+    if not out.parent.is_dir():
+        raise UsageError(f"directory '{out.parent}' does not exist")
+    parameters = load_parameters(args.params)
+    bar, start = ProgressBar("study uncertainty", unit="model runs"), time.monotonic()
+    engine, mapper, where = _start_engine(args)
+    try:
+        print(f"study uncertainty: n = {n} on {where}", file=sys.stderr)
+        result = run_uncertainty(parameters, n, seed=args.seed, map_fn=in_order(mapper),
+                                 chunk_size=args.chunk_size,
+                                 progress=lambda done, total: bar(done, total,
+                                                                  time.monotonic() - start))
+    except UncertaintyError as error:
+        raise UsageError(str(error)) from None
+    except KeyboardInterrupt:
+        print("\nstudy uncertainty: interrupted (nothing written)", file=sys.stderr)
+        raise SystemExit(EXIT_INTERRUPTED) from None
+    finally:
+        if engine is not None:
+            engine.close()
+    data = result.as_dict()
+    out.write_text(json.dumps(data, indent=1, allow_nan=False), encoding="utf-8")
+    if args.json:
+        print(json.dumps(data, indent=1, allow_nan=False))
+    else:
+        print(result.summary())
+        print(f"wrote {out}")
+
+
+def _run(args: argparse.Namespace, study, parameters) -> None:
     from .study_store import open_study, prepare_store, run_into_store
 
     progress = ProgressBar(f"study {study.kind}")
@@ -194,15 +266,7 @@ def _run(args: argparse.Namespace, study, parameters) -> None:
         prepare_store(args.out, study, parameters, resume=True)  # refuses another study's store
     engine = None
     try:
-        if args.serial:
-            mapper, where = serial_map_unordered, "this process (serial)"
-        else:
-            engine = StudyEngine(args.scheduler, args.workers, args.connect_timeout)
-            try:
-                engine.start()
-            except EngineUnavailable as error:
-                raise UsageError(str(error)) from None
-            mapper, where = engine.map_unordered, engine.description
+        engine, mapper, where = _start_engine(args)
         print(f"study {study.kind}: {len(study.chunks())} chunks on {where}", file=sys.stderr)
         run = run_into_store(study, parameters, args.out, mapper, resume=args.resume,
                              progress=progress)

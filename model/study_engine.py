@@ -19,6 +19,7 @@ Generic use (e.g. the Monte-Carlo study of :mod:`model.uncertainty` with a plugg
         results = engine.map(function, items)            # ordered list, like builtins.map
         for index, result in engine.map_unordered(function, items):  # as they finish
             ...
+        run_uncertainty(parameters, n, map_fn=in_order(engine.map_unordered))  # in order, live
 
 ``function`` must be picklable (a module-level function or a ``functools.partial`` of one) and
 pure: a task may run twice (after a worker death), and must give the same result.
@@ -165,3 +166,16 @@ def serial_map_unordered(function: Callable, items: Iterable) -> Iterator[tuple[
     """The same interface in this process, in order (the reference of the tests)."""
     for i, item in enumerate(items):
         yield i, function(item)
+
+
+def in_order(map_unordered):
+    """A ``map(function, items)`` that yields the results in the order of the items, each as soon
+    as it and all before it are finished (for callers that consume results in order)."""
+    def map_fn(function, items):
+        buffer, following = {}, 0
+        for index, result in map_unordered(function, list(items)):
+            buffer[index] = result
+            while following in buffer:
+                yield buffer.pop(following)
+                following += 1
+    return map_fn

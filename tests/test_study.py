@@ -210,3 +210,53 @@ def test_unreachable_scheduler_fails_within_timeout(capsys, tmp_path):
     assert f"cannot reach the Dask scheduler at tcp://127.0.0.1:{port}" in err
     assert elapsed < 15  # 2 s time-out plus start-up; never a hang
     assert not (tmp_path / "l.zarr").exists()
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--samples", "3"], "must be a power of 2"),
+    (["--samples", "0"], "--samples"),
+    (["--samples", "4", "--workers", "0"], "--workers"),
+])
+def test_uncertainty_study_bad_input(capsys, tmp_path, args, message):
+    """``bogie study uncertainty``: one line, exit 2, nothing written, no cluster started."""
+    out = tmp_path / "u.json"
+    try:  # option values are refused by argparse (SystemExit), the rest by the command
+        code, _, err = _cli(capsys, "study", "uncertainty", *args, "--out", str(out))
+    except SystemExit as stop:
+        code, err = stop.code, capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1
+    assert message in err
+    assert not out.exists()
+
+
+def test_uncertainty_study_unreachable_scheduler(capsys, tmp_path):
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    code, _, err = _cli(capsys, "study", "uncertainty", "--samples", "2", "--out",
+                        str(tmp_path / "u.json"), "--scheduler", f"tcp://127.0.0.1:{port}",
+                        "--connect-timeout", "2")
+    assert code == 2
+    assert err.count("\n") == 1
+    assert "cannot reach the Dask scheduler" in err
+    assert not (tmp_path / "u.json").exists()
+
+
+def test_in_order_yields_in_item_order_as_soon_as_possible():
+    """The ordered view of an unordered map: results in item order, none held back longer than
+    the earlier items it waits for."""
+    from model.study_engine import in_order
+
+    seen = []
+
+    def unordered(function, items):
+        for i in (2, 0, 1, 4, 3):
+            seen.append(i)
+            yield i, function(items[i])
+
+    out = []
+    for value in in_order(unordered)(lambda x: 10 * x, [0, 1, 2, 3, 4]):
+        out.append((value, len(seen)))
+    # 0 is ready after two finished tasks, 1 and 2 after three, 3 and 4 after five
+    assert out == [(0, 2), (10, 3), (20, 3), (30, 5), (40, 5)]

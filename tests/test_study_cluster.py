@@ -189,3 +189,21 @@ def test_ctrl_c_with_the_local_cluster_stops_everything_cleanly(tmp_path):
                              text=True, timeout=600)
     assert resumed.returncode == 0, resumed.stderr
     assert json.loads(resumed.stdout)["computed_chunks"] == 6 - finished
+
+
+def test_uncertainty_study_on_the_cluster_equals_serial(cluster):
+    """The Monte-Carlo/Sobol study of model.uncertainty through the engine (the map used by
+    ``bogie study uncertainty``) gives exactly the serial samples and outputs (two uncertain
+    parameters, n = 2: 8 model runs)."""
+    from model.study_engine import in_order
+    from model.uncertainty import UNCERTAIN_PARAMETERS, run_uncertainty
+
+    parameters = load_parameters()
+    uncertain = UNCERTAIN_PARAMETERS[:2]
+    serial = run_uncertainty(parameters, 2, uncertain, chunk_size=1, n_resamples=9)
+    with StudyEngine(scheduler=cluster, connect_timeout=30) as engine:
+        on_cluster = run_uncertainty(parameters, 2, uncertain, chunk_size=1, n_resamples=9,
+                                     map_fn=in_order(engine.map_unordered))
+    assert np.array_equal(on_cluster.samples, serial.samples)
+    assert np.array_equal(on_cluster.values, serial.values, equal_nan=True)
+    assert np.array_equal(on_cluster.first_order, serial.first_order, equal_nan=True)
