@@ -2,7 +2,7 @@
 variants, memory over a soak, and a fuzz of query strings, control values and uploaded files.
 
     .venv/bin/python scripts/reliability_app.py [--sessions 20] [--soak-minutes 10]
-                                                [--fuzz 200] [--json FILE]
+                                                [--fuzz 50] [--json FILE]
 
 Starts ``bogie serve`` on a free port (a separate process, as users run it) and talks to it with
 Bokeh's protocol client (``bokeh.client``: the same messages a browser sends, no rendering):
@@ -16,10 +16,11 @@ Bokeh's protocol client (``bokeh.client``: the same messages a browser sends, no
    every 10 s; reported: start (after the first minute), end, maximum, growth per minute over
    the second half;
 3. fuzz: ``--fuzz`` random query strings (NaN, huge, negative, wrong types, unknown names,
-   oversized and malformed variants) must each give HTTP 200 (a page with a notice, never a
-   server error); bad slider values (NaN, ±1e300, strings) and bad uploads (malformed, not
-   UTF-8, oversized, NaN, wrong types) sent through a session must leave it working (a valid
-   change afterwards still gives new results) and the server alive (liveness 200).
+   oversized and malformed variants; each GET builds a session on the server) must each give
+   HTTP 200 (a page with a notice, never a server error); bad slider values (NaN, ±1e300,
+   strings) and bad uploads (malformed, not UTF-8, oversized, NaN, wrong types) sent through a
+   session must leave it working (a valid change afterwards still gives new results) and the
+   server alive (liveness 200).
 
 The functions are also used by ``tests/test_app_reliability.py`` with short settings.
 """
@@ -369,7 +370,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--sessions", type=int, default=20)
     parser.add_argument("--soak-minutes", type=float, default=10.0)
-    parser.add_argument("--fuzz", type=int, default=200)
+    parser.add_argument("--fuzz", type=int, default=50)
     parser.add_argument("--json", default=None, help="write the results here")
     args = parser.parse_args()
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
