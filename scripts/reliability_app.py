@@ -128,9 +128,7 @@ def _wait_change(session, sources, action, timeout: float = 300.0) -> float:
         callbacks.append((source, changed))
     t0 = time.perf_counter()
     action()
-    deadline = t0 + timeout
-    session._connection._loop_until(
-        lambda: len(seen) == len(sources) or time.perf_counter() > deadline)
+    _run_until(session, lambda: len(seen) == len(sources), timeout)
     for source, changed in callbacks:
         source.remove_on_change("data", changed)
     if len(seen) < len(sources):
@@ -138,10 +136,22 @@ def _wait_change(session, sources, action, timeout: float = 300.0) -> float:
     return time.perf_counter() - t0
 
 
-def _pause(session, seconds: float) -> None:
-    """Let the client's event loop run (receive messages) for ``seconds``."""
-    until = time.monotonic() + seconds
-    session._connection._loop_until(lambda: time.monotonic() > until)
+def _run_until(session, predicate, timeout: float) -> None:
+    """Run the client's event loop until ``predicate()`` or ``timeout`` [s].  Bokeh's client
+    checks the predicate only when a message arrives: a timer stops the loop otherwise."""
+    connection = session._connection
+    loop = connection._loop
+    handle = loop.call_later(timeout, loop.stop)
+    try:
+        connection._loop_until(predicate)
+    finally:
+        loop.remove_timeout(handle)
+
+
+def _pause(_session, seconds: float) -> None:
+    """Wait ``seconds``; messages arriving meanwhile are read by the next :func:`_run_until`."""
+    if seconds > 0:
+        time.sleep(seconds)
 
 
 def _release(slider, value) -> None:
