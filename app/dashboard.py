@@ -477,8 +477,7 @@ class BogieDashboard(pn.viewable.Viewer):
                     if locus_future is not None:
                         _ignore_outcome(locus_future)
                     continue
-                self._post(doc, self._apply_fast, state,
-                                                   fast)
+                self._post(doc, self._apply_fast, state, fast)
                 if self._dirty:
                     if locus_future is not None:
                         _ignore_outcome(locus_future)  # it still fills the cache
@@ -487,13 +486,11 @@ class BogieDashboard(pn.viewable.Viewer):
                     try:
                         locus = await locus_future
                     except MODEL_ERRORS as error:
-                        self._post(doc, self._reject,
-                                                           error)
+                        self._post(doc, self._reject, error)
                         continue
                     if self._dirty:
                         continue
-                    self._post(doc, self._apply_locus,
-                                                       state, locus)
+                    self._post(doc, self._apply_locus, state, locus)
                     dense = loop.run_in_executor(EXECUTOR, self._dense_if_current, state)
                     dense.add_done_callback(partial(self._dense_done, doc, state))
                 # s0*(v) (≈ 0.7 s) is not waited for: a change arriving meanwhile starts at
@@ -523,32 +520,27 @@ class BogieDashboard(pn.viewable.Viewer):
         return self._dense_locus(state) if self.state().locus_key == state.locus_key else None
 
     def _dense_done(self, doc, state: State, future) -> None:
-        if future.cancelled() or self.state().locus_key != state.locus_key:
-            return  # superseded: another sweep is shown
-        error = future.exception()
-        if error is not None:
-            if isinstance(error, MODEL_ERRORS):
-                self._post(doc, self._reject, error)
-            else:
-                log.error("dense root locus failed", exc_info=error)
-            return
-        if future.result() is not None:
-            self._post(doc, self._apply_locus, state,
-                                               future.result())
+        self._background_done(doc, state, future, "dense root locus", self._apply_locus,
+                              lambda: self.state().locus_key == state.locus_key)
 
     def _limit_done(self, doc, state: State, future) -> None:
-        if future.cancelled() or not self._limit_current(state):
-            return  # superseded: another speed, wheel force, motor slope or rail is shown
+        self._background_done(doc, state, future, "stability limit", self._apply_limit,
+                              lambda: self._limit_current(state))
+
+    def _background_done(self, doc, state: State, future, what: str, apply, current) -> None:
+        """A background result (``None``: skipped) is shown with ``apply(state, result)`` if
+        ``current()`` still holds (nothing otherwise: another speed, sweep … is shown)."""
+        if future.cancelled() or not current():
+            return
         error = future.exception()
         if error is not None:
             if isinstance(error, MODEL_ERRORS):
                 self._post(doc, self._reject, error)
             else:
-                log.error("stability limit failed", exc_info=error)
+                log.error("%s failed", what, exc_info=error)
             return
         if future.result() is not None:
-            self._post(doc, self._apply_limit, state,
-                                               future.result())
+            self._post(doc, apply, state, future.result())
 
     def run_locked(self, function, *args) -> None:
         """Run ``function(*args)`` with the session's document lock: served, on the next tick
