@@ -75,7 +75,14 @@ from .operating_point import (
     motor_torque,
 )
 from .outputs import output_matrices
-from .response import LIMITED, MAX_POINTS, MAX_T_END, LimitCrossing, ResponseError, ShortCircuit
+from .response import (
+    LIMITED,
+    MAX_POINTS,
+    LimitCrossing,
+    ResponseError,
+    ShortCircuit,
+    time_grid_points,
+)
 
 CREEP_MODELS = ("nonlinear", "tangent")
 BLOCK_STEPS = 2048  # steps per compiled block (modal states of a block: ≈ 6 MB)
@@ -219,22 +226,6 @@ class NonlinearResult:
 
 # --- the computation --------------------------------------------------------------------------------
 
-def _check_grid(t_end, fs) -> int:
-    for label, value in (("t_end", t_end), ("fs", fs)):
-        if isinstance(value, bool) or not isinstance(value, int | float) \
-                or not math.isfinite(value) or value <= 0:
-            raise NonlinearError(f"{label} = {value!r} is not allowed: must be a positive number")
-    if t_end > MAX_T_END:
-        raise NonlinearError(f"t_end = {t_end} s is not allowed: at most {MAX_T_END:g} s")
-    n_points = round(t_end * fs) + 1
-    if n_points > MAX_POINTS:
-        raise NonlinearError(f"t_end × fs = {t_end * fs:.0f} samples is too many: at most "
-                             f"{MAX_POINTS - 1}")
-    if n_points < 3:
-        raise NonlinearError(f"t_end × fs = {t_end * fs:g}: fewer than 2 samples")
-    return n_points
-
-
 @dataclass(frozen=True)
 class _Setup:
     """Per (model, operating point, step) pieces of the stepping (built once, cached)."""
@@ -334,7 +325,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
                              "[N m]")
     if isinstance(substeps, bool) or not isinstance(substeps, int) or not 1 <= substeps <= 64:
         raise NonlinearError(f"substeps = {substeps!r} is not allowed: a whole number 1…64")
-    n_points = _check_grid(t_end, fs)
+    n_points = time_grid_points(t_end, fs, NonlinearError)
     n_steps = (n_points - 1) * substeps
     if n_steps + 1 > 4 * MAX_POINTS:
         raise NonlinearError("t_end × fs × substeps is too many steps")

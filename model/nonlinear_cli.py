@@ -158,15 +158,9 @@ def summary_table(result) -> str:
     for name, y in result.motor_torques.items():
         lines.append(f"{name}: from {y[0]:.5g} to {y[-1]:.5g} N m (min {y.min():.5g}, max "
                      f"{y.max():.5g})")
-    lines += ["", "limits: " + ", ".join(f"{k} = {v:.5g}" for k, v in result.limits.items())]
-    if result.limit_crossings:
-        lines.append("limit crossings (|total| > limit), first time:")
-        for c in result.limit_crossings:
-            lines.append(f"  {c.time:8.4f} s  {c.output} = {c.value:.5g} beyond {c.limit_name} = "
-                         f"{c.limit:.5g}")
-    else:
-        lines.append("no limit crossed")
-    return "\n".join(lines)
+    from .response_cli import limit_lines  # (response_cli imports this module)
+
+    return "\n".join(lines + limit_lines(result))
 
 
 def write_result(result, path: Path) -> None:

@@ -421,6 +421,23 @@ LIMITED = (("disc_clutch.torque", "M_ad"), ("claw_clutch.torque", "M_ad"),
            ("creep_force", "mu_max N0"))
 
 
+def time_grid_points(t_end, fs, error: type[ResponseError] = ResponseError) -> int:
+    """Samples of the grid t = k/fs, k = 0 … round(t_end fs) (t_end [s], fs [Hz]); a bad value
+    raises ``error`` with a one-line message."""
+    for label, value in (("t_end", t_end), ("fs", fs)):
+        if isinstance(value, bool) or not isinstance(value, int | float) \
+                or not math.isfinite(value) or value <= 0:
+            raise error(f"{label} = {value!r} is not allowed: must be a positive number")
+    if t_end > MAX_T_END:
+        raise error(f"t_end = {t_end} s is not allowed: at most {MAX_T_END:g} s")
+    n_points = round(t_end * fs) + 1
+    if n_points > MAX_POINTS:
+        raise error(f"t_end × fs = {t_end * fs:.0f} samples is too many: at most {MAX_POINTS - 1}")
+    if n_points < 3:
+        raise error(f"t_end × fs = {t_end * fs:g}: fewer than 2 samples")
+    return n_points
+
+
 def short_circuit_response(model: BogieModel, op: OperatingPoint,
                            excitation: ShortCircuit | None = None, t_end: float = 2.0,
                            fs: float = 10_000.0, outputs: list[str] | None = None,
@@ -431,18 +448,7 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
     ``t = k/fs``, k = 0 … round(t_end fs)); ``outputs`` names (default: all loads of both drives).
     """
     excitation = ShortCircuit() if excitation is None else excitation
-    for label, value in (("t_end", t_end), ("fs", fs)):
-        if isinstance(value, bool) or not isinstance(value, int | float) \
-                or not math.isfinite(value) or value <= 0:
-            raise ResponseError(f"{label} = {value!r} is not allowed: must be a positive number")
-    if t_end > MAX_T_END:
-        raise ResponseError(f"t_end = {t_end} s is not allowed: at most {MAX_T_END:g} s")
-    n_points = round(t_end * fs) + 1
-    if n_points > MAX_POINTS:
-        raise ResponseError(f"t_end × fs = {t_end * fs:.0f} samples is too many: at most "
-                            f"{MAX_POINTS - 1}")
-    if n_points < 3:
-        raise ResponseError(f"t_end × fs = {t_end * fs:g}: fewer than 2 samples")
+    n_points = time_grid_points(t_end, fs)
     matrices = output_matrices(model, op)
     names = list(matrices.names) if outputs is None else list(outputs)
     if not names:

@@ -144,15 +144,19 @@ def summary_table(result) -> str:
         lines.append(f"{name:<30} {result.units[name]:<4} {result.steady[name]:>11.4g} "
                      f"{result.peaks[name]:>11.4g} {result.peak_times[name]:>8.4f} "
                      f"{result.perturbation_peaks[name]:>11.4g}  {freqs}")
-    lines += ["", "limits: " + ", ".join(f"{k} = {v:.5g}" for k, v in result.limits.items())]
-    if result.limit_crossings:
-        lines.append("limit crossings (|total| > limit), first time:")
-        for c in result.limit_crossings:
-            lines.append(f"  {c.time:8.4f} s  {c.output} = {c.value:.5g} beyond {c.limit_name} = "
-                         f"{c.limit:.5g}")
-    else:
-        lines.append("no limit crossed")
-    return "\n".join(lines)
+    return "\n".join(lines + limit_lines(result))
+
+
+def limit_lines(result) -> list[str]:
+    """The limits and their first crossings of a (linear or nonlinear) response, as text lines."""
+    lines = ["", "limits: " + ", ".join(f"{k} = {v:.5g}" for k, v in result.limits.items())]
+    if not result.limit_crossings:
+        return [*lines, "no limit crossed"]
+    lines.append("limit crossings (|total| > limit), first time:")
+    for c in result.limit_crossings:
+        lines.append(f"  {c.time:8.4f} s  {c.output} = {c.value:.5g} beyond {c.limit_name} = "
+                     f"{c.limit:.5g}")
+    return lines
 
 
 def write_result(result, path: Path) -> None:
