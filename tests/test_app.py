@@ -226,8 +226,9 @@ def test_render_whole_layout(dash):
         assert f"ctl-{name}" in classes, name
     assert "stability-status" in classes
     plots = [model for model in models if isinstance(model, Plot)]
-    # locus, creep, 2 torques, forces, M_C, side and top view, Fig. 6 (Im, Re, real), variant s0*
-    assert len(plots) == 12
+    # locus, creep, 2 torques, forces, M_C, side and top view, Fig. 6 (Im, Re, real), variant s0*,
+    # sensitivity tornado, study heat map
+    assert len(plots) == 14
     assert {"root-locus", "fig6-im", "fig6-re", "fig6-real", "variant-limits"} <= {
         p.name for p in plots}
     titled = {model.title for model in models if getattr(model, "css_classes", None)

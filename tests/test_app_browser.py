@@ -39,8 +39,9 @@ def test_page_loads_plots_render_and_published_cases_flip(app_server, chromium):
     OUTPUT.mkdir(exist_ok=True)
     page = open_app(chromium, app_server)
     page.locator(".stability-status", has_text="STABLE").wait_for(timeout=60_000)
-    # locus, creep, 2 torques, forces, M_C, 2 mode views, Fig. 6 (3), variant s0*(v)
-    assert page.evaluate(PLOTS) == 12
+    # locus, creep, 2 torques, forces, M_C, 2 mode views, Fig. 6 (3), variant s0*(v), sensitivity
+    # tornado, study heat map
+    assert page.evaluate(PLOTS) == 14
     # every plot on screen has a canvas with a size: the locus and the Response tab (creep,
     # 2 torques, forces, M_C); the other tabs' plots are drawn when their tab is opened
     sizes = page.locator("canvas").evaluate_all("cs => cs.map(c => c.width * c.height)")
