@@ -18,7 +18,9 @@ from __future__ import annotations
 
 import html
 import logging
+import weakref
 from concurrent.futures import ThreadPoolExecutor
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from functools import partial
 
@@ -45,6 +47,33 @@ PATH_POINTS = 1500  # points of each wheel's creepage path sent to the browser
 # it starts is skipped
 HISTORY_EXECUTOR = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bogie-nonlinear")
 REACTION_EXECUTOR = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bogie-reaction")
+# the views alive in this process: a reaction search that no view wants any more (superseded by
+# another operating point, or its session closed) stops between its runs instead of holding the
+# shared worker and the CPU for tens of seconds
+_VIEWS: weakref.WeakSet = weakref.WeakSet()
+
+
+class ReactionSuperseded(Exception):
+    """A reaction search stopped because no session wants its result any more."""
+
+
+_WATCHED: ContextVar[bool] = ContextVar("bogie_reaction_watched", default=False)
+
+
+def _stop_unless_wanted(key: tuple) -> None:
+    if _WATCHED.get() and not any(view._reaction_key == key for view in list(_VIEWS)):
+        raise ReactionSuperseded(key)
+
+
+def wanted_reaction(*key) -> Reaction:
+    """:func:`reaction` for the dashboard's views: it stops (ReactionSuperseded) as soon as no
+    live view wants ``key`` any more — checked before it starts and after every run of its
+    delay grid.  Called directly, :func:`reaction` always completes."""
+    token = _WATCHED.set(True)
+    try:
+        return reaction(*key)
+    finally:
+        _WATCHED.reset(token)
 
 
 @dataclass(frozen=True)
@@ -115,11 +144,14 @@ def reaction(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
              rate: float) -> Reaction:
     """Required reaction time against M_ad (model.antislip) on a coarse grid: 11 delays,
     5 kHz, 2 s — about 20 nonlinear runs."""
+    key = (params_path, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, threshold, rate)
+    _stop_unless_wanted(key)
     m = compute.model(params_path, rail)
     op = compute.operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
     result = required_reaction_time(
         m, op, _excitation(M0_kNm, f, D, dt_ms), anti_slip=AntiSlip(True, 0.1, threshold, rate),
-        delays=REACTION_DELAYS, t_end=2.0, fs=max(REACTION_FS, 20.0 * float(f)))
+        delays=REACTION_DELAYS, t_end=2.0, fs=max(REACTION_FS, 20.0 * float(f)),
+        progress=lambda _text: _stop_unless_wanted(key))  # after each run of the delay grid
     return Reaction(result.required_delay, result.reason, result.detection_time,
                     result.reaction_after_fault, result.limit)
 
@@ -159,6 +191,10 @@ class NonlinearView:
         self._shown_key = None
         self._reaction_key = None
         self._progress = ""
+        _VIEWS.add(self)
+        doc = self._served_doc()
+        if doc is not None:  # a closed session wants no reaction time any more
+            doc.on_session_destroyed(lambda _context: setattr(self, "_reaction_key", None))
         self._add_glyphs()
         for widget in (self.creep, self.anti_slip, self.delay, self.threshold, self.rate):
             widget.param.watch(self._on_change, "value")
@@ -267,7 +303,7 @@ class NonlinearView:
             return
         self._reaction_key = key
         self.reaction = None
-        self._start(key, partial(reaction, *key), self._apply_reaction)
+        self._start(key, partial(wanted_reaction, *key), self._apply_reaction)
 
     def _start(self, key, work, apply) -> None:
         doc = self._served_doc()
@@ -295,6 +331,8 @@ class NonlinearView:
 
     def _done(self, doc, key, apply, future) -> None:
         error = future.exception()
+        if isinstance(error, ReactionSuperseded):
+            return  # no longer wanted (module comment at _VIEWS)
         if error is not None:
             if not isinstance(error, ValueError | np.linalg.LinAlgError):
                 log.error("nonlinear computation failed", exc_info=error)

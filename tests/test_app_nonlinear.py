@@ -111,3 +111,17 @@ def test_reaction_is_cached_plain_data():
     first = reaction(*key)
     assert reaction(*key) is first
     assert first.limit > 0
+
+
+def test_a_reaction_search_no_session_wants_stops_at_once():
+    """A reaction-time search whose key no live view wants (superseded, or its session closed)
+    stops before its first nonlinear run instead of holding the shared worker for ≈ 20 runs."""
+    import time
+
+    from app.nonlinear_view import ReactionSuperseded, wanted_reaction
+
+    start = time.perf_counter()
+    with pytest.raises(ReactionSuperseded):
+        wanted_reaction("", "calibrated", 0.01371, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None,
+                        0.3, 10.0)
+    assert time.perf_counter() - start < 5.0  # no nonlinear run (each ≈ 0.5 s) was started
