@@ -19,8 +19,10 @@ import subprocess
 from importlib import metadata
 from pathlib import Path
 
+from bokeh.document import Document
 from bokeh.embed import components
 from bokeh.embed.bundle import bundle_for_objs_and_resources
+from bokeh.io.doc import patch_curdoc
 from bokeh.layouts import column, row
 from bokeh.resources import INLINE
 
@@ -110,7 +112,12 @@ def build_report(set_key: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
                            row(*responses.figures[2:], sizing_mode="stretch_width"),
                            sizing_mode="stretch_width"),
     }
-    script, divs = components(figures)
+    # bokeh's embedding asks curdoc() for its settings; in a served callback that can be another
+    # session's document (bokeh keeps one global stack of patched documents for all threads),
+    # destroyed by the time it is read: give it a fresh one of its own
+    fresh = Document()
+    with patch_curdoc(fresh):
+        script, divs = components(figures)
     # only what these figures need, inline: BokehJS and its styles as text.  Files to load
     # (``bundle.js_files``: Panel adds its module shim to every bundle once imported) are left
     # out: they would be fetched from a server, and plain Bokeh figures do not use them

@@ -80,6 +80,36 @@ def app_server():
     thread.stop()
 
 
+@pytest.fixture(scope="module")
+def own_server(tmp_path_factory):
+    """(base URL, process id) of a ``bogie serve`` process started for one test module: a fresh
+    server as a reviewer gets it, sharing no state (sessions, caches, background work, Bokeh's
+    and Panel's process-wide settings) with the tests that ran before in this process."""
+    import socket
+    import subprocess
+    import sys
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    log = tmp_path_factory.mktemp("server") / "serve.log"
+    with open(log, "w") as stderr:
+        process = subprocess.Popen([sys.executable, "-m", "model", "serve", "--port", str(port)],
+                                   cwd=Path(__file__).resolve().parent.parent,
+                                   stdout=subprocess.DEVNULL, stderr=stderr,
+                                   env={**os.environ, "OPENBLAS_NUM_THREADS": "1"})
+    url = f"http://127.0.0.1:{port}"
+    try:
+        wait_for_liveness(url, timeout=180)
+        yield url, process.pid
+    finally:
+        process.terminate()
+        try:
+            process.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            process.kill()
+
+
 @pytest.fixture(scope="session")
 def chromium():
     """A headless Chromium (Debian's binary) driven by Playwright."""

@@ -4,12 +4,17 @@
 Through Bokeh's protocol client (the messages a browser sends, no rendering): concurrent
 sessions with different design variants each see their own results; bad query strings, bad
 slider values and bad uploads give notices only, the session keeps working and the server stays
-alive; a short soak reports the server's memory (it is in this process here).
+alive; a short soak reports the server's memory.
+
+The server is a ``bogie serve`` process of its own, started for this module (``own_server``):
+a fresh server (not the one the other served tests have been loading with sessions and
+background work), whose memory is its own.
 """
 
 from __future__ import annotations
 
 import importlib.util
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -17,6 +22,13 @@ import pytest
 pytestmark = pytest.mark.slow
 
 SCRIPT = Path(__file__).resolve().parent.parent / "scripts" / "reliability_app.py"
+
+
+def in_thread(function, *args, **kwargs):
+    """Run Bokeh's protocol client in a thread of its own: an asyncio loop left running in this
+    thread by an earlier test (Playwright's) makes bokeh.client refuse to run its own."""
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        return pool.submit(function, *args, **kwargs).result()
 
 
 @pytest.fixture(scope="module")
@@ -27,29 +39,30 @@ def reliability():
     return module
 
 
-def test_concurrent_sessions_with_different_variants_see_their_own(app_server, reliability):
-    result = reliability.isolation(app_server, sessions=4)
+def test_concurrent_sessions_with_different_variants_see_their_own(own_server, reliability):
+    result = in_thread(reliability.isolation, own_server[0], sessions=4)
     assert result["failures"] == []
     assert result["own_results"] == result["answered"] == 4
     assert result["distinct"] == 4
 
 
-def test_fuzz_of_queries_values_and_uploads(app_server, reliability):
-    queries = reliability.fuzz_queries(app_server, count=15)
+def test_fuzz_of_queries_values_and_uploads(own_server, reliability):
+    queries = in_thread(reliability.fuzz_queries, own_server[0], count=15)
     assert queries["statuses"] == {200: 15}, queries["failures"]
     assert queries["alive_after"]
-    session = reliability.fuzz_session(app_server)
+    session = in_thread(reliability.fuzz_session, own_server[0])
     assert session["bad_inputs_sent"] > 10
     assert session["session_still_working"]
     assert session["alive_after"]
 
 
-def test_short_soak_memory(app_server, reliability):
+def test_short_soak_memory(own_server, reliability):
     """20 s of a control changed every second (the 10-minute run is the script's).  Bound:
-    the process (server and tests) grows by less than 200 MB — caches are bounded
+    the server process grows by less than 200 MB — caches are bounded
     (pn.cache max_items), so a leak per change would show as steady growth long before that
     in the long run; here the check is that nothing explodes and the changes are answered."""
-    result = reliability.soak(app_server, None, minutes=20 / 60, sample_every=5.0)
+    result = in_thread(reliability.soak, own_server[0], own_server[1], minutes=20 / 60,
+                       sample_every=5.0)
     assert result["changes"] >= 10
     assert result["timeouts"] == 0
     assert result["rss_end_mb"] - result["samples"][0][1] < 200

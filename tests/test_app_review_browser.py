@@ -28,13 +28,13 @@ def _tab(page, title: str) -> None:
     page.wait_for_timeout(500)
 
 
-def test_shared_link_restores_state_dense_locus_and_fig6(app_server, chromium):
+def test_shared_link_restores_state_dense_locus_and_fig6(own_server, chromium):
     query = "s0=0.014&v=200&n0=100000&bm=3000&m0=50000&f=90&decay=0.04&t_end=2&tab=fig-6"
     page = chromium.new_page(viewport={"width": 1600, "height": 1000})
     errors: list[str] = []
     page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
     page.on("pageerror", lambda e: errors.append(str(e)))
-    page.goto(f"{app_server}/app?{query}", timeout=120_000)
+    page.goto(f"{own_server[0]}/app?{query}", timeout=120_000)
     page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0", timeout=120_000)
     # the controls show the link's values (N0 in kN, M0 in kN m on the sliders)
     page.wait_for_function(f"() => ({WIDGET_VALUE})('ctl-v') === 200", timeout=120_000)
@@ -66,9 +66,9 @@ def test_shared_link_restores_state_dense_locus_and_fig6(app_server, chromium):
     page.close()
 
 
-def test_bad_link_gives_a_notice_and_the_defaults(app_server, chromium):
+def test_bad_link_gives_a_notice_and_the_defaults(own_server, chromium):
     page = chromium.new_page(viewport={"width": 1600, "height": 1000})
-    page.goto(f"{app_server}/app?s0=nan&v=fast&variant=gear_ratio:-1&tab=nowhere",
+    page.goto(f"{own_server[0]}/app?s0=nan&v=fast&variant=gear_ratio:-1&tab=nowhere",
               timeout=120_000)
     page.locator(".input-notice", has_text="not used").wait_for(timeout=120_000)
     for name in ("s0 = nan", "v = 'fast'", "gear_ratio", "tab = 'nowhere'"):
@@ -79,10 +79,10 @@ def test_bad_link_gives_a_notice_and_the_defaults(app_server, chromium):
     page.close()
 
 
-def test_variant_upload_comparison_click_through_and_report(app_server, chromium, tmp_path):
+def test_variant_upload_comparison_click_through_and_report(own_server, chromium, tmp_path):
     from model.parameters import dumps_parameters, load_parameters
 
-    page = open_app(chromium, app_server)
+    page = open_app(chromium, own_server[0])
     page.errors.clear()
     page.locator(".stability-status", has_text="STABLE").wait_for(timeout=120_000)
 
