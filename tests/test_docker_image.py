@@ -104,7 +104,9 @@ def test_liveness_endpoint_answers_200(served):
 
 def test_app_page_holds_the_bokeh_document(served):
     """/app is Bokeh's server page (its document follows over the websocket): pull it."""
-    import panel  # noqa: F401 - registers Panel's model types for deserialization
+    # Panel's model types for deserialization, the mode table's DataTabulator too (not loaded
+    # by ``import panel`` alone)
+    import panel.models.tabulator  # noqa: F401
     from bokeh.client import pull_session
 
     base, _, _ = served
