@@ -19,7 +19,6 @@ from __future__ import annotations
 import html
 import logging
 import weakref
-from concurrent.futures import ThreadPoolExecutor
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from functools import partial
@@ -33,6 +32,7 @@ from model.nonlinear import AntiSlip, NonlinearError, nonlinear_response
 from model.response import ShortCircuit
 
 from . import compute
+from .workers import NONLINEAR_POOL, SEARCH_POOL
 
 log = logging.getLogger(__name__)
 CREEP_MODELS = ("linear", "nonlinear")
@@ -41,12 +41,6 @@ WHEEL_COLORS = {"ID1.rim12": "#8c564b", "ID1.rim14": "#e377c2", "ID2.rim12": "#1
 REACTION_DELAYS = np.linspace(0.0, 0.5, 11)  # [s] delay grid of the dashboard's reaction time
 REACTION_FS = 5_000.0  # [Hz] its sampling (the CLI's default is 10 kHz)
 PATH_POINTS = 1500  # points of each wheel's creepage path sent to the browser
-# workers of their own: the nonlinear runs (0.3-0.6 s) and the reaction times (≈ 20 runs each)
-# never hold up the dashboard's workers (the linear first answer stays as fast as before), and a
-# running reaction time never holds up the next nonlinear history; a request superseded before
-# it starts is skipped
-HISTORY_EXECUTOR = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bogie-nonlinear")
-REACTION_EXECUTOR = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bogie-reaction")
 # the views alive in this process: a reaction search that no view wants any more (superseded by
 # another operating point, or its session closed) stops between its runs instead of holding the
 # shared worker and the CPU for tens of seconds
@@ -319,7 +313,9 @@ class NonlinearView:
         def if_current():
             return work() if self._current(key, apply) else None
 
-        executor = REACTION_EXECUTOR if apply == self._apply_reaction else HISTORY_EXECUTOR
+        # workers of their own (app.workers), at a lower priority than the linear first answer;
+        # a request superseded before it starts is skipped
+        executor = SEARCH_POOL if apply == self._apply_reaction else NONLINEAR_POOL
         future = executor.submit(if_current)
         future.add_done_callback(partial(self._done, doc, key, apply))
 

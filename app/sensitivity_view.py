@@ -134,9 +134,9 @@ class SensitivityView:
             except Exception as error:
                 self._failed(key, error)
             return
-        from .dashboard import EXECUTOR
+        from .workers import SIDE_VIEW_POOL
 
-        future = EXECUTOR.submit(sensitivity_data, *key)
+        future = SIDE_VIEW_POOL.submit(sensitivity_data, *key)
 
         def done(f) -> None:
             if f.cancelled() or key != self._wanted:

@@ -281,10 +281,11 @@ class VariantView(pn.viewable.Viewer):
         if doc is None or doc.session_context is None:
             self._show(state, self._compute(state, base_key))
             return
-        from .dashboard import EXECUTOR, _ignore_outcome
+        from .dashboard import _ignore_outcome
+        from .workers import SIDE_VIEW_POOL
 
         self.table.object = "<i>⏳ comparing with the baseline…</i>"
-        future = EXECUTOR.submit(self._compute, state, base_key)
+        future = SIDE_VIEW_POOL.submit(self._compute, state, base_key)
         _ignore_outcome(future)
         future.add_done_callback(partial(self._done, doc, state))
 

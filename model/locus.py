@@ -28,6 +28,7 @@ The naive reference (:func:`dense_generalized_eigenvalues`) solves the generaliz
 
 from __future__ import annotations
 
+import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
@@ -137,18 +138,38 @@ class _Reduced:
                 / np.maximum(np.abs(lam), 1e-300))
 
 
-_POOLS: dict[int, ThreadPoolExecutor] = {}
+_POOLS: dict[tuple[int, int], ThreadPoolExecutor] = {}
 _POOLS_LOCK = threading.Lock()
 
 
+def thread_niceness() -> int:
+    """The scheduling niceness of the calling thread (Linux schedules threads one by one; 0
+    where that is not available)."""
+    try:
+        return os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+    except (AttributeError, OSError):
+        return 0
+
+
+def set_thread_niceness(niceness: int) -> None:
+    try:
+        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), niceness)
+    except (AttributeError, OSError):
+        pass  # another OS, or not allowed: the threads keep the process's priority
+
+
 def _solver_pool(workers: int) -> ThreadPoolExecutor:
-    """A persistent pool of ``workers`` threads per process, shared by all root loci (the
-    dashboard computes many; no threads are created and torn down per call)."""
+    """A persistent pool of ``workers`` threads per process and per caller's niceness, shared by
+    all root loci (the dashboard computes many; no threads are created and torn down per call).
+    The threads run at the niceness of the thread that asks (a root locus the dashboard computes
+    in the background must not take the cores from the answer to the next change)."""
+    niceness = thread_niceness()
     with _POOLS_LOCK:
-        if workers not in _POOLS:
-            _POOLS[workers] = ThreadPoolExecutor(max_workers=workers,
-                                                 thread_name_prefix="bogie-locus")
-        return _POOLS[workers]
+        if (workers, niceness) not in _POOLS:
+            _POOLS[workers, niceness] = ThreadPoolExecutor(
+                max_workers=workers, thread_name_prefix=f"bogie-locus-n{niceness}",
+                initializer=set_thread_niceness, initargs=(niceness,))
+        return _POOLS[workers, niceness]
 
 
 def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
