@@ -22,7 +22,6 @@ import json
 import logging
 import math
 import re
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -44,13 +43,15 @@ from .sensitivity_view import SensitivityView  # issue 12: sensitivity tornado
 from .serve import limit_blas_threads
 from .url_state import make_query, parse_query
 from .variant_view import VariantView
+from .workers import FIRST_ANSWER_POOL, FOLLOW_UP_POOL
 
 log = logging.getLogger(__name__)
+# the page loads the script of each extension model up front: the mode table (Tabulator) sits
+# in a tab that is sent to the browser only when opened
+pn.extension("tabulator")
 ASSETS = Path(__file__).resolve().parent.parent / "assets"
 MODEL_ERRORS = (OperatingPointError, ParameterError, NoStabilityLimit, ValueError,
                 np.linalg.LinAlgError)
-# worker threads shared by all sessions: computations release the GIL in LAPACK
-EXECUTOR = ThreadPoolExecutor(max_workers=3, thread_name_prefix="bogie-compute")
 BUSY_DELAY_MS = 400  # the "computing…" notice appears when a change takes longer [ms]
 BUSY_TEXT = '<div class="busy-text">⏳ computing…</div>'
 PUBLISHED_CASES = {"stable": 0.005, "unstable": 0.014}  # s0 at 120 km/h (the study's two cases)
@@ -147,6 +148,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self._shown_locus: tuple | None = None  # (locus key, dense?) of the locus on screen
         self.response: compute.ResponseView | None = None
         self.error = ""  # last rejection message ("" if the current parameters are valid)
+        self._pending_views: dict[tuple[str, str], tuple] = {}  # (tab, what) -> (function, args)
         self._dirty = False
         self._busy = False
         self._build()
@@ -281,7 +283,11 @@ class BogieDashboard(pn.viewable.Viewer):
         self.variant_view = VariantView(self)
         self.click = ModeClickThrough(self)  # tapped locus points and table rows -> mode views
         # the views below the status and the root locus, one tab each; other modules add theirs
-        # with ``self.tabs.append((title, view))``
+        # with ``self.tabs.append((title, view))``.  The views of a hidden tab are brought up to
+        # date when it is opened (``when_shown``): updating all of them at every change made the
+        # browser re-style and re-render the hidden views too.  (Panel's dynamic tabs would keep
+        # them out of the browser altogether, but a pane of a closed tab keeps its detached
+        # model, and its next update switched the stylesheets every pane shares to Panel's CDN.)
         self.tabs = pn.Tabs(
             ("Response", pn.Column(
                 pn.Row(bokeh_pane(self.creep_plot.figure), pn.Column(self.peaks, width=520),
@@ -368,8 +374,28 @@ class BogieDashboard(pn.viewable.Viewer):
                       + "; ".join(notices))
 
     def _tab_shown(self, *_events) -> None:
-        """Views that compute only while shown (the variant comparison) learn it here."""
-        self.variant_view.on_shown(self.tab_names[self.tabs.active] == "variant")
+        """Views that compute only while shown (the variant comparison) learn it here; the
+        updates a hidden view missed are applied."""
+        shown = self.tab_names[self.tabs.active]
+        self.variant_view.on_shown(shown == "variant")
+        self.flush_view(shown)
+
+    def when_shown(self, tab: str, function, *args) -> None:
+        """``function(*args)`` now if the view's tab (``tab_names``) is open or the dashboard is
+        not served, else when the tab is opened (of several calls of one function for a hidden
+        tab, the last one)."""
+        served = pn.state.curdoc is not None and pn.state.curdoc.session_context is not None
+        if not served or self.tab_names[self.tabs.active] == tab:
+            self._pending_views.pop((tab, function.__name__), None)
+            function(*args)
+        else:
+            self._pending_views[tab, function.__name__] = (function, args)
+
+    def flush_view(self, tab: str) -> None:
+        """Apply the updates the view ``tab`` missed while hidden, in the order they came."""
+        for key in [key for key in self._pending_views if key[0] == tab]:
+            function, args = self._pending_views.pop(key)
+            function(*args)
 
     def warn(self, text: str) -> None:
         """Show a notice about input that was not used (the previous state is kept)."""
@@ -468,10 +494,10 @@ class BogieDashboard(pn.viewable.Viewer):
                 # dense one replaces it when ready.  Nothing to do if the dense locus of this
                 # (set, rail, sweep, fixed value, N0, b_M) is on screen already
                 need_locus = self._shown_locus != (state.locus_key, True)
-                locus_future = (loop.run_in_executor(EXECUTOR, self._locus, state)
+                locus_future = (loop.run_in_executor(FIRST_ANSWER_POOL, self._locus, state)
                                 if need_locus else None)
                 try:
-                    fast = await loop.run_in_executor(EXECUTOR, self.compute_fast, state)
+                    fast = await loop.run_in_executor(FIRST_ANSWER_POOL, self.compute_fast, state)
                 except MODEL_ERRORS as error:
                     self._post(doc, self._reject, error)
                     if locus_future is not None:
@@ -491,11 +517,11 @@ class BogieDashboard(pn.viewable.Viewer):
                     if self._dirty:
                         continue
                     self._post(doc, self._apply_locus, state, locus)
-                    dense = loop.run_in_executor(EXECUTOR, self._dense_if_current, state)
+                    dense = loop.run_in_executor(FOLLOW_UP_POOL, self._dense_if_current, state)
                     dense.add_done_callback(partial(self._dense_done, doc, state))
                 # s0*(v) (≈ 0.7 s) is not waited for: a change arriving meanwhile starts at
                 # once; the limit is shown when ready if it still belongs to the parameters
-                limit = loop.run_in_executor(EXECUTOR, self._limit_if_current, state)
+                limit = loop.run_in_executor(FOLLOW_UP_POOL, self._limit_if_current, state)
                 limit.add_done_callback(partial(self._limit_done, doc, state))
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")
@@ -612,17 +638,22 @@ class BogieDashboard(pn.viewable.Viewer):
         self.creep_plot.update_point(point)
         self.response_plots.update(response)
         self._show_status()
+        self.peaks.object = peaks_html(response)
+        self.when_shown("modes", self._show_modes, point)
+        self.locus_plot.zoom(self.zoom == "low")
+        # issue 12: sensitivity tornado (computed when its tab is open, shown when ready)
+        self.when_shown("sensitivity", self.sensitivity.request, self, state)
+
+        self.nonlinear.on_fast(state)  # issue 10: the nonlinear result follows
+
+    def _show_modes(self, point: compute.PointResult) -> None:
+        """The Modes tab: eigenvalue table, mode table, mode choice and the selected mode."""
         self.eigen_table.object = eigen_table_html(point)
         self.click.table.update(point)
-        self.peaks.object = peaks_html(response)
         self.mode_select.options = {f"ν = {m.number}: {m.im_hz:.3f} Hz — {m.description}"[:90]:
                                     m.number for m in point.modes}
         self.mode_select.value = min(self.mode, len(point.modes))
         self._on_mode()
-        self.locus_plot.zoom(self.zoom == "low")
-        self.sensitivity.request(self, state)  # issue 12: sensitivity tornado (when ready)
-
-        self.nonlinear.on_fast(state)  # issue 10: the nonlinear result follows
 
     def _apply_slow(self, state: State, slow) -> None:
         limit, locus = slow
@@ -632,7 +663,7 @@ class BogieDashboard(pn.viewable.Viewer):
     def _apply_limit(self, state: State, limit: compute.LimitResult) -> None:
         self.limit, self._limit_for = limit, (state.rail, state.v, state.N0, state.b_M)
         self.creep_plot.update_limit(limit)
-        self.fig6.update_limit(limit.s0_limit)
+        self.when_shown("fig-6", self.fig6.update_limit, limit.s0_limit)
         self._show_status()
 
     def _apply_locus(self, state: State, locus: compute.LocusResult) -> None:
@@ -641,7 +672,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.locus_result = locus
         self._shown_locus = (state.locus_key, locus.dense)
         self.locus_plot.update_locus(locus)
-        self.fig6.update_locus(locus)
+        self.when_shown("fig-6", self.fig6.update_locus, locus)
         self.locus_plot.zoom(self.zoom == "low")
 
     def _show_status(self) -> None:

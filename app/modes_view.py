@@ -110,6 +110,7 @@ class ModeClickThrough:
 
     def select(self, number: int) -> None:
         """Show mode ν = ``number`` of the current operating point."""
+        self.dashboard.flush_view("modes")  # the tables and views of the current point first
         point = self.dashboard.point
         if point is None or not 1 <= number <= len(point.modes):
             return
@@ -134,6 +135,7 @@ class ModeClickThrough:
         """Show the mode of the root-locus point ``index`` (of the points source): the mode
         nearest to that eigenvalue at that value of the swept parameter."""
         dashboard = self.dashboard
+        dashboard.flush_view("modes")  # the tables and views of the current point first
         data = dashboard.locus_plot.points.data
         locus = dashboard.locus_result
         if locus is None or not 0 <= index < len(data["x"]):
