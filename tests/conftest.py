@@ -130,6 +130,8 @@ def open_app(browser, url: str, timeout_ms: float = 120_000, viewport=(1600, 100
     errors: list[str] = []
     page.on("console", lambda m: errors.append(f"console: {m.text}") if m.type == "error" else None)
     page.on("pageerror", lambda e: errors.append(f"pageerror: {e}"))
+    # which resource failed (the console message does not say)
+    page.on("requestfailed", lambda r: errors.append(f"requestfailed: {r.url} ({r.failure})"))
     page.errors = errors
     page.goto(f"{url}/app", timeout=timeout_ms)
     page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0",
