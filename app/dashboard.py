@@ -46,9 +46,6 @@ from .variant_view import VariantView
 from .workers import FIRST_ANSWER_POOL, FOLLOW_UP_POOL
 
 log = logging.getLogger(__name__)
-# the page loads the script of each extension model up front: the mode table (Tabulator) sits
-# in a tab that is sent to the browser only when opened
-pn.extension("tabulator")
 ASSETS = Path(__file__).resolve().parent.parent / "assets"
 MODEL_ERRORS = (OperatingPointError, ParameterError, NoStabilityLimit, ValueError,
                 np.linalg.LinAlgError)

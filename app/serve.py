@@ -40,15 +40,6 @@ def create_app(params: str | None = None):
 
     from .dashboard import BogieDashboard
 
-    doc = pn.state.curdoc
-    if doc is not None and doc.session_context is not None:
-        from panel.io.resources import get_dist_path
-
-        # Panel gives a session's document the address of its own static files only when it
-        # renders the page; a pane that re-renders before that (the first results) or a tab
-        # opened later fell back to Panel's CDN for its stylesheets, which an offline reviewer
-        # cannot reach (a failed request for loading.css in the browser's console)
-        doc._template_variables.setdefault("dist_url", get_dist_path())
     dashboard = BogieDashboard(params_path=params)
     header = pn.pane.Markdown(
         f"## {TITLE} — stability and short-circuit load of the wheelset drives\n"
