@@ -179,6 +179,10 @@ class StudiesView(pn.viewable.Viewer):
                                          css_classes=["study-band-notice"],
                                          sizing_mode="stretch_width")
         dashboard.param.watch(lambda _event: self.check_band(), ["N0", "b_M", "rail"])
+        # the same band on the Variant tab's baseline s0*(v) (the dashboard's set and sliders)
+        variant_figure = getattr(getattr(dashboard, "variant_view", None), "limits_figure", None)
+        self.variant_band = (BandLayer(variant_figure, name="variant-s0-band")
+                             if variant_figure is not None else None)
         self.start_button.on_click(lambda _event: self.start())
         self.stop_button.on_click(lambda _event: self.stop())
         self.open_button.on_click(lambda _event: self.open(self.store_path.value))
@@ -355,11 +359,15 @@ class StudiesView(pn.viewable.Viewer):
     def screen_conditions(self) -> tuple[str, float, float, str | None, str]:
         """(parameter hash, N0 [N], b_M [N m s/rad], rail or None, what) of the s0*(v) on screen:
         the map shown, or else the dashboard's set and sliders."""
-        from model.parameters import parameter_hash
-
         if self.map is not None and self.map.attrs.get("parameters_hash"):
             return (self.map.attrs["parameters_hash"], self.map.N0, self.map.b_M, None,
                     "the map on screen")
+        return self.dashboard_conditions()
+
+    def dashboard_conditions(self) -> tuple[str, float, float, str | None, str]:
+        """(parameter hash, N0 [N], b_M [N m s/rad], rail, what) of the dashboard's set."""
+        from model.parameters import parameter_hash
+
         d = self.dashboard
         # the set's hash with the result's creep law (a different rail is its own reason)
         rail = self.uncertainty.rail if self.uncertainty is not None else d.rail
@@ -372,6 +380,12 @@ class StudiesView(pn.viewable.Viewer):
         band = self.uncertainty
         if band is None:
             return
+        variant_note = ""
+        if self.variant_band is not None:  # the Variant tab's baseline: the dashboard's set
+            reason = band_mismatch(band, *self.dashboard_conditions()[:4])
+            self.variant_band.update(band if reason is None else None)
+            variant_note = ("; also on the Variant tab's baseline s0*(v)" if reason is None else
+                            f"; not on the Variant tab ({html.escape(reason, quote=False)})")
         hash_, N0, b_M, rail, what = self.screen_conditions()
         reason = band_mismatch(band, hash_, N0, b_M, rail)
         if reason is not None:
@@ -389,4 +403,5 @@ class StudiesView(pn.viewable.Viewer):
             f"s0*(v) band: {band.method}, n = {band.base_samples} ({band.runs} model runs), "
             f"speeds {speeds} km/h; parameters {band.parameters_hash[:12]}…, N0 = "
             f"{band.wheel_force / 1e3:g} kN, b_M = {band.motor_slope:g} N m s/rad"
-            + (" (sampled)" if band.motor_slope_sampled else "") + f", rail {band.rail}")
+            + (" (sampled)" if band.motor_slope_sampled else "") + f", rail {band.rail}"
+            + variant_note)

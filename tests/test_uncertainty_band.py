@@ -69,7 +69,7 @@ def view(dash):
     return view
 
 
-def test_matching_result_draws_its_band(view, tmp_path):
+def test_matching_result_draws_its_band(view, dash, tmp_path):
     parameters = compute.parameters("", "calibrated")
     assert (parameters["wheel_force"], parameters["motor_slope"]) == (100e3, 3000.0)
     path = _result_file(tmp_path / "u.json", parameters)
@@ -92,6 +92,11 @@ def test_matching_result_draws_its_band(view, tmp_path):
     assert "s0* 5–95 % (posterior, n = 8) [-]" in labels
     assert "posterior, n = 8" in view.band_status.object
     assert "40, 120, 200 km/h" in view.band_status.object
+    # the same band on the Variant tab's baseline s0*(v)
+    assert view.variant_band.shown
+    np.testing.assert_array_equal(view.variant_band.source.data["high"], band.p95)
+    assert view.variant_band.area in dash.variant_view.limits_figure.renderers
+    assert "also on the Variant tab" in view.band_status.object
 
 
 @pytest.mark.parametrize(("change", "reason"), [
@@ -106,6 +111,7 @@ def test_other_conditions_clear_the_band_and_say_why(view, dash, tmp_path, chang
         dash.param.update(**change)
     view.check_band()
     assert not view.plot.band.shown
+    assert not view.variant_band.shown
     assert view.band_notice.visible
     assert reason in view.band_notice.object
     assert "does not match the dashboard's set" in view.band_notice.object
@@ -167,6 +173,7 @@ def test_the_map_on_screen_decides(view, tmp_path):
     assert "does not match the map on screen" in view.band_notice.object
     view._show(map_view(parameter_hash(parameters), N0=90e3))
     assert "wheel force N0: result 100 kN, screen 90 kN" in view.band_notice.object
+    assert view.variant_band.shown  # the Variant tab shows the dashboard's set, which matches
     view._show(map_view(parameter_hash(parameters)))
     assert view.plot.band.shown
 
