@@ -397,6 +397,8 @@ class StudiesView(pn.viewable.Viewer):
             self.band_status.object = ""
             return
         self.plot.band.update(band)
+        if self.map is None:  # no map yet: drop the placeholder image so the axes fit the band
+            self.plot.image.data = {"image": [], "x": [], "y": [], "dw": [], "dh": []}
         self.band_notice.visible = False
         speeds = ", ".join(f"{v:g}" for v in band.speeds_kmh)
         self.band_status.object = (

@@ -79,6 +79,7 @@ def test_matching_result_draws_its_band(view, dash, tmp_path):
     assert view.uncertainty is not None
     assert not view.band_notice.visible, view.band_notice.object
     assert view.plot.band.shown
+    assert len(view.plot.image.data["image"]) == 0  # no map: the axes fit the band
     data = view.plot.band.source.data
     np.testing.assert_array_equal(data["v"], SPEEDS)
     np.testing.assert_array_equal(data["low"], band.p5)
