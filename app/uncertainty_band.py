@@ -23,7 +23,7 @@ import numpy as np
 from bokeh.models import ColumnDataSource
 
 RESULT_FORMAT = "bogie-uncertainty-2"  # model.uncertainty.RESULT_FORMAT
-BAND_COLOR = "#f4a582"
+BAND_COLOR = "#7b3294"  # purple: not in the map's red-blue palette
 MAX_BYTES = 50_000_000  # a result file larger than this is refused (not read)
 
 
@@ -124,8 +124,9 @@ class BandLayer:
         self.source = ColumnDataSource({"v": [], "low": [], "high": [], "median": []},
                                        name=name)
         self.area = figure.varea("v", "low", "high", source=self.source, fill_color=BAND_COLOR,
-                                 fill_alpha=0.45, legend_label="s0* 5–95 % band [-]")
-        self.median = figure.line("v", "median", source=self.source, line_color="#b2182b",
+                                 fill_alpha=0.35, hatch_pattern="/", hatch_color=BAND_COLOR,
+                                 hatch_alpha=0.6, legend_label="s0* 5–95 % band [-]")
+        self.median = figure.line("v", "median", source=self.source, line_color=BAND_COLOR,
                                   line_dash="dashed", line_width=1.5,
                                   legend_label="s0* median [-]")
         self.legend = figure.legend[0]

@@ -4,14 +4,16 @@
         --speeds 40,80,120,160,200,250 --out assets/data/uncertainty_no-indices_n32.json
     OPENBLAS_NUM_THREADS=1 .venv/bin/bogie uncertainty --samples 32 --posterior \\
         --speeds 40,80,120,160,200,250 --out assets/data/uncertainty_posterior_n32.json
-    OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/figures_posterior.py [--out assets/figures]
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/figures_posterior.py [--out assets/figures] [--app]
 
 Prints the prior and posterior standard deviations of ln p per uncertain parameter
 (:mod:`model.posterior`) with the targets that pin each (largest Jacobian entries), the linear
 prediction of the posterior spread of the creep maximum at 120 km/h, and the 5–95 % widths of
 every output of both studies; draws ``uncertainty_prior_posterior.png`` (s0*(v) of the set,
-both 5–95 % bands with their medians, the published 0.0082 at 120 km/h).  The two studies
-take ≈ 35 CPU-s each (n = 32, six speeds).
+both 5–95 % bands with their medians, the published 0.0082 at 120 km/h).  ``--app`` also
+computes a 25 × 6 stability map (≈ 10 s, serial) and renders the dashboard's Studies figure with
+the posterior band over it in headless Chromium (/usr/bin/chromium):
+``uncertainty_band_app.png``.  The two studies take ≈ 35 CPU-s each (n = 32, six speeds).
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ def main() -> None:
     parser.add_argument("--prior", default="assets/data/uncertainty_no-indices_n32.json")
     parser.add_argument("--posterior", default="assets/data/uncertainty_posterior_n32.json")
     parser.add_argument("--out", default="assets/figures")
+    parser.add_argument("--app", action="store_true", help="also the dashboard's figure (Chromium)")
     args = parser.parse_args()
     parameters = load_parameters()
     post = linearized_posterior(parameters, UNCERTAIN_PARAMETERS)
@@ -100,6 +103,50 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     fig.savefig(out / "uncertainty_prior_posterior.png", dpi=110)
     print(f"\nwrote {out / 'uncertainty_prior_posterior.png'}")
+    if args.app:
+        app_figure(parameters, Path(args.posterior), out / "uncertainty_band_app.png")
+
+
+def app_figure(parameters, result: Path, png: Path) -> None:
+    """The Studies tab's figure (app.studies_view.StudyMapPlot) with a fresh map and the band."""
+    import tempfile
+
+    from bokeh.embed import file_html
+    from bokeh.resources import INLINE
+    from playwright.sync_api import sync_playwright
+
+    from app.studies_view import StudyMapPlot, read_map
+    from app.uncertainty_band import band_mismatch, read_band
+    from model.operating_point import KMH
+    from model.study import MapStudy
+    from model.study_engine import serial_map_unordered
+    from model.study_store import run_into_store
+
+    with tempfile.TemporaryDirectory() as folder:
+        store = Path(folder) / "map.zarr"
+        study = MapStudy(np.linspace(0.004, 0.016, 25), np.array([40, 80, 120, 160, 200, 250]) * KMH,
+                         [parameters["wheel_force"]], [parameters["motor_slope"]])
+        run_into_store(study, parameters, store, serial_map_unordered)
+        view = read_map(store)
+        band = read_band(result)
+        reason = band_mismatch(band, view.attrs["parameters_hash"], view.N0, view.b_M, None)
+        if reason is not None:
+            raise SystemExit(f"{result} does not match the map: {reason}")
+        plot = StudyMapPlot()
+        plot.update(view)
+        plot.band.update(band)
+        plot.figure.sizing_mode, plot.figure.width = "fixed", 1000
+        page_file = Path(folder) / "map.html"
+        page_file.write_text(file_html(plot.figure, INLINE, "Studies"), encoding="utf-8")
+        with sync_playwright() as playwright:
+            browser = playwright.chromium.launch(executable_path="/usr/bin/chromium",
+                                                 args=["--no-sandbox", "--headless=new"])
+            page = browser.new_page(viewport={"width": 1100, "height": 400})
+            page.goto(page_file.as_uri())
+            page.wait_for_timeout(1500)
+            page.screenshot(path=str(png))
+            browser.close()
+    print(f"wrote {png}")
 
 
 if __name__ == "__main__":
