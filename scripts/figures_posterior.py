@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import time
 from pathlib import Path
 
 import matplotlib
@@ -50,7 +51,25 @@ def main() -> None:
     parser.add_argument("--app", action="store_true", help="also the dashboard's figure (Chromium)")
     args = parser.parse_args()
     parameters = load_parameters()
+    # cost: the posterior (one eigen-analysis with vectors, the analytic sensitivities with the
+    # derivative matrices of a fresh model, 24 operating-data evaluations) against one
+    # eigen-analysis with vectors of the same set, same run
+    from model.assembly import build_model
+    from model.calibration import S0_STABLE, V_REF
+    from model.eigen import eigen_analysis
+    from model.operating_point import OperatingPoint
+
+    op = OperatingPoint(S0_STABLE, V_REF, parameters["wheel_force"], parameters["motor_slope"])
+    model = build_model(parameters)
+    eigen_analysis(model, op)  # warm-up (the state-space pieces of the model)
+    began = time.perf_counter()
+    eigen_analysis(model, OperatingPoint(S0_STABLE * 1.001, V_REF, op.N0, op.b_M))  # a fresh point
+    reference = time.perf_counter() - began
+    began = time.perf_counter()
     post = linearized_posterior(parameters, UNCERTAIN_PARAMETERS)
+    cost = time.perf_counter() - began
+    print(f"cost: one eigen-analysis with vectors {reference * 1e3:.0f} ms; the linearized "
+          f"posterior {cost:.2f} s = {cost / reference:.0f}x (machine shared)\n")
     print(f"{'parameter':<34} {'prior sd ln p':>13} {'posterior':>10} {'ratio':>6}  "
           "largest whitened Jacobian entries ∂r/∂ln p")
     for j, (name, s0, s) in enumerate(zip(post.names, post.prior_sd_log, post.sd_log, strict=True)):
