@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 from bokeh.models import ColumnDataSource
 
-RESULT_FORMAT = "bogie-uncertainty-2"  # model.uncertainty.RESULT_FORMAT
+from model.uncertainty import RESULT_FORMAT
+
 BAND_COLOR = "#7b3294"  # purple: not in the map's red-blue palette
 MAX_BYTES = 50_000_000  # a result file larger than this is refused (not read)
 

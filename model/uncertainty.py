@@ -16,8 +16,8 @@ covariance ``(Jᵀ W J + Σ_prior⁻¹)⁻¹`` from the Jacobian of the calibrat
 distributions only (Sobol indices assume independent inputs).
 
 Outputs per model run (:func:`output_names`; :data:`OUTPUT_NAMES` for the default speeds):
-s0* at the study's speeds (default 120 and 200 km/h; more speeds give the s0*(v) band); the imaginary part
-[Hz] and damping ratio of the ten Table-1 modes (matched by character at s0 = 0.005, 120 km/h,
+s0* at the study's speeds (default 120 and 200 km/h; more speeds give the s0*(v) band); the
+imaginary part [Hz] and damping ratio of the ten Table-1 modes (matched by character at s0 = 0.005, 120 km/h,
 :func:`model.calibration.match_table1_modes`, so that modes do not swap between samples); the peak
 totals of ID1's and ID2's disc-clutch and driving-shaft torques after the short circuit (default
 excitation, 0.5 s at 5 kHz: the oscillating part has died out after 0.2 s).
