@@ -5,8 +5,11 @@ at an address, or this process), writes it into a Zarr store (:mod:`model.study_
 its progress without blocking the session (the study runs on a background thread; a periodic
 callback of the served session polls it), and draws the heat map of the largest real part with
 the stability limit s0*(v) over it.  A finished store (from here or from ``bogie study map``)
-can be opened.  Bad input (an empty range, fewer than two points, a path that is not a map
-store) shows a notice and keeps the previous map.
+can be opened, and so can an uncertainty result (``bogie uncertainty --speeds … --out FILE``):
+its 5–95 % band of s0*(v) is drawn over the map when it belongs to the parameter set and the
+conditions on screen (:mod:`app.uncertainty_band`), else a notice says why not.  Bad input (an
+empty range, fewer than two points, a path that is not a map store) shows a notice and keeps the
+previous map.
 
 Hooked into :class:`app.dashboard.BogieDashboard` with one section (marked "issue 13"); it reads
 the dashboard's ``N0`` [kN], ``b_M``, ``rail`` and parameter file when a study starts.
@@ -31,6 +34,7 @@ from model.operating_point import KMH
 
 from . import compute
 from .plots import _figure
+from .uncertainty_band import BandLayer, UncertaintyBand, band_mismatch, read_band
 
 WHERE = {"local Dask cluster": "local", "Dask cluster at the address": "address",
          "this process (no Dask)": "serial"}
@@ -48,6 +52,8 @@ class MapView:
     finished: int  # s0-lines written
     total: int  # s0-lines of the study
     attrs: dict  # the store's attributes (hash, code version, arguments)
+    N0: float = float("nan")  # wheel force of the slice [N]
+    b_M: float = float("nan")  # motor slope of the slice [N m s/rad]
 
 
 def read_map(path: str | Path, n0_index: int = 0, bm_index: int = 0) -> MapView:
@@ -68,7 +74,7 @@ def read_map(path: str | Path, n0_index: int = 0, bm_index: int = 0) -> MapView:
         return MapView(sliced["s0"].values, sliced["v_kmh"].values, growth,
                        np.where(sliced["chunk_done"].values == 1, sliced["s0_limit"].values,
                                 np.nan), int((done == 1).sum()), int(done.size),
-                       dict(dataset.attrs))
+                       dict(dataset.attrs), float(sliced["N0"].values), float(sliced["b_M"].values))
 
 
 class StudyMapPlot:
@@ -92,6 +98,7 @@ class StudyMapPlot:
         self.figure.line("v", "s0", source=self.limit, line_color="black", line_width=2,
                          legend_label="s0*(v)")
         self.figure.scatter("v", "s0", source=self.limit, color="black", size=4)
+        self.band = BandLayer(self.figure, name="study-s0-band")  # issue 12: uncertainty band
         self.figure.legend.location = "top_right"
 
     def update(self, view: MapView) -> None:
@@ -156,6 +163,26 @@ class StudiesView(pn.viewable.Viewer):
         self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
                                     css_classes=["study-notice"], sizing_mode="stretch_width")
         self.plot = StudyMapPlot()
+        # issue 12: an uncertainty result's s0*(v) band over the map (app/uncertainty_band.py)
+        self.uncertainty: UncertaintyBand | None = None
+        self.uncertainty_path = pn.widgets.TextInput(
+            label="uncertainty result (.json, bogie uncertainty --speeds … --out)",
+            placeholder="/path/uncertainty.json", css_classes=["study-uncertainty"], width=360)
+        self.uncertainty_button = pn.widgets.Button(label="Open result",
+                                                    css_classes=["study-open-uncertainty"],
+                                                    width=120)
+        self.uncertainty_button.on_click(
+            lambda _event: self.open_uncertainty(self.uncertainty_path.value))
+        self.band_status = pn.pane.HTML("", css_classes=["study-band-status"],
+                                        sizing_mode="stretch_width")
+        self.band_notice = pn.pane.Alert("", alert_type="warning", visible=False,
+                                         css_classes=["study-band-notice"],
+                                         sizing_mode="stretch_width")
+        dashboard.param.watch(lambda _event: self.check_band(), ["N0", "b_M", "rail"])
+        # the same band on the Variant tab's baseline s0*(v) (the dashboard's set and sliders)
+        variant_figure = getattr(getattr(dashboard, "variant_view", None), "limits_figure", None)
+        self.variant_band = (BandLayer(variant_figure, name="variant-s0-band")
+                             if variant_figure is not None else None)
         self.start_button.on_click(lambda _event: self.start())
         self.stop_button.on_click(lambda _event: self.stop())
         self.open_button.on_click(lambda _event: self.open(self.store_path.value))
@@ -165,7 +192,8 @@ class StudiesView(pn.viewable.Viewer):
                    sizing_mode="stretch_width"),
             pn.Row(self.where, self.address, self.start_button, self.stop_button),
             pn.Row(self.store_path, self.open_button),
-            self.progress, self.status,
+            pn.Row(self.uncertainty_path, self.uncertainty_button),
+            self.progress, self.status, self.band_notice, self.band_status,
             pn.pane.Bokeh(self.plot.figure, sizing_mode="stretch_width"),
             sizing_mode="stretch_width", css_classes=["studies-view"])
 
@@ -312,3 +340,70 @@ class StudiesView(pn.viewable.Viewer):
     def _show(self, view: MapView) -> None:
         self.map = view
         self.plot.update(view)
+        self.check_band()
+
+    # --- the uncertainty band (issue 12) ---------------------------------------------------------
+
+    def open_uncertainty(self, path: str) -> None:
+        """Open an uncertainty result; a bad file shows a notice and the previous band stays."""
+        try:
+            band = read_band(path)
+        except (ValueError, OSError) as error:
+            self.band_notice.object = (f"**Uncertainty result not opened (previous one kept):** "
+                                       f"{html.escape(str(error))}")
+            self.band_notice.visible = True
+            return
+        self.uncertainty = band
+        self.check_band()
+
+    def screen_conditions(self) -> tuple[str, float, float, str | None, str]:
+        """(parameter hash, N0 [N], b_M [N m s/rad], rail or None, what) of the s0*(v) on screen:
+        the map shown, or else the dashboard's set and sliders."""
+        if self.map is not None and self.map.attrs.get("parameters_hash"):
+            return (self.map.attrs["parameters_hash"], self.map.N0, self.map.b_M, None,
+                    "the map on screen")
+        return self.dashboard_conditions()
+
+    def dashboard_conditions(self) -> tuple[str, float, float, str | None, str]:
+        """(parameter hash, N0 [N], b_M [N m s/rad], rail, what) of the dashboard's set."""
+        from model.parameters import parameter_hash
+
+        d = self.dashboard
+        # the set's hash with the result's creep law (a different rail is its own reason)
+        rail = self.uncertainty.rail if self.uncertainty is not None else d.rail
+        parameters = compute.parameters(d._params_path, rail if rail in compute.RAIL_CONDITIONS
+                                        else d.rail)
+        return parameter_hash(parameters), d.N0 * 1e3, d.b_M, d.rail, "the dashboard's set"
+
+    def check_band(self) -> None:
+        """Draw the opened band if it belongs to what is on screen; else clear it and say why."""
+        band = self.uncertainty
+        if band is None:
+            return
+        variant_note = ""
+        if self.variant_band is not None:  # the Variant tab's baseline: the dashboard's set
+            reason = band_mismatch(band, *self.dashboard_conditions()[:4])
+            self.variant_band.update(band if reason is None else None)
+            variant_note = ("; also on the Variant tab's baseline s0*(v)" if reason is None else
+                            f"; not on the Variant tab ({html.escape(reason, quote=False)})")
+        hash_, N0, b_M, rail, what = self.screen_conditions()
+        reason = band_mismatch(band, hash_, N0, b_M, rail)
+        if reason is not None:
+            self.plot.band.update(None)
+            self.band_notice.object = (f"**Uncertainty band not drawn** ({html.escape(band.path)} "
+                                       f"does not match {what}): "
+                                       f"{html.escape(reason, quote=False)}")
+            self.band_notice.visible = True
+            self.band_status.object = ""
+            return
+        self.plot.band.update(band)
+        if self.map is None:  # no map yet: drop the placeholder image so the axes fit the band
+            self.plot.image.data = {"image": [], "x": [], "y": [], "dw": [], "dh": []}
+        self.band_notice.visible = False
+        speeds = ", ".join(f"{v:g}" for v in band.speeds_kmh)
+        self.band_status.object = (
+            f"s0*(v) band: {band.method}, n = {band.base_samples} ({band.runs} model runs), "
+            f"speeds {speeds} km/h; parameters {band.parameters_hash[:12]}…, N0 = "
+            f"{band.wheel_force / 1e3:g} kN, b_M = {band.motor_slope:g} N m s/rad"
+            + (" (sampled)" if band.motor_slope_sampled else "") + f", rail {band.rail}"
+            + variant_note)

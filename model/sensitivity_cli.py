@@ -1,7 +1,8 @@
 """``bogie sensitivity`` and ``bogie uncertainty``: which parameter moves what, and how sure.
 
     bogie sensitivity --s0 0.005 --v 120 [--n0 N --bm B --params FILE] [--only a,b] [--json]
-    bogie uncertainty --samples N [--seed S] [--json] [--out FILE.json]
+    bogie uncertainty --samples N [--seed S] [--posterior | --no-indices] [--speeds LIST]
+                      [--json] [--out FILE.json]
 
 ``sensitivity`` JSON keys: ``operating_point``; ``modes`` (the ten lowest complex pairs: ``re``
 [1/s], ``im_hz`` [Hz], ``description``, ``reliable``); ``parameters``: a list of ``{name, value,
@@ -43,9 +44,40 @@ def register(subparsers) -> None:
     p.add_argument("--seed", type=int, default=12, help="seed of the scrambled Sobol' sequence")
     p.add_argument("--params", default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
+    add_uncertainty_options(p)
     p.add_argument("--json", action="store_true", help="machine-readable JSON output")
     p.add_argument("--out", default=None, metavar="FILE", help="also write the JSON result here")
     p.set_defaults(func=cmd_uncertainty)
+
+
+def add_uncertainty_options(p: argparse.ArgumentParser) -> None:
+    """--posterior, --no-indices, --speeds (shared with ``bogie study uncertainty``)."""
+    p.add_argument("--posterior", action="store_true",
+                   help="sample the linearized posterior given the calibration's targets "
+                        "(model/posterior.py; n runs, distributions only) instead of the prior "
+                        "ranges")
+    p.add_argument("--no-indices", action="store_true",
+                   help="prior: distributions only from n QMC samples (n runs, no Sobol indices)")
+    p.add_argument("--speeds", default=None, metavar="LIST",
+                   help="speeds of s0* [km/h]: x1,x2,… or A:B:N (default 120,200); several "
+                        "speeds give the s0*(v) band the dashboard's Studies view draws")
+
+
+def uncertainty_options(args: argparse.Namespace) -> dict:
+    """Keyword arguments of :func:`model.uncertainty.run_uncertainty` from the shared options
+    (raises UsageError)."""
+    from .study_cli import parse_values
+    from .uncertainty import V_SPEEDS_KMH
+
+    if args.posterior and args.no_indices:
+        raise UsageError("--posterior and --no-indices exclude each other (the posterior never "
+                         "has Sobol indices)")
+    speeds = (parse_values(args.speeds, "--speeds", 1, 500, "km/h", increasing=True)
+              if args.speeds is not None else list(V_SPEEDS_KMH))
+    if len(speeds) > 50:
+        raise UsageError(f"--speeds: {len(speeds)} speeds, at most 50 allowed")
+    return {"method": "posterior" if args.posterior else "prior",
+            "indices": not (args.posterior or args.no_indices), "speeds_kmh": speeds}
 
 
 def cmd_sensitivity(args: argparse.Namespace) -> None:
@@ -112,9 +144,10 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
     out = Path(args.out) if args.out else None
     if out is not None and not out.parent.is_dir():
         raise UsageError(f"directory '{out.parent}' does not exist")
+    options = uncertainty_options(args)
     parameters = load_parameters(args.params)
     try:
-        result = run_uncertainty(parameters, n, seed=args.seed,
+        result = run_uncertainty(parameters, n, seed=args.seed, **options,
                                  progress=None if args.json else
                                  lambda done, total: print(f"  {done}/{total} model runs",
                                                            flush=True))

@@ -4,6 +4,7 @@
                       --out X.zarr [--scheduler tcp://HOST:PORT] [--workers N] [--resume]
     bogie study limit --v A:B:N [--n0 LIST] [--bm LIST] … --out X.zarr …
     bogie study uncertainty --samples N [--seed S] [--params FILE] --out U.json
+                      [--posterior | --no-indices] [--speeds LIST]
                       [--scheduler tcp://HOST:PORT] [--workers N] [--serial]
 
 ``A:B:N`` is N values from A to B (N = 1: A alone); a LIST is comma-separated values or A:B:N.
@@ -122,6 +123,9 @@ def register(subparsers) -> None:
     u.add_argument("--chunk-size", type=positive_int("--chunk-size"), default=4,
                    help="model runs per task (default %(default)s)")
     _engine_options(u)
+    from .sensitivity_cli import add_uncertainty_options
+
+    add_uncertainty_options(u)
     u.add_argument("--json", action="store_true", help="the result as JSON on stdout")
     u.set_defaults(func=cmd_uncertainty)
 
@@ -224,12 +228,15 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
     out = Path(args.out)
     if not out.parent.is_dir():
         raise UsageError(f"directory '{out.parent}' does not exist")
+    from .sensitivity_cli import uncertainty_options
+
+    options = uncertainty_options(args)
     parameters = load_parameters(args.params)
     bar, start = ProgressBar("study uncertainty", unit="model runs"), time.monotonic()
     engine, mapper, where = _start_engine(args)
     try:
         print(f"study uncertainty: n = {n} on {where}", file=sys.stderr)
-        result = run_uncertainty(parameters, n, seed=args.seed, map_fn=in_order(mapper),
+        result = run_uncertainty(parameters, n, seed=args.seed, map_fn=in_order(mapper), **options,
                                  chunk_size=args.chunk_size,
                                  progress=lambda done, total: bar(done, total,
                                                                   time.monotonic() - start))

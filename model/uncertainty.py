@@ -6,18 +6,18 @@ for the loss time) by a scrambled Sobol' sequence (``scipy.stats.qmc`` through
 ``scipy.stats.sobol_indices``, Saltelli 2010 estimators, bootstrap confidence intervals).  The
 other parameters stay at the calibrated set's values.
 
-Prior, not posterior.  The calibration constrains some of these parameters (the disc clutch and
-driving shaft stiffnesses by the 2.7 Hz and 298 Hz modes, the creep law by the operating data and
-the creep maximum at 0.0082).  Sampling the prior ranges answers "how much could the verdict move
-given what we did not know before fitting": it is wider than the spread left after the fit.  A
-linearized posterior (Gaussian with covariance ``σ² (JᵀJ)⁻¹`` from the calibration's Jacobian of
-the residuals) would answer "how much is still unknown given the published numbers"; it is not
-implemented here (the calibration keeps no Jacobian, and its soft-L1 pattern search has none to
-offer), so the bands below are upper bounds of the remaining uncertainty for the constrained
-parameters.
+Prior or posterior (``method``).  The calibration constrains some of these parameters (the disc
+clutch and driving shaft stiffnesses by the 2.7 Hz and 298 Hz modes, the creep law by the
+operating data and the creep maximum at 0.0082).  Sampling the prior ranges answers "how much
+could the verdict move given what we did not know before fitting": it is wider than the spread
+left after the fit.  The linearized posterior (:mod:`model.posterior`: Gaussian in ln p with
+covariance ``(Jᵀ W J + Σ_prior⁻¹)⁻¹`` from the Jacobian of the calibration's residuals) answers
+"how much is still unknown given the published numbers"; its inputs are correlated, so it gives
+distributions only (Sobol indices assume independent inputs).
 
-Outputs per model run (:data:`OUTPUT_NAMES`): s0*(120 km/h), s0*(200 km/h); the imaginary part
-[Hz] and damping ratio of the ten Table-1 modes (matched by character at s0 = 0.005, 120 km/h,
+Outputs per model run (:func:`output_names`; :data:`OUTPUT_NAMES` for the default speeds):
+s0* at the study's speeds (default 120 and 200 km/h; more speeds give the s0*(v) band); the
+imaginary part [Hz] and damping ratio of the ten Table-1 modes (matched by character at s0 = 0.005, 120 km/h,
 :func:`model.calibration.match_table1_modes`, so that modes do not swap between samples); the peak
 totals of ID1's and ID2's disc-clutch and driving-shaft torques after the short circuit (default
 excitation, 0.5 s at 5 kHz: the oscillating part has died out after 0.2 s).
@@ -57,6 +57,17 @@ OUTPUT_NAMES = ("s0_limit_120", "s0_limit_200",
                 *(f"mode{k}_damping_ratio" for k in range(1, MODE_COUNT + 1)),
                 *(f"peak.{name}" for name in PEAK_OUTPUTS))
 OUTPUT_UNITS = ("1", "1", *("Hz",) * MODE_COUNT, *("1",) * MODE_COUNT, *("N m",) * len(PEAK_OUTPUTS))
+METHODS = ("prior", "posterior")
+RESULT_FORMAT = "bogie-uncertainty-2"  # results that carry their parameter set and conditions
+
+
+def output_names(speeds_kmh: Sequence[float] = V_SPEEDS_KMH) -> tuple[str, ...]:
+    """Output names with the stability limit at each speed (``s0_limit_120`` for 120 km/h)."""
+    return (*(f"s0_limit_{v:g}" for v in speeds_kmh), *OUTPUT_NAMES[2:])
+
+
+def output_units(speeds_kmh: Sequence[float] = V_SPEEDS_KMH) -> tuple[str, ...]:
+    return (*("1",) * len(speeds_kmh), *OUTPUT_UNITS[2:])
 
 
 class UncertaintyError(ValueError):
@@ -103,9 +114,11 @@ UNCERTAIN_PARAMETERS: tuple[UncertainParameter, ...] = (
 )
 
 
-def sample_outputs(values: Mapping[str, float]) -> np.ndarray:
-    """All :data:`OUTPUT_NAMES` for one full parameter set (name -> value, SI) (NaN where a
-    quantity could not be computed, e.g. no stability limit in the searched range)."""
+def sample_outputs(values: Mapping[str, float],
+                   speeds_kmh: Sequence[float] = V_SPEEDS_KMH) -> np.ndarray:
+    """All :func:`output_names` (s0* at ``speeds_kmh`` [km/h], the modes, the peaks) for one full
+    parameter set (name -> value, SI) (NaN where a quantity could not be computed, e.g. no
+    stability limit in the searched range)."""
     from .assembly import build_model
     from .calibration import match_table1_modes
     from .eigen import eigen_analysis
@@ -116,8 +129,8 @@ def sample_outputs(values: Mapping[str, float]) -> np.ndarray:
     parameters = Parameters(dict(values))
     model = build_model(parameters)
     N0, b_M = parameters["wheel_force"], parameters["motor_slope"]
-    out = np.full(len(OUTPUT_NAMES), np.nan)
-    for k, v_kmh in enumerate(V_SPEEDS_KMH):
+    out = np.full(len(speeds_kmh) + len(OUTPUT_NAMES) - 2, np.nan)
+    for k, v_kmh in enumerate(speeds_kmh):
         v = v_kmh * KMH
         try:
             s_max, _ = creep_law(parameters, N0).maximum(v)
@@ -136,17 +149,20 @@ def sample_outputs(values: Mapping[str, float]) -> np.ndarray:
     result = eigen_analysis(model, op)
     matched, _ = match_table1_modes(model, result)
     lam = result.eigenvalues[matched]
-    out[2:2 + MODE_COUNT] = lam.imag / (2 * np.pi)
-    out[2 + MODE_COUNT:2 + 2 * MODE_COUNT] = -lam.real / np.abs(lam)
+    first = len(speeds_kmh)
+    out[first:first + MODE_COUNT] = lam.imag / (2 * np.pi)
+    out[first + MODE_COUNT:first + 2 * MODE_COUNT] = -lam.real / np.abs(lam)
     response = short_circuit_response(model, op, t_end=RESPONSE_T_END, fs=RESPONSE_FS,
                                       outputs=list(PEAK_OUTPUTS))
-    out[2 + 2 * MODE_COUNT:] = [response.peaks[name] for name in PEAK_OUTPUTS]
+    out[first + 2 * MODE_COUNT:] = [response.peaks[name] for name in PEAK_OUTPUTS]
     return out
 
 
-def evaluate_chunk(samples: np.ndarray, base: Mapping[str, float], names: Sequence[str]) -> np.ndarray:
-    """Outputs (len(samples) x len(OUTPUT_NAMES)) for rows of sample values of ``names`` on top of
-    the base set ``base`` (plain data in and out: picklable for any executor)."""
+def evaluate_chunk(samples: np.ndarray, base: Mapping[str, float], names: Sequence[str],
+                   speeds_kmh: Sequence[float] = V_SPEEDS_KMH) -> np.ndarray:
+    """Outputs (len(samples) x len(output_names(speeds_kmh))) for rows of sample values of
+    ``names`` on top of the base set ``base`` (plain data in and out: picklable for any
+    executor)."""
     from threadpoolctl import threadpool_limits
 
     rows = []
@@ -154,14 +170,19 @@ def evaluate_chunk(samples: np.ndarray, base: Mapping[str, float], names: Sequen
         for sample in np.atleast_2d(samples):
             values = dict(base)
             values.update(zip(names, map(float, sample), strict=True))
-            rows.append(sample_outputs(values))
-    return np.array(rows).reshape(len(np.atleast_2d(samples)), len(OUTPUT_NAMES))
+            rows.append(sample_outputs(values, speeds_kmh))
+    return np.array(rows).reshape(len(np.atleast_2d(samples)), len(OUTPUT_NAMES) - 2 + len(speeds_kmh))
 
 
 @dataclass(frozen=True)
 class UncertaintyResult:
-    """Distributions and Sobol indices (plain data).  Samples are the prior QMC samples A and B
-    (2n runs); the indices use all n (d + 2) runs."""
+    """Distributions and Sobol indices (plain data).  With indices: the samples are the prior QMC
+    samples A and B (2n runs); the indices use all n (d + 2) runs.  Without (``indices`` False:
+    a posterior, or a prior sampled for its distributions only): n QMC samples, n runs, the
+    index arrays NaN.  What the result belongs to: the parameter set's hash
+    (:func:`model.parameters.parameter_hash`), the wheel force N0 [N], the motor slope b_M
+    [N m s/rad] (its nominal value: it is sampled when ``motor_slope`` is among ``names``), the
+    rail condition (the set's own creep law: ``calibrated``) and the speeds of s0* [km/h]."""
 
     names: tuple[str, ...]  # uncertain parameters
     ranges: tuple[tuple[float, float], ...]  # their prior ranges [schema unit]
@@ -177,6 +198,15 @@ class UncertaintyResult:
     total_order_ci: np.ndarray  # 2 x len(outputs) x d
     seed: int
     nominal: np.ndarray  # outputs of the base set
+    method: str = "prior"  # "prior" (documented ranges) or "posterior" (linearized, model.posterior)
+    indices: bool = True  # Sobol indices computed
+    speeds_kmh: tuple[float, ...] = V_SPEEDS_KMH  # speeds of the s0* outputs [km/h]
+    parameters_hash: str = ""
+    wheel_force: float = math.nan  # N0 [N]
+    motor_slope: float = math.nan  # nominal b_M [N m s/rad]
+    rail: str = "calibrated"
+    clipped: int = 0  # posterior coordinates clipped to the documented ranges
+    posterior: dict | None = None  # LinearizedPosterior.as_dict()
 
     def percentiles(self, q=(5, 50, 95)) -> np.ndarray:
         """len(q) x len(outputs) percentiles of the sample distribution (NaN ignored)."""
@@ -187,9 +217,24 @@ class UncertaintyResult:
             return [None if not math.isfinite(float(x)) else float(x) for x in np.ravel(a)]
 
         p5, p50, p95 = self.percentiles()
+        if self.method == "posterior":
+            sampling = ("linearized posterior (model/posterior.py): scrambled Sobol' QMC, normal "
+                        "ppf, Cholesky factor, clipped to the documented ranges; no Sobol indices "
+                        "(correlated inputs)")
+        elif self.indices:
+            sampling = ("prior ranges (log-uniform), scrambled Sobol' QMC, Saltelli 2010 "
+                        "(scipy.stats.sobol_indices), 95 % bootstrap confidence intervals")
+        else:
+            sampling = "prior ranges (log-uniform), scrambled Sobol' QMC, distributions only"
         return {
-            "method": "prior ranges (log-uniform), scrambled Sobol' QMC, Saltelli 2010 "
-                      "(scipy.stats.sobol_indices), 95 % bootstrap confidence intervals",
+            "format": RESULT_FORMAT, "method": self.method, "sampling": sampling,
+            "indices": self.indices, "parameters_hash": self.parameters_hash,
+            "conditions": {"wheel_force_N": clean([self.wheel_force])[0],
+                           "motor_slope_Nms_per_rad": clean([self.motor_slope])[0],
+                           "motor_slope_sampled": "motor_slope" in self.names,
+                           "rail": self.rail},
+            "speeds_kmh": [float(v) for v in self.speeds_kmh],
+            "clipped_coordinates": self.clipped, "posterior": self.posterior,
             "base_samples": self.base_samples, "runs": self.runs, "seed": self.seed,
             "parameters": [{"name": n, "low": lo, "high": hi}
                            for n, (lo, hi) in zip(self.names, self.ranges, strict=True)],
@@ -209,10 +254,16 @@ class UncertaintyResult:
 
     def summary(self) -> str:
         p5, p50, p95 = self.percentiles()
-        lines = [f"uncertainty: {len(self.names)} parameters (prior ranges), n = {self.base_samples}, "
-                 f"{self.runs} model runs", "",
-                 f"{'output':<34} {'nominal':>11} {'p5':>11} {'p50':>11} {'p95':>11}  leading S_T"]
+        lines = [f"uncertainty: {len(self.names)} parameters ({self.method}), n = "
+                 f"{self.base_samples}, {self.runs} model runs"
+                 + (f", {self.clipped} coordinates clipped to the ranges" if self.clipped else ""),
+                 "", f"{'output':<34} {'nominal':>11} {'p5':>11} {'p50':>11} {'p95':>11}"
+                 + ("  leading S_T" if self.indices else "")]
         for j, name in enumerate(self.outputs):
+            if not self.indices:
+                lines.append(f"{name:<34} {self.nominal[j]:>11.5g} {p5[j]:>11.5g} "
+                             f"{p50[j]:>11.5g} {p95[j]:>11.5g}")
+                continue
             lead = int(np.nanargmax(self.total_order[j])) if np.any(np.isfinite(self.total_order[j])) else 0
             width = self.total_order_ci[1, j, lead] - self.total_order_ci[0, j, lead]
             lines.append(f"{name:<34} {self.nominal[j]:>11.5g} {p5[j]:>11.5g} {p50[j]:>11.5g} "
@@ -271,21 +322,61 @@ def sobol_study(evaluate: Callable[[np.ndarray], np.ndarray], distributions: Seq
     return runs, samples, values, first, total, first_ci, total_ci
 
 
+def qmc_study(evaluate: Callable[[np.ndarray], np.ndarray], transform: Callable, d: int, n: int,
+              seed: int = 12, map_fn: Callable = map, chunk_size: int = 4,
+              progress: Callable[[int, int], None] | None = None):
+    """Distributions only: n scrambled Sobol' points in (0, 1)^d, ``transform(u)`` -> (samples
+    n x d, clipped count), evaluated through ``map_fn`` in chunks.  Returns (samples, outputs
+    n x s, clipped)."""
+    if isinstance(n, bool) or not isinstance(n, int) or n < 2 or n & (n - 1):
+        raise UncertaintyError(f"n = {n!r} is not allowed: must be a power of 2 >= 2")
+    u = stats.qmc.Sobol(d, scramble=True, rng=np.random.default_rng(seed)).random(n)
+    samples, clipped = transform(u)
+    parts, done = [], 0
+    for part in map_fn(evaluate, _chunks(samples, chunk_size)):
+        parts.append(np.atleast_2d(np.asarray(part)))
+        done += len(parts[-1])
+        if progress is not None:
+            progress(done, n)
+    return samples, np.vstack(parts), clipped
+
+
 def run_uncertainty(parameters: Parameters, n: int, uncertain: Iterable[UncertainParameter] = UNCERTAIN_PARAMETERS,
                     seed: int = 12, map_fn: Callable = map, chunk_size: int = 4,
                     progress: Callable[[int, int], None] | None = None,
-                    n_resamples: int = 999) -> UncertaintyResult:
-    """Sobol indices and distributions of :data:`OUTPUT_NAMES` over the prior ranges.
+                    n_resamples: int = 999, method: str = "prior", indices: bool | None = None,
+                    speeds_kmh: Sequence[float] = V_SPEEDS_KMH, rail: str = "calibrated",
+                    posterior=None) -> UncertaintyResult:
+    """Distributions (and, for the prior, Sobol indices) of :func:`output_names`.
 
-    ``n``: base sample count (power of 2, ≥ 2); ``n (d + 2)`` model runs.  ``map_fn(func, chunks)``
-    evaluates :func:`evaluate_chunk` over chunks of ``chunk_size`` samples (builtin ``map``:
-    serial; a Dask client's or a process pool's ``map`` runs them in parallel — results are
-    collected in order).  ``progress(done, total)`` after every chunk."""
+    ``n``: base sample count (power of 2, ≥ 2).  ``method``: ``"prior"`` samples the documented
+    ranges (independent; with ``indices`` (default) Saltelli's design, ``n (d + 2)`` runs; with
+    ``indices=False`` n runs, distributions only); ``"posterior"`` samples the linearized
+    posterior (:mod:`model.posterior`, computed here unless given; n runs, no indices: the
+    inputs are correlated).  ``speeds_kmh``: the speeds of s0* [km/h] (the s0*(v) band).
+    ``rail``: the creep law ``parameters`` carry (recorded with the result, not applied here).
+    ``map_fn(func, chunks)`` evaluates :func:`evaluate_chunk` over chunks of ``chunk_size``
+    samples (builtin ``map``: serial; a Dask client's or a process pool's ``map`` runs them in
+    parallel — results are collected in order).  ``progress(done, total)`` after every chunk."""
+    from .parameters import parameter_hash
+
     uncertain = tuple(uncertain)
+    if method not in METHODS:
+        raise UncertaintyError(f"method '{method}' is not allowed: use one of {', '.join(METHODS)}")
+    if indices is None:
+        indices = method == "prior"
+    if indices and method == "posterior":
+        raise UncertaintyError("Sobol indices need independent inputs: not for the posterior")
     if not uncertain:
         raise UncertaintyError("no uncertain parameters given")
     if chunk_size < 1:
         raise UncertaintyError(f"chunk_size = {chunk_size} is not allowed: must be >= 1")
+    speeds_kmh = tuple(float(v) for v in speeds_kmh)
+    if not speeds_kmh or any(not (math.isfinite(v) and 1.0 <= v <= 500.0) for v in speeds_kmh):
+        raise UncertaintyError(f"speeds {speeds_kmh} are not allowed: at least one, each in "
+                               "[1, 500] km/h")
+    if len(set(speeds_kmh)) != len(speeds_kmh):
+        raise UncertaintyError("speeds must be distinct")
     for item in uncertain:
         if item.name not in parameters.values:
             raise UncertaintyError(f"unknown parameter '{item.name}'")
@@ -297,14 +388,47 @@ def run_uncertainty(parameters: Parameters, n: int, uncertain: Iterable[Uncertai
             raise UncertaintyError(f"range of '{item.name}': {error}") from None
     names = tuple(item.name for item in uncertain)
     base = dict(parameters.values)
-    study = sobol_study(partial(evaluate_chunk, base=base, names=names),
-                        [item.distribution() for item in uncertain], n, seed=seed, map_fn=map_fn,
-                        chunk_size=chunk_size, progress=progress, n_resamples=n_resamples)
-    nominal = evaluate_chunk(np.array([[base[name] for name in names]]), base, names)[0]
-    runs, samples, values, first, total, first_ci, total_ci = study
-    return UncertaintyResult(names, tuple((item.low, item.high) for item in uncertain), OUTPUT_NAMES,
-                             OUTPUT_UNITS, n, runs, samples, values, first, total, first_ci,
-                             total_ci, seed, nominal)
+    evaluate = partial(evaluate_chunk, base=base, names=names, speeds_kmh=speeds_kmh)
+    outputs = output_names(speeds_kmh)
+    blank = np.full((len(outputs), len(names)), np.nan)
+    clipped, posterior_data = 0, None
+    if indices:
+        study = sobol_study(evaluate, [item.distribution() for item in uncertain], n, seed=seed,
+                            map_fn=map_fn, chunk_size=chunk_size, progress=progress,
+                            n_resamples=n_resamples)
+        runs, samples, values, first, total, first_ci, total_ci = study
+    else:
+        if method == "posterior":
+            from .posterior import PosteriorError, linearized_posterior
+
+            if posterior is None:
+                try:
+                    posterior = linearized_posterior(parameters, uncertain)
+                except (PosteriorError, ValueError) as error:
+                    raise UncertaintyError(f"linearized posterior: {error}") from None
+            if posterior.names != names:
+                raise UncertaintyError("the posterior belongs to other parameters")
+            transform = posterior.transform
+            posterior_data = posterior.as_dict()
+        else:
+            distributions = [item.distribution() for item in uncertain]
+
+            def transform(u):
+                return np.column_stack([dist.ppf(u[:, j]) for j, dist in
+                                        enumerate(distributions)]), 0
+        samples, values, clipped = qmc_study(evaluate, transform, len(names), n, seed=seed,
+                                             map_fn=map_fn, chunk_size=chunk_size,
+                                             progress=progress)
+        runs, first, total = n, blank, blank
+        first_ci = total_ci = np.array([blank, blank])
+    nominal = evaluate_chunk(np.array([[base[name] for name in names]]), base, names, speeds_kmh)[0]
+    return UncertaintyResult(names, tuple((item.low, item.high) for item in uncertain), outputs,
+                             output_units(speeds_kmh), n, runs, samples, values, first, total,
+                             first_ci, total_ci, seed, nominal, method=method, indices=indices,
+                             speeds_kmh=speeds_kmh, parameters_hash=parameter_hash(parameters),
+                             wheel_force=float(parameters["wheel_force"]),
+                             motor_slope=float(parameters["motor_slope"]), rail=rail,
+                             clipped=clipped, posterior=posterior_data)
 
 
 def creep_maximum_chunk(samples: np.ndarray, base: Mapping[str, float], names: Sequence[str],

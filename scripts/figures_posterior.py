@@ -1,0 +1,172 @@
+"""Prior against linearized posterior: the numbers docs/sensitivity.md quotes and one figure.
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/bogie uncertainty --samples 32 --no-indices \\
+        --speeds 40,80,120,160,200,250 --out assets/data/uncertainty_no-indices_n32.json
+    OPENBLAS_NUM_THREADS=1 .venv/bin/bogie uncertainty --samples 32 --posterior \\
+        --speeds 40,80,120,160,200,250 --out assets/data/uncertainty_posterior_n32.json
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/figures_posterior.py [--out assets/figures] [--app]
+
+Prints the prior and posterior standard deviations of ln p per uncertain parameter
+(:mod:`model.posterior`) with the targets that pin each (largest Jacobian entries), the linear
+prediction of the posterior spread of the creep maximum at 120 km/h, and the 5–95 % widths of
+every output of both studies; draws ``uncertainty_prior_posterior.png`` (s0*(v) of the set,
+both 5–95 % bands with their medians, the published 0.0082 at 120 km/h).  ``--app`` also
+computes a 25 × 6 stability map (≈ 10 s, serial) and renders the dashboard's Studies figure with
+the posterior band over it in headless Chromium (/usr/bin/chromium):
+``uncertainty_band_app.png``.  The two studies take ≈ 35 CPU-s each (n = 32, six speeds).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from model.calibration import STABILITY_LIMIT
+from model.parameters import load_parameters, parameter_hash
+from model.posterior import linearized_posterior
+from model.uncertainty import UNCERTAIN_PARAMETERS
+
+
+def limits(data: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(speeds [km/h], rows nominal/p5/p50/p95 of s0*) of a result."""
+    rows = [o for o in data["outputs"] if o["name"].startswith("s0_limit_")]
+    speeds = np.array([float(o["name"][len("s0_limit_"):]) for o in rows])
+    return speeds, np.array([[o[k] for o in rows] for k in ("nominal", "p5", "p50", "p95")],
+                            dtype=float)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--prior", default="assets/data/uncertainty_no-indices_n32.json")
+    parser.add_argument("--posterior", default="assets/data/uncertainty_posterior_n32.json")
+    parser.add_argument("--out", default="assets/figures")
+    parser.add_argument("--app", action="store_true", help="also the dashboard's figure (Chromium)")
+    args = parser.parse_args()
+    parameters = load_parameters()
+    # cost: the posterior (one eigen-analysis with vectors, the analytic sensitivities with the
+    # derivative matrices of a fresh model, 24 operating-data evaluations) against one
+    # eigen-analysis with vectors of the same set, same run
+    from model.assembly import build_model
+    from model.calibration import S0_STABLE, V_REF
+    from model.eigen import eigen_analysis
+    from model.operating_point import OperatingPoint
+
+    op = OperatingPoint(S0_STABLE, V_REF, parameters["wheel_force"], parameters["motor_slope"])
+    model = build_model(parameters)
+    eigen_analysis(model, op)  # warm-up (the state-space pieces of the model)
+    began = time.perf_counter()
+    eigen_analysis(model, OperatingPoint(S0_STABLE * 1.001, V_REF, op.N0, op.b_M))  # a fresh point
+    reference = time.perf_counter() - began
+    began = time.perf_counter()
+    post = linearized_posterior(parameters, UNCERTAIN_PARAMETERS)
+    cost = time.perf_counter() - began
+    print(f"cost: one eigen-analysis with vectors {reference * 1e3:.0f} ms; the linearized "
+          f"posterior {cost:.2f} s = {cost / reference:.0f}x (machine shared)\n")
+    print(f"{'parameter':<34} {'prior sd ln p':>13} {'posterior':>10} {'ratio':>6}  "
+          "largest whitened Jacobian entries ∂r/∂ln p")
+    for j, (name, s0, s) in enumerate(zip(post.names, post.prior_sd_log, post.sd_log, strict=True)):
+        column = post.jacobian[:, j]
+        lead = ", ".join(f"{post.targets[i][:24]} {column[i]:+.3g}"
+                         for i in np.argsort(-np.abs(column))[:2])
+        print(f"{name:<34} {s0:>13.3f} {s:>10.3f} {s / s0:>6.2f}  {lead}")
+    print("targets used:", len(post.targets), "dropped:", list(post.dropped) or "none")
+    k = post.targets.index("creep maximum s (stability-limit proxy)")
+    g = post.jacobian[k] * post.sigmas[k]  # ∂ ln s_max(120) / ∂θ
+    print(f"linear sd of ln s_max(120 km/h): prior {np.sqrt(g @ (post.prior_sd_log**2 * g)):.4f}, "
+          f"posterior {np.sqrt(g @ post.covariance_log @ g):.4f}")
+
+    studies = {}
+    for label, path in (("prior", args.prior), ("posterior", args.posterior)):
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        if data.get("parameters_hash") != parameter_hash(parameters):
+            print(f"WARNING: {path} belongs to another parameter set: re-run the commands above")
+        studies[label] = data
+        samples = np.array(data["samples"], dtype=float)
+        mean = np.log([parameters[p["name"]] for p in data["parameters"]])
+        print(f"\n{label}: {data['method']}, n = {data['base_samples']}, {data['runs']} runs, "
+              f"{data.get('clipped_coordinates', 0)} coordinates clipped; sampled sd of "
+              f"g·(ln p − ln p_set) = {np.std((np.log(samples) - mean) @ g):.4f}")
+        values = np.array(data["values"], dtype=float)
+        for j, o in enumerate(data["outputs"]):
+            width = o["p95"] - o["p5"]
+            extra = ""
+            if o["name"].startswith("s0_limit_"):
+                extra = f"  sd of ln: {np.nanstd(np.log(values[:, j])):.4f}"
+            print(f"  {o['name']:<32} nominal {o['nominal']:>10.5g}  5–95 % {o['p5']:>10.5g} … "
+                  f"{o['p95']:>10.5g}  width {width / abs(o['nominal']):>7.1%} of nominal{extra}")
+
+    fig, ax = plt.subplots(figsize=(8, 4.2), layout="constrained")
+    for label, color in (("prior", "tab:blue"), ("posterior", "tab:red")):
+        speeds, (nominal, p5, p50, p95) = limits(studies[label])
+        data = studies[label]
+        ax.fill_between(speeds, p5, p95, color=color, alpha=0.25,
+                        label=f"5–95 % {label} (n = {data['base_samples']})")
+        ax.plot(speeds, p50, color=color, lw=0.9, ls="--", label=f"median {label}")
+    ax.plot(speeds, nominal, "k.-", lw=1.2, label="calibrated set")
+    ax.plot([120], [STABILITY_LIMIT], "k*", ms=12, label="published s0* = 0.0082 at 120 km/h")
+    ax.set(xlabel="speed v [km/h]", ylabel="stability limit s0* [-]",
+           title="s0*(v): prior ranges against the linearized posterior given the calibration's "
+                 "targets")
+    ax.title.set_fontsize(9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out / "uncertainty_prior_posterior.png", dpi=110)
+    print(f"\nwrote {out / 'uncertainty_prior_posterior.png'}")
+    if args.app:
+        app_figure(parameters, Path(args.posterior), out / "uncertainty_band_app.png")
+
+
+def app_figure(parameters, result: Path, png: Path) -> None:
+    """The Studies tab's figure (app.studies_view.StudyMapPlot) with a fresh map and the band."""
+    import tempfile
+
+    from bokeh.embed import file_html
+    from bokeh.resources import INLINE
+    from playwright.sync_api import sync_playwright
+
+    from app.studies_view import StudyMapPlot, read_map
+    from app.uncertainty_band import band_mismatch, read_band
+    from model.operating_point import KMH
+    from model.study import MapStudy
+    from model.study_engine import serial_map_unordered
+    from model.study_store import run_into_store
+
+    with tempfile.TemporaryDirectory() as folder:
+        store = Path(folder) / "map.zarr"
+        study = MapStudy(np.linspace(0.004, 0.016, 25), np.array([40, 80, 120, 160, 200, 250]) * KMH,
+                         [parameters["wheel_force"]], [parameters["motor_slope"]])
+        run_into_store(study, parameters, store, serial_map_unordered)
+        view = read_map(store)
+        band = read_band(result)
+        reason = band_mismatch(band, view.attrs["parameters_hash"], view.N0, view.b_M, None)
+        if reason is not None:
+            raise SystemExit(f"{result} does not match the map: {reason}")
+        plot = StudyMapPlot()
+        plot.update(view)
+        plot.band.update(band)
+        plot.figure.sizing_mode, plot.figure.width = "fixed", 1000
+        page_file = Path(folder) / "map.html"
+        page_file.write_text(file_html(plot.figure, INLINE, "Studies"), encoding="utf-8")
+        with sync_playwright() as playwright:
+            browser = playwright.chromium.launch(executable_path="/usr/bin/chromium",
+                                                 args=["--no-sandbox", "--headless=new"])
+            page = browser.new_page(viewport={"width": 1100, "height": 400})
+            page.goto(page_file.as_uri())
+            page.wait_for_timeout(1500)
+            page.screenshot(path=str(png))
+            browser.close()
+    print(f"wrote {png}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,190 @@
+"""The s0*(v) uncertainty band in the Studies view (app/uncertainty_band.py), without a server.
+
+The result files are written by the model's own :meth:`UncertaintyResult.as_dict` (a small
+result assembled from plain arrays: the band's logic needs the provenance and the percentiles,
+not a model run; a real CLI run is in tests/test_posterior.py).  Checked: a result of the set
+and conditions on screen draws its 5–95 % band and median at its speeds, with the method and
+sample count in the legend; a different wheel force, motor slope, rail condition or parameter
+set clears the band and the notice says which; a result without provenance (the older format
+of assets/data/uncertainty_n16.json) is not drawn; a bad file keeps the previous band; with a
+map on screen the map's set and conditions count.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import param
+import pytest
+from bokeh.document import Document
+
+from app import compute
+from app.dashboard import BogieDashboard
+from app.studies_view import MapView
+from app.uncertainty_band import band_mismatch, read_band
+from model.parameters import parameter_hash
+from model.uncertainty import UNCERTAIN_PARAMETERS, UncertaintyResult, output_names, output_units
+
+SPEEDS = (40.0, 120.0, 200.0)
+
+
+def _result_file(path: Path, parameters, method="posterior", names=None, seed=3) -> Path:
+    names = tuple(p.name for p in UNCERTAIN_PARAMETERS) if names is None else names
+    outputs = output_names(SPEEDS)
+    rng = np.random.default_rng(seed)
+    n = 8
+    values = rng.uniform(0.5, 1.5, (n, len(outputs)))
+    values[:, :len(SPEEDS)] *= np.array([0.012, 0.0082, 0.006])  # s0* [-]
+    blank = np.full((len(outputs), len(names)), np.nan)
+    result = UncertaintyResult(names, tuple((1.0, 2.0) for _ in names), outputs,
+                               output_units(SPEEDS), n, n, rng.uniform(1, 2, (n, len(names))),
+                               values, blank, blank, np.array([blank, blank]),
+                               np.array([blank, blank]), seed, values.mean(axis=0),
+                               method=method, indices=False, speeds_kmh=SPEEDS,
+                               parameters_hash=parameter_hash(parameters),
+                               wheel_force=parameters["wheel_force"],
+                               motor_slope=parameters["motor_slope"])
+    path.write_text(json.dumps(result.as_dict(), allow_nan=False), encoding="utf-8")
+    return path
+
+
+@pytest.fixture(scope="module")
+def dash():
+    dashboard = BogieDashboard()
+    doc = Document()
+    doc.add_root(dashboard.layout.get_root(doc))
+    return dashboard
+
+
+@pytest.fixture
+def view(dash):
+    with param.parameterized.discard_events(dash):
+        dash.N0, dash.b_M, dash.rail = 100.0, 3000.0, "calibrated"
+    view = dash.studies
+    view.map, view.uncertainty = None, None
+    view.plot.band.update(None)
+    view.band_notice.visible = False
+    return view
+
+
+def test_matching_result_draws_its_band(view, dash, tmp_path):
+    parameters = compute.parameters("", "calibrated")
+    assert (parameters["wheel_force"], parameters["motor_slope"]) == (100e3, 3000.0)
+    path = _result_file(tmp_path / "u.json", parameters)
+    band = read_band(path)
+    view.uncertainty_path.value = str(path)
+    view.uncertainty_button.clicks += 1  # the button's own callback
+    assert view.uncertainty is not None
+    assert not view.band_notice.visible, view.band_notice.object
+    assert view.plot.band.shown
+    assert len(view.plot.image.data["image"]) == 0  # no map: the axes fit the band
+    data = view.plot.band.source.data
+    np.testing.assert_array_equal(data["v"], SPEEDS)
+    np.testing.assert_array_equal(data["low"], band.p5)
+    np.testing.assert_array_equal(data["high"], band.p95)
+    assert np.all(data["low"] < data["median"])
+    assert np.all(data["median"] < data["high"])
+    stored = json.loads(path.read_text())
+    p5 = [o["p5"] for o in stored["outputs"] if o["name"].startswith("s0_limit_")]
+    np.testing.assert_allclose(data["low"], p5)
+    labels = [item.label["value"] for item in view.plot.figure.legend[0].items]
+    assert "s0* 5–95 % (posterior, n = 8) [-]" in labels
+    assert "posterior, n = 8" in view.band_status.object
+    assert "40, 120, 200 km/h" in view.band_status.object
+    # the same band on the Variant tab's baseline s0*(v)
+    assert view.variant_band.shown
+    np.testing.assert_array_equal(view.variant_band.source.data["high"], band.p95)
+    assert view.variant_band.area in dash.variant_view.limits_figure.renderers
+    assert "also on the Variant tab" in view.band_status.object
+
+
+@pytest.mark.parametrize(("change", "reason"), [
+    ({"N0": 120.0}, "wheel force N0: result 100 kN, screen 120 kN"),
+    ({"b_M": 2000.0}, "motor slope b_M: result sampled around 3000 N m s/rad, screen 2000"),
+    ({"rail": "wet"}, "rail condition: result 'calibrated', screen 'wet'"),
+])
+def test_other_conditions_clear_the_band_and_say_why(view, dash, tmp_path, change, reason):
+    view.open_uncertainty(str(_result_file(tmp_path / "u.json", compute.parameters("", "calibrated"))))
+    assert view.plot.band.shown
+    with param.parameterized.discard_events(dash):
+        dash.param.update(**change)
+    view.check_band()
+    assert not view.plot.band.shown
+    assert not view.variant_band.shown
+    assert view.band_notice.visible
+    assert reason in view.band_notice.object
+    assert "does not match the dashboard's set" in view.band_notice.object
+    with param.parameterized.discard_events(dash):
+        dash.N0, dash.b_M, dash.rail = 100.0, 3000.0, "calibrated"
+    view.check_band()
+    assert view.plot.band.shown
+    assert not view.band_notice.visible
+
+
+def test_slider_change_rechecks_the_band(view, dash, tmp_path):
+    view.open_uncertainty(str(_result_file(tmp_path / "u.json", compute.parameters("", "calibrated"))))
+    assert view.plot.band.shown
+    dash.N0 = 110.0  # the watcher re-checks (the dashboard recomputes its point too)
+    assert not view.plot.band.shown
+    assert "wheel force N0" in view.band_notice.object
+    dash.N0 = 100.0
+    assert view.plot.band.shown
+
+
+def test_other_parameter_set_and_old_format_are_not_drawn(view, tmp_path):
+    other = compute.parameters("", "calibrated").replace(yaw_damping=3e5)
+    view.open_uncertainty(str(_result_file(tmp_path / "u.json", other)))
+    assert not view.plot.band.shown
+    assert "parameter set: result" in view.band_notice.object
+    assert "re-calibrated" in view.band_notice.object
+    old = Path(__file__).resolve().parent.parent / "assets" / "data" / "uncertainty_n16.json"
+    view.open_uncertainty(str(old))
+    assert not view.plot.band.shown
+    assert "does not say which parameter set" in view.band_notice.object
+
+
+def test_bad_file_keeps_the_previous_band(view, tmp_path):
+    path = _result_file(tmp_path / "u.json", compute.parameters("", "calibrated"))
+    view.open_uncertainty(str(path))
+    shown = view.uncertainty
+    (tmp_path / "bad.json").write_text("{not json", encoding="utf-8")
+    for bad, message in ((tmp_path / "bad.json", "is not JSON"),
+                         (tmp_path / "missing.json", "is not a file")):
+        view.open_uncertainty(str(bad))
+        assert view.band_notice.visible
+        assert message in view.band_notice.object
+        assert "previous one kept" in view.band_notice.object
+        assert view.uncertainty is shown
+        assert view.plot.band.shown
+
+
+def test_the_map_on_screen_decides(view, tmp_path):
+    parameters = compute.parameters("", "calibrated")
+    view.open_uncertainty(str(_result_file(tmp_path / "u.json", parameters)))
+    assert view.plot.band.shown
+
+    def map_view(hash_, N0=100e3, b_M=3000.0):
+        return MapView(np.array([0.005, 0.01]), np.array([40.0, 200.0]), np.zeros((2, 2)),
+                       np.full(2, np.nan), 2, 2, {"parameters_hash": hash_}, N0, b_M)
+
+    view._show(map_view(parameter_hash(compute.parameters("", "wet"))))  # a wet-rail map
+    assert not view.plot.band.shown
+    assert "does not match the map on screen" in view.band_notice.object
+    view._show(map_view(parameter_hash(parameters), N0=90e3))
+    assert "wheel force N0: result 100 kN, screen 90 kN" in view.band_notice.object
+    assert view.variant_band.shown  # the Variant tab shows the dashboard's set, which matches
+    view._show(map_view(parameter_hash(parameters)))
+    assert view.plot.band.shown
+
+
+def test_band_mismatch_without_sampled_motor_slope(tmp_path):
+    parameters = compute.parameters("", "calibrated")
+    names = ("creep_slope",)
+    band = read_band(_result_file(tmp_path / "u.json", parameters, method="prior", names=names))
+    assert band.method == "prior"
+    assert not band.motor_slope_sampled
+    assert band_mismatch(band, parameter_hash(parameters), 100e3, 3000.0, "calibrated") is None
+    reason = band_mismatch(band, parameter_hash(parameters), 100e3, 2000.0, "calibrated")
+    assert reason == "motor slope b_M: result 3000 N m s/rad, screen 2000 N m s/rad"

@@ -1,0 +1,55 @@
+"""The s0*(v) uncertainty band in the served Studies tab (headless Chromium).
+
+A result of the calibrated set at the dashboard's default N0 and b_M (written by the model's
+``UncertaintyResult.as_dict``, see tests/test_uncertainty_band.py) is opened by its path; the
+band's data reach the browser, the figure renders without console errors, and a result of
+another wheel force shows the notice instead.  Screenshot: ``test-artifacts/uncertainty_band.png``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import open_app
+from test_uncertainty_band import SPEEDS, _result_file
+
+from app import compute
+
+OUTPUT = Path(__file__).resolve().parent.parent / "test-artifacts"  # git-ignored
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
+
+BAND = """() => {
+  const source = Bokeh.documents[0].get_model_by_name('study-s0-band');
+  const d = source.data;
+  const v = d instanceof Map ? d.get('v') : d['v'];
+  return Array.from(v);
+}"""
+
+
+def _open(page, path: Path) -> None:
+    page.locator(".study-uncertainty input").fill(str(path))
+    page.locator(".study-uncertainty input").press("Enter")
+    page.locator(".study-open-uncertainty button").click()
+
+
+def test_band_is_drawn_and_a_mismatch_is_explained(app_server, chromium, tmp_path):
+    OUTPUT.mkdir(exist_ok=True)
+    parameters = compute.parameters("", "calibrated")
+    good = _result_file(tmp_path / "good.json", parameters)
+    other = _result_file(tmp_path / "other.json", parameters.replace(wheel_force=120e3))
+    page = open_app(chromium, app_server)
+    page.locator(".stability-status", has_text="STABLE").wait_for(timeout=60_000)
+    page.locator(".bk-tab", has_text="Studies").first.click()
+    _open(page, good)
+    page.wait_for_function(f"() => ({BAND})().length === {len(SPEEDS)}", timeout=60_000)
+    assert page.evaluate(BAND) == list(SPEEDS)
+    page.locator(".study-band-status", has_text="posterior, n = 8").wait_for(timeout=30_000)
+    page.wait_for_timeout(500)
+    page.screenshot(path=str(OUTPUT / "uncertainty_band.png"), full_page=True)
+    _open(page, other)
+    page.locator(".study-band-notice", has_text="wheel force N0: result 120 kN, screen 100 kN"
+                 ).wait_for(timeout=30_000)
+    page.wait_for_function(f"() => ({BAND})().length === 0", timeout=30_000)
+    assert page.errors == [], page.errors
+    page.close()
