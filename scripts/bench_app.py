@@ -32,16 +32,17 @@ import asyncio
 import json
 import os
 import random
-import socket
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
-import urllib.request
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+import served_app  # noqa: E402 - the scripts' own helpers
+from served_app import free_port  # noqa: E402 - also used by bench_nonlinear_app
+
 CHROMIUM = "/usr/bin/chromium"
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
@@ -74,29 +75,8 @@ def cpu_seconds(match: str) -> float:
     return total
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def start_server(port: int) -> subprocess.Popen:
-    server_log = Path(tempfile.gettempdir()) / f"bench_app_server_{port}.log"
-    log(f"server log: {server_log}")
-    process = subprocess.Popen([str(ROOT / ".venv/bin/bogie"), "serve", "--port", str(port)],
-                               cwd=ROOT, stdout=subprocess.DEVNULL,
-                               stderr=server_log.open("w"))
-    deadline = time.monotonic() + 180
-    while time.monotonic() < deadline:
-        try:
-            with urllib.request.urlopen(f"http://127.0.0.1:{port}/liveness?endpoint=/app",
-                                        timeout=120) as r:
-                if r.status == 200:
-                    return process
-        except OSError:
-            time.sleep(0.5)
-    process.kill()
-    raise SystemExit("bench_app: the server did not come up")
+def start_server(port: int):
+    return served_app.start_server(port, "bench_app")
 
 
 async def open_page(browser, url: str):

@@ -32,11 +32,8 @@ import base64
 import json
 import os
 import random
-import socket
 import statistics
-import subprocess
 import sys
-import tempfile
 import threading
 import time
 import urllib.error
@@ -45,42 +42,17 @@ import urllib.request
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+import served_app  # noqa: E402 - the scripts' own helpers
+from served_app import alive, free_port  # noqa: E402
 
 
 def log(message: str) -> None:
     print(f"reliability_app: {time.strftime('%H:%M:%S')} {message}", file=sys.stderr, flush=True)
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def start_server(port: int) -> subprocess.Popen:
-    server_log = Path(tempfile.gettempdir()) / f"reliability_app_server_{port}.log"
-    log(f"server log: {server_log}")
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
-    process = subprocess.Popen([str(ROOT / ".venv/bin/bogie"), "serve", "--port", str(port)],
-                               cwd=ROOT, stdout=subprocess.DEVNULL,
-                               stderr=server_log.open("w"), env=env)
-    if not alive(f"http://127.0.0.1:{port}", timeout=180):
-        process.kill()
-        raise SystemExit("reliability_app: the server did not come up")
-    return process
-
-
-def alive(url: str, timeout: float = 60.0) -> bool:
-    """Whether ``/liveness?endpoint=/app`` answers 200 (it builds the app) within ``timeout``."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        try:
-            with urllib.request.urlopen(f"{url}/liveness?endpoint=/app", timeout=120) as r:
-                if r.status == 200:
-                    return True
-        except (OSError, urllib.error.URLError):
-            time.sleep(0.5)
-    return False
+def start_server(port: int):
+    return served_app.start_server(port, "reliability_app")
 
 
 def rss_mb(pid: int) -> float:

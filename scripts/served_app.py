@@ -1,0 +1,53 @@
+"""Start ``bogie serve`` for a benchmark or reliability script: a free port, the server as a
+separate process (as users run it, one BLAS thread per computation), its log in the temporary
+directory, and a wait until its liveness endpoint answers."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.request
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def alive(url: str, timeout: float = 60.0) -> bool:
+    """Whether ``/liveness?endpoint=/app`` answers 200 (it builds the app) within ``timeout``
+    [s]."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            with urllib.request.urlopen(f"{url}/liveness?endpoint=/app", timeout=120) as r:
+                if r.status == 200:
+                    return True
+        except (OSError, urllib.error.URLError):
+            time.sleep(0.5)
+    return False
+
+
+def start_server(port: int, name: str) -> subprocess.Popen:
+    """``bogie serve --port PORT`` with its log in ``<tmp>/<name>_server_<port>.log``; exits
+    the calling script if the server is not up within 180 s."""
+    server_log = Path(tempfile.gettempdir()) / f"{name}_server_{port}.log"
+    print(f"{name}: {time.strftime('%H:%M:%S')} server log: {server_log}", file=sys.stderr,
+          flush=True)
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    process = subprocess.Popen([str(ROOT / ".venv/bin/bogie"), "serve", "--port", str(port)],
+                               cwd=ROOT, stdout=subprocess.DEVNULL,
+                               stderr=server_log.open("w"), env=env)
+    if not alive(f"http://127.0.0.1:{port}", timeout=180):
+        process.kill()
+        raise SystemExit(f"{name}: the server did not come up")
+    return process
