@@ -16,8 +16,6 @@ them, with the same output names (totals), plus per wheel ``<rim>.creepage`` [-]
 from __future__ import annotations
 
 import argparse
-import csv
-import json
 from pathlib import Path
 
 import numpy as np
@@ -164,26 +162,9 @@ def summary_table(result) -> str:
 
 
 def write_result(result, path: Path) -> None:
-    data = series(result)
-    names = list(data)
-    if path.suffix == ".npz":
-        arrays = {"t": result.t, "M_C": result.M_C, **{n: data[n][0] for n in names},
-                  "names": np.array(names, dtype=str),
-                  "units": np.array([data[n][1] for n in names], dtype=str),
-                  "steady": np.array([result.steady.get(n, np.nan) for n in names])}
-        np.savez(path, **arrays)
-    elif path.suffix == ".csv":
-        with path.open("w", newline="") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(["t [s]", "M_C [N m]"] + [f"{n} [{data[n][1]}]" for n in names])
-            table = np.column_stack([result.t, result.M_C] + [data[n][0] for n in names])
-            writer.writerows([[repr(float(x)) for x in row] for row in table])
-    else:
-        summary = summary_data(result)
-        summary["t"] = result.t.tolist()
-        summary["M_C"] = result.M_C.tolist()
-        summary["series"] = {n: data[n][0].tolist() for n in names}
-        path.write_text(json.dumps(summary, allow_nan=False))
+    from .response_cli import write_series  # (response_cli imports this module)
+
+    write_series(path, result.t, result.M_C, series(result), result.steady, summary_data(result))
 
 
 def cmd_nonlinear_response(args: argparse.Namespace, excitation, names, out: Path | None) -> None:
@@ -194,12 +175,9 @@ def cmd_nonlinear_response(args: argparse.Namespace, excitation, names, out: Pat
     model, op, _ = load_model(args)
     result = nonlinear_response(model, op, excitation, args.t_end, args.fs, creep=args.creep,
                                 anti_slip=anti_slip, outputs=names, strength=args.strength)
-    if out is not None:
-        write_result(result, out)
-    summary = summary_data(result)
-    if out is not None:
-        summary["out"] = str(out)
-    emit(args, summary, summary_table(result) + (f"\nwrote {out}" if out else ""))
+    from .response_cli import finish  # (response_cli imports this module)
+
+    finish(args, result, out, write_result, summary_data, summary_table)
 
 
 # --- bogie antislip ------------------------------------------------------------------------------

@@ -97,12 +97,18 @@ def cmd_response(args: argparse.Namespace) -> None:
         raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the highest excited "
                          f"frequency {result.highest_excited_hz:.4g} Hz: must be at least "
                          f"{MIN_SAMPLES_PER_PERIOD * result.highest_excited_hz:.4g} Hz")
+    finish(args, result, out, write_result, summary_data, summary_table)
+
+
+def finish(args: argparse.Namespace, result, out: Path | None, write, summarize, table) -> None:
+    """The tail of a response command: ``write(result, out)`` if asked, then the summary
+    (``summarize(result)``, JSON) or the table (``table(result)``, text)."""
     if out is not None:
-        write_result(result, out)
-    summary = summary_data(result)
+        write(result, out)
+    summary = summarize(result)
     if out is not None:
         summary["out"] = str(out)
-    emit(args, summary, summary_table(result) + (f"\nwrote {out}" if out else ""))
+    emit(args, summary, table(result) + (f"\nwrote {out}" if out else ""))
 
 
 def summary_data(result) -> dict:
@@ -160,22 +166,34 @@ def limit_lines(result) -> list[str]:
 
 
 def write_result(result, path: Path) -> None:
-    names = list(result.outputs)
+    write_series(path, result.t, result.M_C,
+                 {name: (result.outputs[name], result.units[name]) for name in result.outputs},
+                 result.steady, summary_data(result))
+
+
+def write_series(path: Path, t: np.ndarray, M_C: np.ndarray,
+                 series: dict[str, tuple[np.ndarray, str]], steady: dict[str, float],
+                 summary: dict) -> None:
+    """Time series (name -> (values, unit)) at times ``t`` [s] with the short-circuit torque
+    ``M_C`` [N m] as ``.npz`` (arrays, names, units, steady values; NaN where a series has
+    none), ``.csv`` (one column per series, units in the header) or ``.json`` (``summary``
+    plus the series)."""
+    names = list(series)
     if path.suffix == ".npz":
-        arrays = {"t": result.t, "M_C": result.M_C, **result.outputs,
+        arrays = {"t": t, "M_C": M_C, **{n: series[n][0] for n in names},
                   "names": np.array(names, dtype=str),
-                  "units": np.array([result.units[n] for n in names], dtype=str),
-                  "steady": np.array([result.steady[n] for n in names])}
+                  "units": np.array([series[n][1] for n in names], dtype=str),
+                  "steady": np.array([steady.get(n, np.nan) for n in names])}
         np.savez(path, **arrays)
     elif path.suffix == ".csv":
         with path.open("w", newline="") as handle:
             writer = csv.writer(handle)
-            writer.writerow(["t [s]", "M_C [N m]"] + [f"{n} [{result.units[n]}]" for n in names])
-            table = np.column_stack([result.t, result.M_C] + [result.outputs[n] for n in names])
+            writer.writerow(["t [s]", "M_C [N m]"] + [f"{n} [{series[n][1]}]" for n in names])
+            table = np.column_stack([t, M_C] + [series[n][0] for n in names])
             writer.writerows([[repr(float(x)) for x in row] for row in table])
     else:
-        data = summary_data(result)
-        data["t"] = result.t.tolist()
-        data["M_C"] = result.M_C.tolist()
-        data["series"] = {n: result.outputs[n].tolist() for n in names}
+        data = dict(summary)
+        data["t"] = t.tolist()
+        data["M_C"] = M_C.tolist()
+        data["series"] = {n: series[n][0].tolist() for n in names}
         path.write_text(json.dumps(data, allow_nan=False))
