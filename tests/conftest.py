@@ -139,3 +139,28 @@ def open_app(browser, url: str, timeout_ms: float = 120_000, viewport=(1600, 100
     page.wait_for_selector("canvas", timeout=timeout_ms)
     page.wait_for_selector(".stability-status", timeout=timeout_ms)
     return page
+
+
+# --- golden files (tests/golden/*.json) ------------------------------------------------------------
+
+def load_golden(path: Path, regenerate: str) -> dict:
+    """A golden file's contents; fails (naming the regeneration command) if it is missing."""
+    import json
+
+    if not path.is_file():
+        pytest.fail(f"{path} is missing; {regenerate}")
+    return json.loads(path.read_text(encoding="utf-8"))
+
+
+def golden_parameters(golden: dict, path: Path, regenerate: str):
+    """The parameter set stored in a golden file (its values, units from the schema); fails if
+    they no longer fit the schema."""
+    from model import ParameterError
+    from model.parameters import SCHEMA, parse_parameters
+
+    table = {name: {"value": value, "unit": SCHEMA[name][0] if name in SCHEMA else "?"}
+             for name, value in golden["parameters"].items()}
+    try:
+        return parse_parameters(table, source=str(path))
+    except ParameterError as error:
+        pytest.fail(f"the golden parameters no longer fit the schema ({error}); {regenerate}")

@@ -13,14 +13,13 @@ at worst, docs/response.md), and 0.5 s of the nonlinear response does not amplif
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import pytest
+from conftest import golden_parameters, load_golden
 
 from model import build_model
-from model.parameters import SCHEMA, parse_parameters
 
 ROOT = Path(__file__).resolve().parent.parent
 GOLDEN_FILE = ROOT / "tests" / "golden" / "nonlinear.json"
@@ -30,16 +29,12 @@ RTOL = 1e-7
 
 @pytest.fixture(scope="module")
 def golden() -> dict:
-    if not GOLDEN_FILE.is_file():
-        pytest.fail(f"{GOLDEN_FILE} is missing; {REGENERATE}")
-    return json.loads(GOLDEN_FILE.read_text(encoding="utf-8"))
+    return load_golden(GOLDEN_FILE, REGENERATE)
 
 
 @pytest.fixture(scope="module")
 def golden_model(golden):
-    table = {name: {"value": value, "unit": SCHEMA[name][0] if name in SCHEMA else "?"}
-             for name, value in golden["parameters"].items()}
-    parameters = parse_parameters(table, source=str(GOLDEN_FILE))
+    parameters = golden_parameters(golden, GOLDEN_FILE, REGENERATE)
     return parameters, build_model(parameters)
 
 

@@ -14,11 +14,11 @@ These are not literature tests: they guard against unintended changes, at tight 
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import golden_parameters, load_golden
 from scipy.optimize import linear_sum_assignment
 
 from model import (
@@ -30,7 +30,6 @@ from model import (
     stability_limit,
 )
 from model.operating_point import KMH, OperatingPoint
-from model.parameters import SCHEMA, ParameterError, parse_parameters
 
 GOLDEN_FILE = Path(__file__).resolve().parent / "golden" / "calibrated.json"
 REGENERATE = "regenerate with: .venv/bin/python scripts/make_golden.py"
@@ -49,20 +48,12 @@ LIMIT_ATOL = 2e-7
 
 @pytest.fixture(scope="module")
 def golden() -> dict:
-    if not GOLDEN_FILE.is_file():
-        pytest.fail(f"{GOLDEN_FILE} is missing; {REGENERATE}")
-    return json.loads(GOLDEN_FILE.read_text(encoding="utf-8"))
+    return load_golden(GOLDEN_FILE, REGENERATE)
 
 
 @pytest.fixture(scope="module")
 def golden_model(golden):
-    table = {name: {"value": value, "unit": SCHEMA[name][0] if name in SCHEMA else "?"}
-             for name, value in golden["parameters"].items()}
-    try:
-        parameters = parse_parameters(table, source=str(GOLDEN_FILE))
-    except ParameterError as error:
-        pytest.fail(f"the golden parameters no longer fit the schema ({error}); {REGENERATE}")
-    return build_model(parameters)
+    return build_model(golden_parameters(golden, GOLDEN_FILE, REGENERATE))
 
 
 def test_golden_file_is_of_the_current_calibrated_set(golden):
