@@ -43,7 +43,7 @@ from .sensitivity_view import SensitivityView  # issue 12: sensitivity tornado
 from .serve import limit_blas_threads
 from .url_state import make_query, parse_query
 from .variant_view import VariantView
-from .workers import FIRST_ANSWER_POOL, FOLLOW_UP_POOL
+from .workers import FIRST_ANSWER_POOL, FOLLOW_UP_POOL, SIDE_VIEW_POOL
 
 log = logging.getLogger(__name__)
 ASSETS = Path(__file__).resolve().parent.parent / "assets"
@@ -517,8 +517,9 @@ class BogieDashboard(pn.viewable.Viewer):
                     dense = loop.run_in_executor(FOLLOW_UP_POOL, self._dense_if_current, state)
                     dense.add_done_callback(partial(self._dense_done, doc, state))
                 # s0*(v) (≈ 0.7 s) is not waited for: a change arriving meanwhile starts at
-                # once; the limit is shown when ready if it still belongs to the parameters
-                limit = loop.run_in_executor(FOLLOW_UP_POOL, self._limit_if_current, state)
+                # once; the limit is shown when ready if it still belongs to the parameters.  It
+                # yields to the dense locus (which has a target: ≤ 2 s after a speed change)
+                limit = loop.run_in_executor(SIDE_VIEW_POOL, self._limit_if_current, state)
                 limit.add_done_callback(partial(self._limit_done, doc, state))
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")

@@ -19,8 +19,8 @@ from model.locus import set_thread_niceness
 
 # niceness (0 .. 19; CPU share against a niceness-0 thread: 5 → 33 %, 10 → 11 %, 19 → 1.5 %)
 FIRST_ANSWER = 0  # eigenvalues, status, time histories; the coarse root locus
-FOLLOW_UP = 5  # dense root locus, s0*(v), nonlinear histories: awaited on screen
-SIDE_VIEW = 10  # sensitivities, the variant comparison: views beside the main one
+FOLLOW_UP = 5  # dense root locus, nonlinear histories: awaited on screen
+SIDE_VIEW = 10  # s0*(v), sensitivities, the variant comparison
 SEARCH = 19  # reaction-time searches (tens of nonlinear runs)
 
 

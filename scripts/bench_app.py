@@ -20,7 +20,8 @@ Starts ``bogie serve`` on a free port (a separate process, as users run it), the
    headless Chromium pages take most of the CPU themselves; in a design review every reviewer's
    browser runs on their own computer, so 4 is the load the *server* sees from ten reviewers,
    and 3 the worst case of everything on one machine.  Both are reported;
-5. ``--screenshots``: assets/screenshots/stable.png and unstable.png (published cases).
+5. ``--screenshots``: assets/screenshots/stable.png and unstable.png (published cases) and
+   tab_*.png (the review tabs at the unstable case).
 
 Prints medians and writes the numbers as JSON (``--json FILE``).
 """
@@ -249,8 +250,16 @@ async def screenshots(browser, url: str) -> None:
         await page.locator(f".case-{case} button").click()
         word = "UNSTABLE" if case == "unstable" else "STABLE"
         await page.locator(".stability-status", has_text=word).wait_for()
+        await page.wait_for_function(f"() => !({LOCUS_TITLE})().includes('computing')",
+                                     polling=100, timeout=300_000)  # the dense locus is shown
         await wait_idle(page)
         await page.screenshot(path=str(out / f"{case}.png"), full_page=True)
+    # the review tabs at the unstable case (s0 = 0.014, 120 km/h)
+    for title, name in (("Fig. 6", "fig6"), ("Modes", "modes"), ("Variant", "variant"),
+                        ("Sensitivity", "sensitivity"), ("Studies", "studies")):
+        await page.locator(".bk-tab", has_text=title).first.click()
+        await asyncio.sleep(6.0)  # the tab's views are brought up to date, then drawn
+        await page.screenshot(path=str(out / f"tab_{name}.png"), full_page=True)
     await page.close()
 
 
