@@ -49,7 +49,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from .assembly import BogieModel
-from .eigen import state_space
+from .eigen import eigen_analysis, state_space
 from .operating_point import (
     OperatingPoint,
     creep_coefficients,
@@ -358,7 +358,8 @@ class Continuation:
         nearby = np.zeros(len(mu), dtype=int)
         active = np.arange(len(mu))
         iterations = 0
-        for iterations in range(1, MAX_ITERATIONS + 1):
+        while iterations < MAX_ITERATIONS:
+            iterations += 1
             new, derivative, near = self._newton_step(dc, mu[active], members[active])
             delta = (new - mu[active]) / (1.0 - derivative)
             mu[active] += delta
@@ -394,8 +395,9 @@ class Continuation:
         if np.any(copies > multiplicity):
             return "two roots converged to one value"
         trace = a.poles.sum() + dc * a.trace_update
-        if abs(full.sum() - trace) > TRACE_RTOL * np.abs(full).sum():
-            return f"trace identity violated (a root is lost): {abs(full.sum() - trace) / np.abs(full).sum():.1e}"
+        mismatch = abs(full.sum() - trace) / np.abs(full).sum()
+        if mismatch > TRACE_RTOL:
+            return f"trace identity violated (a root is lost): {mismatch:.1e}"
         # tr (Λ + Δc Ũ Ṽᵀ)⁻¹ by Sherman–Morrison–Woodbury
         inv_poles = 1.0 / a.poles
         correction = 0.0
@@ -403,8 +405,9 @@ class Continuation:
             small = np.eye(4) / dc + (a.Vt * inv_poles) @ a.Ut
             correction = np.trace(np.linalg.solve(small, (a.Vt * inv_poles**2) @ a.Ut))
         inverse_trace = inv_poles.sum() - correction
-        if abs((1.0 / full).sum() - inverse_trace) > TRACE_RTOL * np.abs(1.0 / full).sum():
-            return f"inverse-trace identity violated (a small root is lost): {abs((1.0 / full).sum() - inverse_trace) / np.abs(1.0 / full).sum():.1e}"
+        mismatch = abs((1.0 / full).sum() - inverse_trace) / np.abs(1.0 / full).sum()
+        if mismatch > TRACE_RTOL:
+            return f"inverse-trace identity violated (a small root is lost): {mismatch:.1e}"
         return None
 
     @staticmethod
@@ -440,7 +443,7 @@ class LineContinuation:
     """Continuation along one line at (v, N0, b_M) [m/s, N, N m s/rad]; points in any order
     (each continues from the last certified one)."""
 
-    MAX_HALVINGS = 4  # a step that fails is halved up to this often (≤ 16 substeps)
+    MAX_HALVINGS = 6  # a failing step is halved down to 1/64 of the way before a fallback
 
     def __init__(self, model: BogieModel, v: float, N0: float, b_M: float):
         self.model, self.v, self.N0, self.b_M = model, v, N0, b_M
@@ -492,14 +495,24 @@ class LineContinuation:
         if reason is None:
             self.tracked = Tracked(mu, self.tracked.mirrored, self.tracked.origin)
             self.c = c
-            self._history = (self._history + [(c, mu)])[-2:]
+            self._history = [*self._history, (c, mu)][-2:]
         return reason
 
-    def evaluate(self, s0: float) -> tuple[np.ndarray, bool]:
+    def state(self) -> tuple:
+        """The continuation's state (to come back to with :meth:`restore`)."""
+        return self.current, self.tracked, self.c, list(self._history)
+
+    def restore(self, state: tuple) -> None:
+        self.current, self.tracked, self.c, history = state
+        self._history = list(history)
+
+    def evaluate(self, s0: float, reanchor: bool = True) -> tuple[np.ndarray, bool]:
         """(all non-rigid eigenvalues [1/s], solved densely) at s0; the first call anchors
         there.  A step that fails the checks is retried as shorter steps (halved, down to
         1/2^MAX_HALVINGS of the way; a successful piece is kept and the next one doubled)
-        before the point is solved densely and becomes the new anchor."""
+        before the point is solved densely: with ``reanchor`` it becomes the new anchor (an
+        eigendecomposition with vectors), without (off-grid evaluations, e.g. for s0*) only its
+        eigenvalues are computed and the state stays at the last certified point."""
         op = self.op(s0)
         if self.current is None:
             return self._anchor_at(op), True
@@ -522,6 +535,8 @@ class LineContinuation:
                 break
         self.fallbacks += 1
         self.reasons.append(f"s0 = {s0:.6g}: {reason}")
+        if not reanchor:
+            return eigen_analysis(self.model, op, vectors=False).eigenvalues, True
         return self._anchor_at(op), True
 
 
