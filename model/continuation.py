@@ -47,6 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
 
 from .assembly import BogieModel
 from .eigen import eigen_analysis, state_space
@@ -65,7 +67,8 @@ TRACE_RTOL = 1e-9  # tolerance of the trace identities, relative to Σ|μ| and �
 MAX_ITERATIONS = 12
 REAL_RTOL = 1e-9  # |Im μ| ≤ this·|μ|: real
 GROUP_TERM = 0.1  # poles whose term in E_R is larger than this are eliminated with the root
-GROUP_MAX = 8  # at most this many poles per root
+GROUP_MAX = 8  # at most this many poles per root (more where more roots share a group)
+ROOT_NEIGHBOURS = 0.1  # roots closer than this x their distance to the nearest pole share
 PREDICTOR_GROUPING = 3.0  # poles closer than this x their summed first-order shifts interact
 KICK = 1e-7  # relative imaginary start of real roots (see LineContinuation._predict)
 UNMIRROR = 0.05  # pairs with Im ≤ this·|μ| are tracked half by half (they may turn real)
@@ -272,24 +275,51 @@ class Continuation:
                 values[best] = np.inf
         return result
 
-    def _groups(self, dc: float, D: np.ndarray) -> np.ndarray:
-        """The poles eliminated with each root (rows of D = μ − λ_j): the anchor cluster of its
-        nearest pole, and the poles whose term |Δc|·‖ũ_j‖‖ṽ_j‖/|μ − λ_j| in E_R exceeds
-        :data:`GROUP_TERM` (they interact with the root strongly), at most :data:`GROUP_MAX` by
-        that size.  Any choice is exact; it only shapes Newton's basins."""
+    def _groups(self, dc: float, mu: np.ndarray) -> np.ndarray:
+        """The poles eliminated with each root μ: the anchor cluster of its nearest pole, and
+        the poles whose term |Δc|·‖ũ_j‖‖ṽ_j‖/|μ − λ_j| in E_R exceeds :data:`GROUP_TERM` (they
+        interact with the root strongly), at most :data:`GROUP_MAX` by that size.  Roots
+        closer to each other than :data:`ROOT_NEIGHBOURS` x their distance to the nearest pole
+        (e.g. two real roots about to meet) share one group of at least as many poles as they
+        are (the union of theirs, topped up by the largest terms), so that they choose jointly
+        among as many eigenvalues of S.  Any choice is exact; it only shapes Newton's basins.
+        Returns (b, width) pole indices, −1 padded."""
         a = self.anchor
-        distance = np.abs(D)
+        distance = np.abs(mu[:, None] - a.poles[None, :])
         score = abs(dc) * a.weight[None, :] / np.maximum(distance, 1e-300)
         nearest = np.argmin(distance, axis=1)
         own = a.members[a.cluster[nearest]]
-        b = np.repeat(np.arange(len(D)), own.shape[1])
+        b = np.repeat(np.arange(len(mu)), own.shape[1])
         ok = own.ravel() >= 0
         score[b[ok], own.ravel()[ok]] = np.inf
         top = np.argpartition(-score, GROUP_MAX - 1, axis=1)[:, :GROUP_MAX]
         chosen = np.take_along_axis(score, top, axis=1) > GROUP_TERM
         order = np.argsort(~chosen, axis=1, kind="stable")  # chosen first
         top = np.take_along_axis(np.where(chosen, top, -1), order, axis=1)
-        return top
+        # roots that are neighbours share a group
+        gap = distance[np.arange(len(mu)), nearest]
+        close = np.abs(mu[:, None] - mu[None, :]) <= ROOT_NEIGHBOURS * np.minimum(
+            gap[:, None], gap[None, :])
+        count, label = connected_components(csr_matrix(close), directed=False)
+        sizes = np.bincount(label, minlength=count)
+        shared = {}
+        for k in np.flatnonzero(sizes > 1):
+            roots = np.flatnonzero(label == k)
+            poles = np.unique(top[roots])
+            poles = list(poles[poles >= 0])
+            if len(poles) < len(roots):  # top up by the largest terms over the roots
+                ranking = np.argsort(-score[roots].max(axis=0))
+                poles += [j for j in ranking if j not in poles][:len(roots) - len(poles)]
+            shared[k] = (roots, poles)
+        if not shared:
+            return top
+        width = max(top.shape[1], max(len(p) for _, p in shared.values()))
+        groups = np.full((len(mu), width), -1)
+        groups[:, :top.shape[1]] = top
+        for roots, poles in shared.values():
+            groups[roots] = -1
+            groups[np.ix_(roots, np.arange(len(poles)))] = poles
+        return groups
 
     def _newton_step(self, dc: float, mu: np.ndarray, members: np.ndarray):
         """One Newton step for the roots ``mu`` at Δc with their groups of poles ``members``
@@ -351,7 +381,7 @@ class Continuation:
         :func:`_select`) have converged."""
         dc = c - self.anchor.c_ref
         mu = np.array(start, dtype=complex)
-        members = self._groups(dc, mu[:, None] - self.anchor.poles[None, :])
+        members = self._groups(dc, mu)
         _, key = np.unique(np.sort(members, axis=1), axis=0, return_inverse=True)
         key = key.ravel()
         step = np.full(len(mu), np.inf)
