@@ -5,7 +5,7 @@ The unit of work is a **line**: all creepages s0 of the map at one (v, N0, b_M).
 only the longitudinal creep coefficient b11 = N0 μ'(s0)/v changes (b22, b23, b33 depend on v and
 N0 only), so the state matrix is a rank-4 update of the one at an anchor creepage.
 
-:func:`s0_line` (method "continuation", the default) continues **every** non-rigid eigenvalue
+:func:`s0_line` with method "continuation" continues **every** non-rigid eigenvalue
 along the line from one eigendecomposition (:mod:`model.continuation`): exact to its
 convergence tolerance at every point, checked there (convergence, local multiplicity, trace and
 inverse-trace identities); a point failing the checks is solved by a full eigen-analysis and
@@ -272,17 +272,19 @@ class _LineModel:
 
 
 def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
-            s0_limit_xtol: float = 1e-6, method: str = "continuation",
+            s0_limit_xtol: float = 1e-6, method: str = "reduced",
             max_frequency_hz: float = 10.0, rtol: float = 1e-6) -> LineResult:
     """Largest real part, flutter pairs and divergent reals at every creepage of ``s0_values``
     (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
     [N m s/rad]; and s0* inside the line's range by Brent's method on the same evaluation.
 
-    ``method``: "continuation" (default, :mod:`model.continuation`: every non-rigid eigenvalue
-    at every point, exact to the convergence tolerance, checked at every point; a point that
-    fails the checks is solved by a full eigen-analysis and counted in ``fallbacks``),
-    "reduced" (:func:`reduced_s0_line`, ``max_frequency_hz`` and ``rtol`` apply) or "dense"
-    (:func:`dense_line`)."""
+    ``method``: "continuation" (:mod:`model.continuation`: every non-rigid eigenvalue at every
+    point, exact to the convergence tolerance, checked at every point; a point that fails the
+    checks is solved by a full eigen-analysis and counted in ``fallbacks``), "reduced" (the
+    default: :func:`reduced_s0_line`, ``max_frequency_hz`` and ``rtol`` apply) or "dense"
+    (:func:`dense_line`).  The default stays "reduced" because it is cheaper: measured on the
+    shared machine, a map point cost 0.35 of an eigenvalues-only analysis with "reduced" and
+    1.26 with "continuation" (BENCHMARKS.md, issue 13)."""
     if method == "reduced":
         return reduced_s0_line(model, s0_values, v, N0, b_M, max_frequency_hz, rtol,
                                s0_limit_xtol)
@@ -396,7 +398,7 @@ class MapStudy:
     b_M: tuple[float, ...]  # motor slopes [N m s/rad]
     max_frequency_hz: float = 10.0  # reduction basis disc (method "reduced", see s0_line)
     rtol: float = 1e-6  # relative accuracy of the decisive eigenvalues (method "reduced")
-    method: str = "continuation"  # s0_line's method: "continuation", "reduced" or "dense"
+    method: str = "reduced"  # s0_line's method: "reduced", "continuation" or "dense"
     kind: str = field(default="map", init=False)
 
     def __post_init__(self) -> None:

@@ -106,10 +106,10 @@ def register(subparsers) -> None:
                                                   allowed="must be in (0.5, 500) Hz"),
                    default=10.0, help="method reduced: reduction basis disc |λ| < 2π f [Hz] "
                    "(default %(default)s)")
-    m.add_argument("--method", choices=("continuation", "reduced", "dense"),
-                   default="continuation", help="per s0-line: exact continuation of all "
-                   "eigenvalues (default), the Galerkin-reduced model, or a full eigen-analysis "
-                   "per point")
+    m.add_argument("--method", choices=("reduced", "continuation", "dense"),
+                   default="reduced", help="per s0-line: the Galerkin-reduced model (default, "
+                   "cheapest), the exact continuation of all eigenvalues, or a full "
+                   "eigen-analysis per point")
     _common(m)
     m.set_defaults(func=cmd_map)
     limit = sub.add_parser("limit", help="stability limit s0*(v) for lists of N0 and b_M")

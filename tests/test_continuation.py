@@ -97,7 +97,7 @@ def test_s0_line_limit_equals_dense(setup):
     parameters, model = setup
     v, N0, b_M = 120 * KMH, parameters["wheel_force"], parameters["motor_slope"]
     s0 = np.linspace(0.004, 0.016, 13)
-    line = s0_line(model, s0, v, N0, b_M)
+    line = s0_line(model, s0, v, N0, b_M, method="continuation")
     reference = dense_line(model, s0, v, N0, b_M)
     assert line.method == "continuation"
     np.testing.assert_allclose(line.largest_real_part, reference.largest_real_part, rtol=0,
