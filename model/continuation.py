@@ -28,13 +28,15 @@ eigenvalue derivative of S), all roots at once: the sum over R is one complex ma
 degenerate first-order perturbation from the anchor, then secant extrapolation in c), so every
 branch keeps its identity without any eigenvector matching.
 
-**Checks at every point (else: a full eigen-analysis there, which becomes the new anchor):**
-each root's last Newton step ≤ :data:`STEP_RTOL`·max(|μ|, 1 1/s); a tracked real root stays real
-and a complex one keeps Im > 0 (a collision on the real axis changes the count); no two roots
-closer than :data:`DUPLICATE_RTOL` unless they come from one pole cluster (numerically repeated
-twins); and two exact identities of the update, ``Σ μ = tr A22(c) = Σ λ_j + Δc tr(ṼᵀŨ)`` and
-``Σ 1/μ = tr A22(c)⁻¹`` (Sherman–Morrison–Woodbury; it weighs the small eigenvalues that decide
-stability), to :data:`TRACE_RTOL` of the sums of magnitudes.  The fallbacks are counted.
+**Checks at every point (else: shorter steps, then a full eigen-analysis there, which becomes
+the new anchor):** each root's last Newton step ≤ :data:`STEP_RTOL`·max(|μ|, 1 1/s); a complex
+pair tracked by one half keeps Im > 0 (a collision on the real axis changes the count); roots
+closer to each other than :data:`CLUSTER_RTOL` must be, one to one, the eigenvalues of their
+S(μ) there to :data:`DUPLICATE_RTOL` (S(μ) holds every root near μ: a root found twice, or one
+of a near-multiple group found in place of another, fails); and two exact identities of the
+update, ``Σ μ = tr A22(c) = Σ λ_j + Δc tr(ṼᵀŨ)`` and ``Σ 1/μ = tr A22(c)⁻¹``
+(Sherman–Morrison–Woodbury; it weighs the small eigenvalues that decide stability), to
+:data:`TRACE_RTOL` of the sums of magnitudes.  The fallbacks are counted.
 
 Only the tracked half of the spectrum is computed: one of each complex pair (Im > 0) and the real
 ones; the other half are their conjugates (A is real).  Units: c [N s/m], eigenvalues [1/s].
@@ -61,8 +63,8 @@ from .operating_point import (
 
 CLUSTER_GAP = 1e-5  # poles closer than this relative gap are eliminated together
 STEP_RTOL = 1e-10  # a root is converged when its Newton step is below this relative size
-DUPLICATE_RTOL = 1e-11  # k roots closer than this (relative) are one root found k times...
-MULTIPLICITY_RTOL = 1e-9  # ...unless S(μ) has k eigenvalues this close (a multiple root)
+CLUSTER_RTOL = 1e-6  # roots this close (relative) must match S(μ)'s eigenvalues there...
+DUPLICATE_RTOL = 1e-9  # ...one to one, to this (relative; plus |dS/dμ| x their distance)
 TRACE_RTOL = 1e-9  # tolerance of the trace identities, relative to Σ|μ| and Σ|1/μ|
 MAX_ITERATIONS = 12
 REAL_RTOL = 1e-9  # |Im μ| ≤ this·|μ|: real
@@ -302,8 +304,15 @@ class Continuation:
             gap[:, None], gap[None, :])
         count, label = connected_components(csr_matrix(close), directed=False)
         sizes = np.bincount(label, minlength=count)
+        # components whose roots already share one group with enough poles need nothing
+        rows = np.sort(top, axis=1)
+        _, first = np.unique(label, return_index=True)
+        differs = np.any(rows != rows[first[label]], axis=1)
+        enough = np.count_nonzero(rows >= 0, axis=1) >= sizes[label]
+        needs = np.zeros(count, dtype=bool)
+        np.logical_or.at(needs, label, differs | ~enough)
         shared = {}
-        for k in np.flatnonzero(sizes > 1):
+        for k in np.flatnonzero((sizes > 1) & needs):
             roots = np.flatnonzero(label == k)
             poles = np.unique(top[roots])
             poles = list(poles[poles >= 0])
@@ -323,8 +332,8 @@ class Continuation:
 
     def _newton_step(self, dc: float, mu: np.ndarray, members: np.ndarray):
         """One Newton step for the roots ``mu`` at Δc with their groups of poles ``members``
-        (b x GROUP_MAX, −1 padded): (selected eigenvalue of each root's S(μ), h'(μ) + 1,
-        eigenvalues of S(μ) within MULTIPLICITY_RTOL·max(|μ|, 1) of μ)."""
+        (b x width, −1 padded): (selected eigenvalue of each root's S(μ), h'(μ) + 1, all
+        eigenvalues of each root's S(μ), nan padded)."""
         a = self.anchor
         dr = mu.real[:, None] - a.poles.real[None, :]
         di = mu.imag[:, None] - a.poles.imag[None, :]
@@ -342,8 +351,7 @@ class Continuation:
         Einv = np.linalg.inv(np.eye(4) - dc * F)
         new = np.empty(len(mu), dtype=complex)
         derivative = np.empty(len(mu), dtype=complex)
-        nearby = np.empty(len(mu), dtype=int)
-        radius = MULTIPLICITY_RTOL * np.maximum(np.abs(mu), 1.0)
+        local = np.full((len(mu), members.shape[1]), np.nan, dtype=complex)  # eig S(μ)
         sizes = np.count_nonzero(members >= 0, axis=1)
         for m in np.unique(sizes):
             sel = np.flatnonzero(sizes == m)
@@ -358,7 +366,7 @@ class Continuation:
             if m == 1:
                 new[sel] = S[:, 0, 0]
                 derivative[sel] = dS[:, 0, 0]
-                nearby[sel] = np.abs(S[:, 0, 0] - mu[sel]) <= radius[sel]
+                local[sel, 0] = S[:, 0, 0]
                 continue
             if m == 2:
                 values, vectors = _eig2(S)
@@ -369,14 +377,13 @@ class Continuation:
             l_vec = np.linalg.inv(vectors)[b, pick, :]  # (b, m)
             new[sel] = values[b, pick]
             derivative[sel] = np.einsum("bi,bij,bj->b", l_vec, dS, r_vec)
-            nearby[sel] = np.count_nonzero(np.abs(values - mu[sel, None]) <= radius[sel, None],
-                                           axis=1)
-        return new, derivative, nearby
+            local[sel, :m] = values
+        return new, derivative, local
 
     def solve(self, c: float, start: np.ndarray):
         """Roots at creep coefficient ``c`` [N s/m] from ``start``: (roots, last relative step
-        of each, how many eigenvalues of its S(μ) lie at each root (local multiplicity),
-        iterations).  The groups of poles are chosen once, at the start; a root stops
+        of each, (eigenvalues of each root's S(μ) at its last iterate, nan padded; |dS/dμ|
+        of the selected one), iterations).  The groups of poles are chosen once, at the start; a root stops
         iterating when it and every root sharing its group (they choose jointly, see
         :func:`_select`) have converged."""
         dc = c - self.anchor.c_ref
@@ -385,15 +392,17 @@ class Continuation:
         _, key = np.unique(np.sort(members, axis=1), axis=0, return_inverse=True)
         key = key.ravel()
         step = np.full(len(mu), np.inf)
-        nearby = np.zeros(len(mu), dtype=int)
+        local = np.full((len(mu), members.shape[1]), np.nan, dtype=complex)
+        slope = np.zeros(len(mu))
         active = np.arange(len(mu))
         iterations = 0
         while iterations < MAX_ITERATIONS:
             iterations += 1
-            new, derivative, near = self._newton_step(dc, mu[active], members[active])
+            new, derivative, values = self._newton_step(dc, mu[active], members[active])
             delta = (new - mu[active]) / (1.0 - derivative)
             mu[active] += delta
-            nearby[active] = near
+            local[active] = values
+            slope[active] = np.abs(derivative)
             step[active] = np.abs(delta) / np.maximum(np.abs(mu[active]), 1.0)
             if not np.all(np.isfinite(mu)):
                 break
@@ -401,12 +410,13 @@ class Continuation:
             if len(open_keys) == 0:
                 break
             active = np.flatnonzero(np.isin(key, open_keys))
-        return mu, step, nearby, iterations
+        return mu, step, (local, slope), iterations
 
-    def check(self, c: float, mu: np.ndarray, step: np.ndarray, nearby: np.ndarray,
+    def check(self, c: float, mu: np.ndarray, step: np.ndarray, local: tuple,
               tracked: Tracked) -> str | None:
         """Why the roots ``mu`` at ``c`` (continuing ``tracked``) cannot be certified (None:
-        certified).  ``nearby``: eigenvalues of each root's S(μ) at the root (from solve)."""
+        certified).  ``local``: the eigenvalues of each root's S(μ) and |dS/dμ| (from
+        :meth:`solve`)."""
         a = self.anchor
         dc = c - a.c_ref
         if not np.all(np.isfinite(mu)):
@@ -417,13 +427,25 @@ class Continuation:
         if np.any(mu[mirrored].imag <= REAL_RTOL * np.abs(mu[mirrored])):
             return "a complex pair reached the real axis"
         full = all_eigenvalues(mu, mirrored)
-        multiplicity = np.concatenate([nearby, nearby[mirrored]])
+        values, slope = local
+        values = np.concatenate([values, values[mirrored].conj()])
+        slope = np.concatenate([slope, slope[mirrored]])
+        # Roots with neighbours (within CLUSTER_RTOL): they must be, one to one, the eigenvalues
+        # of S(μ) within that radius (S(μ) holds every root near μ up to |dS/dμ|·distance): a
+        # root found twice, or one of a near-multiple group found instead of another, fails
         scale = np.maximum(np.abs(full), 1.0)
-        close = np.abs(full[:, None] - full[None, :]) <= DUPLICATE_RTOL * np.maximum(
-            scale[:, None], scale[None, :])
-        copies = close.sum(axis=1)  # the root itself included
-        if np.any(copies > multiplicity):
-            return "two roots converged to one value"
+        radius = CLUSTER_RTOL * scale
+        close = np.abs(full[:, None] - full[None, :]) <= radius[:, None]
+        for i in np.flatnonzero(close.sum(axis=1) > 1):
+            ours = full[close[i]]
+            theirs = values[i][np.abs(values[i] - full[i]) <= radius[i]]
+            if len(theirs) != len(ours):
+                return "two roots converged to one value"
+            cost = np.abs(ours[:, None] - theirs[None, :])
+            rows, cols = linear_sum_assignment(cost)
+            allowed = DUPLICATE_RTOL * scale[i] + 2.0 * slope[i] * np.abs(ours[rows] - full[i])
+            if np.any(cost[rows, cols] > allowed):
+                return "two roots converged to one value"
         trace = a.poles.sum() + dc * a.trace_update
         mismatch = abs(full.sum() - trace) / np.abs(full).sum()
         if mismatch > TRACE_RTOL:
@@ -519,9 +541,9 @@ class LineContinuation:
     def _step(self, c: float) -> str | None:
         """Continue to c; None when certified (state advanced), else the reason."""
         self.tracked, self._history = Continuation.unmirror(self.tracked, self._history)
-        mu, step, nearby, iterations = self.current.solve(c, self._predict(c))
+        mu, step, local, iterations = self.current.solve(c, self._predict(c))
         self.iterations += iterations
-        reason = self.current.check(c, mu, step, nearby, self.tracked)
+        reason = self.current.check(c, mu, step, local, self.tracked)
         if reason is None:
             self.tracked = Tracked(mu, self.tracked.mirrored, self.tracked.origin)
             self.c = c

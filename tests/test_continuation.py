@@ -117,9 +117,9 @@ def test_checks_catch_lost_and_wrong_roots(setup):
     continuation = Continuation(anchor)
     tracked = continuation.start()
     c = creep_coefficient(model, OperatingPoint(0.0062, v, N0, b_M))
-    mu, step, nearby, _ = continuation.solve(c, continuation.predictor(c - anchor.c_ref,
+    mu, step, local, _ = continuation.solve(c, continuation.predictor(c - anchor.c_ref,
                                                                        tracked))
-    assert continuation.check(c, mu, step, nearby, tracked) is None
+    assert continuation.check(c, mu, step, local, tracked) is None
     # the reference: the roots are the eigenvalues of the full model at that b11
     U, V = update_vectors(model)
     A = state_matrix(model, anchor.operating_point) + (c - anchor.c_ref) * (U @ V.T)
@@ -127,16 +127,20 @@ def test_checks_catch_lost_and_wrong_roots(setup):
     dense = dense[np.argsort(np.abs(dense))[model.rigid_body_modes.shape[1]:]]
     assert _worst_relative(np.concatenate([mu, mu[tracked.mirrored].conj()]), dense) <= EIG_RTOL
 
-    single = np.flatnonzero(~tracked.mirrored & (np.abs(mu) > 10) & (nearby == 1))
-    i, j = single[0], single[1]  # two simple real roots
+    gap = np.abs(mu[:, None] - mu[None, :]) + np.diag(np.full(len(mu), np.inf))
+    isolated = gap.min(axis=1) > 1e-3 * np.abs(mu)
+    single = np.flatnonzero(~tracked.mirrored & (np.abs(mu) > 10) & isolated)
+    i, j = single[0], single[1]  # two real roots with no other root near
     twice = mu.copy()
     twice[j] = twice[i]
-    assert "one value" in continuation.check(c, twice, step, nearby, tracked)
-    big = int(np.argmax(np.abs(mu)))
+    assert "one value" in continuation.check(c, twice, step, local, tracked)
+    # real roots moved without a neighbour: only the traces see it
+    candidates = np.flatnonzero(isolated & ~tracked.mirrored)
+    big = int(candidates[np.argmax(np.abs(mu[candidates]))])
     moved = mu.copy()
     moved[big] *= 1 + 1e-3
-    assert "trace identity" in continuation.check(c, moved, step, nearby, tracked)
-    small = int(np.argmin(np.abs(mu)))
+    assert "trace identity" in continuation.check(c, moved, step, local, tracked)
+    small = int(candidates[np.argmin(np.abs(mu[candidates]))])
     moved = mu.copy()
     moved[small] *= 1 + 1e-3
-    assert "inverse-trace" in continuation.check(c, moved, step, nearby, tracked)
+    assert "inverse-trace" in continuation.check(c, moved, step, local, tracked)
