@@ -14,12 +14,12 @@ the same continuation.  Against a full eigen-analysis at every point of 100-poin
 120 and 250 km/h: all eigenvalues within 6.1·10⁻⁹ relative, the counts identical
 (``scripts/bench_study.py --check-lines``, tests/test_continuation.py).
 
-The first method of issue 13, :func:`reduced_s0_line` (method "reduced"), is kept for comparison:
-it reuses one Galerkin-reduced model (:class:`model.locus._Reduced`, the root locus's projection
-on exact eigenvectors at a few *anchor* creepages) and costs two or three dense eigen-analyses
-plus one small eigenproblem per point.  The anchors are both ends and the grid creepage of the
-most negative b11 (the steepest falling creep slope, the most destabilizing point), when it
-lies inside the line.  Its properties:
+The first method of issue 13, :func:`reduced_s0_line` (method "reduced", the default: it is
+cheaper, see BENCHMARKS.md), reuses one Galerkin-reduced model (:class:`model.locus._Reduced`,
+the root locus's projection on exact eigenvectors at a few *anchor* creepages) and costs two or
+three dense eigen-analyses plus one small eigenproblem per point.  The anchors are both ends
+and the grid creepage of the most negative b11 (the steepest falling creep slope, the most
+destabilizing point), when it lies inside the line.  Its properties:
 
 What a point reports is a property of **all** eigenvalues, not only of tracked branches:
 
@@ -272,8 +272,8 @@ class _LineModel:
 
 
 def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
-            s0_limit_xtol: float = 1e-6, method: str = "reduced",
-            max_frequency_hz: float = 10.0, rtol: float = 1e-6) -> LineResult:
+            max_frequency_hz: float = 10.0, rtol: float = 1e-6,
+            s0_limit_xtol: float = 1e-6, method: str = "reduced") -> LineResult:
     """Largest real part, flutter pairs and divergent reals at every creepage of ``s0_values``
     (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
     [N m s/rad]; and s0* inside the line's range by Brent's method on the same evaluation.
@@ -320,9 +320,9 @@ def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
 def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
                     max_frequency_hz: float = 10.0, rtol: float = 1e-6,
                     s0_limit_xtol: float = 1e-6) -> LineResult:
-    """The Galerkin-reduced line (issue 13's first method, kept for comparison and for
-    ``MapStudy(method="reduced")``): largest real part, flutter pairs and divergent reals at
-    every creepage of ``s0_values`` (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
+    """The Galerkin-reduced line (issue 13's first method, ``s0_line``'s default): largest
+    real part, flutter pairs and divergent reals at every creepage of ``s0_values``
+    (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
     [N m s/rad]; and s0* inside the line's range by Brent's method on the same evaluation.
 
     ``max_frequency_hz``: the reduction basis holds the exact eigenvectors with |λ| < 2π·f (and
