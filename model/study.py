@@ -11,7 +11,7 @@ convergence tolerance at every point, checked there (convergence, local multipli
 inverse-trace identities); a point failing the checks is solved by a full eigen-analysis and
 becomes the new anchor (counted in ``LineResult.fallbacks``).  s0* is found by Brent's method on
 the same continuation.  Against a full eigen-analysis at every point of 100-point lines at 40,
-120 and 250 km/h: all eigenvalues within 6.1·10⁻⁹ relative, the counts identical
+120 and 250 km/h: all eigenvalues within 6.5·10⁻⁹ relative, the counts identical
 (``scripts/bench_study.py --check-lines``, tests/test_continuation.py).
 
 The first method of issue 13, :func:`reduced_s0_line` (method "reduced", the default: it is
