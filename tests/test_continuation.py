@@ -5,7 +5,7 @@ catch a lost or wrong root.  Real components, no mocks.
 
 Tolerances.  Both sides carry rounding errors of the order of eps·‖A‖·cond(λ): ‖A‖ ≈ 3·10⁵ 1/s
 (|λ| up to 3·10⁵ 1/s), so the two computations of one eigenvalue differ by more than eps·|λ|.
-Measured on 100-point lines at 40, 120 and 250 km/h: at most 6.2·10⁻⁹ relative to
+Measured on 100-point lines at 40, 120 and 250 km/h: at most 6.5·10⁻⁹ relative to
 max(|λ|, 1 1/s) (the ill-conditioned near-twin eigenvalues), largest real part within 4.2·10⁻⁹
 1/s.  EIG_RTOL = 2·10⁻⁸ and GROWTH_ATOL = 10⁻⁷ 1/s leave a factor 3 and 20 to these.  s0*: both
 searches stop within xtol = 10⁻⁶, so they differ by at most 2·10⁻⁶.
