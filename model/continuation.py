@@ -14,19 +14,22 @@ The rigid-body zeros are exact for every c and deflated as in :mod:`model.linear
 
     Λ + Δc Ũ Ṽᵀ,   Ũ = X⁻¹ U2 (p x 4),  Ṽᵀ = V2ᵀ X (4 x p),  Δc = c − c_ref.
 
-**Secular equation with the own poles removed.**  Split the poles into a cluster C (the poles
-numerically close to the root's nearest pole: the near-twin ID1/ID2 and left/right modes, relative
-gap ≤ :data:`CLUSTER_GAP`) and the rest R.  Eliminating the rest exactly gives the m x m
-(m = |C|) nonlinear eigenproblem
+**Secular equation with the root's own poles removed.**  For each root, split the poles into a
+group C (the anchor cluster of its nearest pole — the near-twin ID1/ID2 and left/right modes,
+relative gap ≤ :data:`CLUSTER_GAP` —, the poles whose term in E_R exceeds :data:`GROUP_TERM`,
+and, shared, those of roots close to it) and the rest R.  Eliminating the rest exactly gives the
+m x m (m = |C|) nonlinear eigenproblem
 
     μ ∈ eig S(μ),   S(μ) = Λ_C + Δc Ũ_C E_R(μ)⁻¹ Ṽ_Cᵀ,   E_R(μ) = I₄ − Δc Σ_{j∈R} ṽ_j ũ_jᵀ/(μ − λ_j)
 
-which is smooth near the cluster's poles (unlike det(I − Δc F(μ)), which has them as poles).
-Every tracked root solves ``h(μ) = eig_sel S(μ) − μ = 0`` by Newton's method (h' from the
-eigenvalue derivative of S), all roots at once: the sum over R is one complex matrix product
-(roots x poles) @ (poles x 16).  The roots are continued from point to point (predictor: the
-degenerate first-order perturbation from the anchor, then secant extrapolation in c), so every
-branch keeps its identity without any eigenvector matching.
+which is smooth near the group's poles (unlike det(I − Δc F(μ)), which has them as poles).  Any
+grouping is exact; it only shapes Newton's basins.  Every tracked root solves
+``h(μ) = eig_sel S(μ) − μ = 0`` by Newton's method (h' from the eigenvalue derivative of S), all
+roots at once: the sum over R is one complex matrix product (roots x poles) @ (poles x 16);
+roots sharing a group choose their eigenvalues of S jointly.  The roots are continued from point
+to point (predictor: the degenerate first-order perturbation from the anchor, then the secant in
+c; real roots get a small imaginary kick so that two that meet can leave the axis as a pair), so
+every branch keeps its identity without any eigenvector matching.
 
 **Checks at every point (else: shorter steps, then a full eigen-analysis there, which becomes
 the new anchor):** each root's last Newton step ≤ :data:`STEP_RTOL`·max(|μ|, 1 1/s); a complex
@@ -38,8 +41,9 @@ update, ``Σ μ = tr A22(c) = Σ λ_j + Δc tr(ṼᵀŨ)`` and ``Σ 1/μ = tr A2
 (Sherman–Morrison–Woodbury; it weighs the small eigenvalues that decide stability), to
 :data:`TRACE_RTOL` of the sums of magnitudes.  The fallbacks are counted.
 
-Only the tracked half of the spectrum is computed: one of each complex pair (Im > 0) and the real
-ones; the other half are their conjugates (A is real).  Units: c [N s/m], eigenvalues [1/s].
+Only one of each complex pair far from the real axis is tracked (its conjugate is implied: A is
+real); real roots and pairs near the axis are tracked one by one.  Units: c [N s/m],
+eigenvalues [1/s].  docs/continuation.md has the measured accuracy and cost.
 """
 
 from __future__ import annotations
@@ -81,10 +85,6 @@ def creep_coefficient(model: BogieModel, op: OperatingPoint) -> float:
     return float(creep_coefficients(model.parameters, op).b11)
 
 
-class ContinuationFailure(RuntimeError):
-    """The continuation could not certify a point (the caller solves it densely)."""
-
-
 @dataclass
 class Anchor:
     """The anchor's eigendecomposition in the form the continuation needs."""
@@ -100,7 +100,6 @@ class Anchor:
     sizes: np.ndarray  # (clusters,) members per cluster
     trace_update: complex  # tr(ṼᵀŨ) [1/s per N s/m]
     weight: np.ndarray  # (p,) ‖ũ_j‖‖ṽ_j‖: how strongly pole j moves with c [1/s per N s/m]
-
 
 
 def update_vectors(model: BogieModel) -> tuple[np.ndarray, np.ndarray]:
