@@ -3,7 +3,7 @@ against one eigen-analysis, the scheduler's overhead per task, and a projection 
 
     .venv/bin/python scripts/bench_study.py [--s0-points 100] [--v-points 100] [--workers N]
                                             [--scheduler tcp://HOST:PORT] [--check-lines 5]
-                                            [--method continuation|reduced]
+                                            [--method reduced|continuation]
 
 Default map: s0 = 0.001…0.02 (100 points) × v = 40…250 km/h (100 speeds), calibrated set,
 N0 and b_M of the set.  In the same run:
@@ -74,8 +74,8 @@ def main() -> None:
     parser.add_argument("--check-lines", type=int, default=5)
     parser.add_argument("--sobol-samples", type=int, default=2**10)
     parser.add_argument("--sobol-parameters", type=int, default=12)
-    parser.add_argument("--method", default="continuation", choices=["continuation", "reduced"],
-                        help="s0_line's method for the map")
+    parser.add_argument("--method", default="reduced", choices=["reduced", "continuation"],
+                        help="s0_line's method for the map (default: the map's, reduced)")
     args = parser.parse_args()
     print(f"python {platform.python_version()}, numpy {np.__version__}, {os.cpu_count()} cores, "
           f"load average {os.getloadavg()[0]:.2f} (1 min) at start")
