@@ -3,11 +3,23 @@ and the stability limit s0*(v) for lists of N0 and b_M.
 
 The unit of work is a **line**: all creepages s0 of the map at one (v, N0, b_M).  Along a line
 only the longitudinal creep coefficient b11 = N0 μ'(s0)/v changes (b22, b23, b33 depend on v and
-N0 only), so the line reuses one reduced model (:class:`model.locus._Reduced`, the root locus's
-Galerkin projection on exact eigenvectors at a few *anchor* creepages) and costs two or three
-dense eigen-analyses plus one small eigenproblem per point.  The anchors are both ends and the
-grid creepage of the most negative b11 (the steepest falling creep slope, the most
-destabilizing point), when it lies inside the line.
+N0 only), so the state matrix is a rank-4 update of the one at an anchor creepage.
+
+:func:`s0_line` with method "continuation" continues **every** non-rigid eigenvalue
+along the line from one eigendecomposition (:mod:`model.continuation`): exact to its
+convergence tolerance at every point, checked there (convergence, local multiplicity, trace and
+inverse-trace identities); a point failing the checks is solved by a full eigen-analysis and
+becomes the new anchor (counted in ``LineResult.fallbacks``).  s0* is found by Brent's method on
+the same continuation.  Against a full eigen-analysis at every point of 100-point lines at 40,
+120 and 250 km/h: all eigenvalues within 6.5·10⁻⁹ relative, the counts identical
+(``scripts/bench_study.py --check-lines``, tests/test_continuation.py).
+
+The first method of issue 13, :func:`reduced_s0_line` (method "reduced", the default: it is
+cheaper, see BENCHMARKS.md), reuses one Galerkin-reduced model (:class:`model.locus._Reduced`,
+the root locus's projection on exact eigenvectors at a few *anchor* creepages) and costs two or
+three dense eigen-analyses plus one small eigenproblem per point.  The anchors are both ends
+and the grid creepage of the most negative b11 (the steepest falling creep slope, the most
+destabilizing point), when it lies inside the line.  Its properties:
 
 What a point reports is a property of **all** eigenvalues, not only of tracked branches:
 
@@ -48,6 +60,7 @@ import scipy.linalg as sla
 from scipy.optimize import brentq
 
 from .assembly import BogieModel, build_model
+from .continuation import LineContinuation
 from .eigen import eigen_analysis
 from .locus import _coefficients, _newton, _Reduced, creep_patterns
 from .operating_point import OperatingPoint, damping_matrix
@@ -100,7 +113,9 @@ class LineResult:
     dense_points: np.ndarray  # (n,) bool: solved by a full eigen-analysis
     newton_refinements: int  # Ritz values refined by Newton's method on the full model
     outside_max_real_part: float  # largest Re outside the basis at the anchors [1/s]
-    basis_size: int  # columns of the reduction basis (0: the line was solved densely)
+    basis_size: int  # columns of the reduction basis (0: dense or continuation)
+    fallbacks: int = 0  # continuation: points where its checks failed (solved densely there)
+    method: str = "dense"  # "continuation", "reduced" or "dense"
 
     @property
     def stable(self) -> np.ndarray:
@@ -258,8 +273,55 @@ class _LineModel:
 
 def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
             max_frequency_hz: float = 10.0, rtol: float = 1e-6,
-            s0_limit_xtol: float = 1e-6) -> LineResult:
+            s0_limit_xtol: float = 1e-6, method: str = "reduced") -> LineResult:
     """Largest real part, flutter pairs and divergent reals at every creepage of ``s0_values``
+    (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
+    [N m s/rad]; and s0* inside the line's range by Brent's method on the same evaluation.
+
+    ``method``: "continuation" (:mod:`model.continuation`: every non-rigid eigenvalue at every
+    point, exact to the convergence tolerance, checked at every point; a point that fails the
+    checks is solved by a full eigen-analysis and counted in ``fallbacks``), "reduced" (the
+    default: :func:`reduced_s0_line`, ``max_frequency_hz`` and ``rtol`` apply) or "dense"
+    (:func:`dense_line`).  The default stays "reduced" because it is cheaper: measured on the
+    shared machine, a map point cost 0.35 of an eigenvalues-only analysis with "reduced" and
+    1.26 with "continuation" (BENCHMARKS.md, issue 13)."""
+    if method == "reduced":
+        return reduced_s0_line(model, s0_values, v, N0, b_M, max_frequency_hz, rtol,
+                               s0_limit_xtol)
+    if method == "dense":
+        return dense_line(model, s0_values, v, N0, b_M, s0_limit_xtol)
+    if method != "continuation":
+        raise ValueError(f"method must be 'continuation', 'reduced' or 'dense', got '{method}'")
+    s0_values = _check_s0(s0_values)
+    n = len(s0_values)
+    line = LineContinuation(model, v, N0, b_M)
+    rows, dense, states = [], np.zeros(n, dtype=bool), []
+    for i, s in enumerate(s0_values):
+        spectrum, dense[i] = line.evaluate(float(s))
+        rows.append(spectrum_summary(spectrum))
+        states.append(line.state())
+    growth = np.array([r[0] for r in rows])
+
+    def growth_at(s: float, start: int) -> float:
+        line.restore(states[start])  # continue from the grid point below s
+        return spectrum_summary(line.evaluate(s, reanchor=False)[0])[0]
+
+    unstable = np.flatnonzero(growth > 0)
+    limit = float("nan")
+    if len(unstable) and unstable[0] > 0:
+        i = unstable[0]
+        limit = float(brentq(growth_at, s0_values[i - 1], s0_values[i], args=(i - 1,),
+                             xtol=s0_limit_xtol, rtol=1e-12))
+    return LineResult(s0_values, v, N0, b_M, growth, np.array([r[1] for r in rows]),
+                      np.array([r[2] for r in rows]), limit, dense, 0, float("nan"), 0,
+                      line.fallbacks, "continuation")
+
+
+def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
+                    max_frequency_hz: float = 10.0, rtol: float = 1e-6,
+                    s0_limit_xtol: float = 1e-6) -> LineResult:
+    """The Galerkin-reduced line (issue 13's first method, ``s0_line``'s default): largest
+    real part, flutter pairs and divergent reals at every creepage of ``s0_values``
     (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
     [N m s/rad]; and s0* inside the line's range by Brent's method on the same evaluation.
 
@@ -280,7 +342,8 @@ def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
         initial=-np.inf)) for r in anchors.values())
     if n < 3:
         line = dense_line(model, s0_values, v, N0, b_M, s0_limit_xtol)
-        return LineResult(**{**line.__dict__, "outside_max_real_part": outside})
+        return LineResult(**{**line.__dict__, "outside_max_real_part": outside,
+                             "method": "reduced"})
     line_model = _LineModel(model, v, N0, b_M, list(anchors.values()), max_frequency_hz, rtol)
     rows = []
     dense = np.zeros(n, dtype=bool)
@@ -295,7 +358,7 @@ def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
     limit = _line_limit(model, line_model, s0_values, growth, v, N0, b_M, s0_limit_xtol)
     return LineResult(s0_values, v, N0, b_M, growth, np.array([r[1] for r in rows]),
                       np.array([r[2] for r in rows]), limit, dense, line_model.newton, outside,
-                      line_model.reduced.size)
+                      line_model.reduced.size, 0, "reduced")
 
 
 # --- studies: pure descriptions and their chunks --------------------------------------------
@@ -333,14 +396,18 @@ class MapStudy:
     v: tuple[float, ...]  # speeds [m/s]
     N0: tuple[float, ...]  # wheel forces [N]
     b_M: tuple[float, ...]  # motor slopes [N m s/rad]
-    max_frequency_hz: float = 10.0  # reduction basis disc (see s0_line)
-    rtol: float = 1e-6  # relative accuracy of the decisive eigenvalues
+    max_frequency_hz: float = 10.0  # reduction basis disc (method "reduced", see s0_line)
+    rtol: float = 1e-6  # relative accuracy of the decisive eigenvalues (method "reduced")
+    method: str = "reduced"  # s0_line's method: "reduced", "continuation" or "dense"
     kind: str = field(default="map", init=False)
 
     def __post_init__(self) -> None:
         for name in ("s0", "v", "N0", "b_M"):
             object.__setattr__(self, name, _grid(getattr(self, name), name))
         _check_s0(self.s0)
+        if self.method not in ("continuation", "reduced", "dense"):
+            raise ValueError(f"method must be 'continuation', 'reduced' or 'dense', "
+                             f"got '{self.method}'")
         for v in self.v:
             for n0 in self.N0:
                 for bm in self.b_M:
@@ -360,13 +427,14 @@ class MapStudy:
         """The study's arguments (JSON-able; stored with the results, compared on resume)."""
         return {"kind": self.kind, "s0": list(self.s0), "v": list(self.v), "N0": list(self.N0),
                 "b_M": list(self.b_M), "max_frequency_hz": self.max_frequency_hz,
-                "rtol": self.rtol}
+                "rtol": self.rtol, "method": self.method}
 
     def run_chunk(self, parameters: Parameters, key: tuple[int, int, int]) -> dict:
         """The s0-line of chunk ``key`` as plain arrays (what the store writes)."""
         i, j, k = key
         line = s0_line(cached_model(parameters), self.s0, self.v[i], self.N0[j], self.b_M[k],
-                       self.max_frequency_hz, self.rtol)
+                       method=self.method, max_frequency_hz=self.max_frequency_hz,
+                       rtol=self.rtol)
         return {"largest_real_part": line.largest_real_part, "stable": line.stable,
                 "flutter_pairs": line.flutter_pairs.astype(np.int16),
                 "divergent_real": line.divergent_real.astype(np.int16),

@@ -105,7 +105,12 @@ def register(subparsers) -> None:
     m.add_argument("--v", required=True, metavar="A:B:N", help="speeds [km/h]")
     m.add_argument("--max-frequency", type=number("--max-frequency (Hz)", 0.5, 500,
                                                   allowed="must be in (0.5, 500) Hz"),
-                   default=10.0, help="reduction basis disc |λ| < 2π f [Hz] (default %(default)s)")
+                   default=10.0, help="method reduced: reduction basis disc |λ| < 2π f [Hz] "
+                   "(default %(default)s)")
+    m.add_argument("--method", choices=("reduced", "continuation", "dense"),
+                   default="reduced", help="per s0-line: the Galerkin-reduced model (default, "
+                   "cheapest), the exact continuation of all eigenvalues, or a full "
+                   "eigen-analysis per point")
     _common(m)
     m.set_defaults(func=cmd_map)
     limit = sub.add_parser("limit", help="stability limit s0*(v) for lists of N0 and b_M")
@@ -157,7 +162,8 @@ def cmd_map(args: argparse.Namespace) -> None:
     parameters = _parameters(args)
     s0 = parse_values(args.s0, "--s0", 1e-9, 1 - 1e-9, "-", increasing=True)
     v, n0, bm = _grids(args, parameters)
-    _run(args, MapStudy(s0, v, n0, bm, max_frequency_hz=args.max_frequency), parameters)
+    _run(args, MapStudy(s0, v, n0, bm, max_frequency_hz=args.max_frequency,
+                        method=args.method), parameters)
 
 
 def cmd_limit(args: argparse.Namespace) -> None:

@@ -51,11 +51,14 @@ DESCRIPTIONS = {
     "stable": "all non-rigid eigenvalues in the closed left half-plane",
     "flutter_pairs": "complex eigenvalue pairs with positive real part",
     "divergent_real": "positive real eigenvalues",
-    "dense_points": "point solved by a full eigen-analysis (else the reduced model)",
+    "dense_points": "point solved by a full eigen-analysis (else the continuation or the "
+                    "reduced model)",
     "s0_limit": "stability limit s0*: smallest creepage where the bogie turns unstable "
                 "(nan: none in the searched range)",
-    "outside_max_real_part": "largest real part of the eigenvalues outside the reduction basis "
-                             "at the anchors of the s0-line (its ends, the steepest falling creep slope)",
+    "outside_max_real_part": "method reduced: largest real part of the eigenvalues outside the "
+                             "reduction basis at the anchors of the s0-line (its ends, the "
+                             "steepest falling creep slope); nan for the continuation (no "
+                             "eigenvalue is outside)",
     "evaluations": "eigen-analyses used by the limit search",
     "chunk_done": "1 when the chunk (s0-line or limit point) is completely written",
 }

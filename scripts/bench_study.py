@@ -3,6 +3,7 @@ against one eigen-analysis, the scheduler's overhead per task, and a projection 
 
     .venv/bin/python scripts/bench_study.py [--s0-points 100] [--v-points 100] [--workers N]
                                             [--scheduler tcp://HOST:PORT] [--check-lines 5]
+                                            [--method reduced|continuation]
 
 Default map: s0 = 0.001…0.02 (100 points) × v = 40…250 km/h (100 speeds), calibrated set,
 N0 and b_M of the set.  In the same run:
@@ -17,7 +18,8 @@ N0 and b_M of the set.  In the same run:
 4. the scheduler's overhead per task: ``--tasks`` no-op tasks through the same engine;
 5. one stability-limit search s0*(v) (``stability_limit``; the unit of a Monte-Carlo sample);
 6. accuracy: ``--check-lines`` s0-lines (evenly spread speeds) against a full eigen-analysis at
-   every point (largest real part, counts, verdicts);
+   every point (largest real part, counts, verdicts; for the continuation also every
+   eigenvalue, and the fallbacks), each line timed against the dense line in the same run;
 7. a projection to W workers: T(W) = chunks × (t_chunk + overhead) / W for the map and for a
    2¹⁰-sample Sobol study of 12 parameters (Saltelli: 2¹⁰ × (12 + 2) limit searches).
 
@@ -35,9 +37,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 from threadpoolctl import threadpool_limits
 
 from model import KMH, build_model, eigen_analysis, load_parameters, stability_limit
+from model.continuation import continue_line
 from model.eigen import forget_systems
 from model.operating_point import OperatingPoint
 from model.study import MapStudy, dense_line, s0_line
@@ -70,6 +74,8 @@ def main() -> None:
     parser.add_argument("--check-lines", type=int, default=5)
     parser.add_argument("--sobol-samples", type=int, default=2**10)
     parser.add_argument("--sobol-parameters", type=int, default=12)
+    parser.add_argument("--method", default="reduced", choices=["reduced", "continuation"],
+                        help="s0_line's method for the map (default: the map's, reduced)")
     args = parser.parse_args()
     print(f"python {platform.python_version()}, numpy {np.__version__}, {os.cpu_count()} cores, "
           f"load average {os.getloadavg()[0]:.2f} (1 min) at start")
@@ -78,7 +84,8 @@ def main() -> None:
     model = build_model(parameters)
     N0, b_M = parameters["wheel_force"], parameters["motor_slope"]
     study = MapStudy(np.linspace(0.001, 0.02, args.s0_points),
-                     np.linspace(40.0, 250.0, args.v_points) * KMH, [N0], [b_M])
+                     np.linspace(40.0, 250.0, args.v_points) * KMH, [N0], [b_M],
+                     method=args.method)
     points = args.s0_points * args.v_points
 
     with threadpool_limits(1):
@@ -96,7 +103,7 @@ def main() -> None:
     t_chunk = t_serial / len(study.chunks())
     per_point = t_serial / points
     print(f"\nmap {args.s0_points} (s0 0.001-0.02) x {args.v_points} (v 40-250 km/h) = {points} "
-          f"points, {len(study.chunks())} chunks (s0-lines)")
+          f"points, {len(study.chunks())} chunks (s0-lines), method {args.method}")
     print(f"one eigen-analysis: eigenvalues only {t_values * 1e3:.1f} ms, with vectors "
           f"{t_vectors * 1e3:.1f} ms (best of 5, cold)")
     print(f"serial map: {t_serial:.2f} s, {t_chunk * 1e3:.0f} ms per s0-line, "
@@ -139,18 +146,41 @@ def main() -> None:
 
     with threadpool_limits(1):
         v_check = np.linspace(40.0, 250.0, args.check_lines) * KMH
-        worst, counts_equal, s0 = 0.0, True, np.array(study.s0)
+        worst, worst_eig, counts_equal, s0 = 0.0, 0.0, True, np.array(study.s0)
+        fallbacks, t_line, t_dense = 0, 0.0, 0.0
         for v in v_check:
-            line = s0_line(model, s0, v, N0, b_M)
+            start = time.perf_counter()
+            line = s0_line(model, s0, v, N0, b_M, method=args.method)
+            t_line += time.perf_counter() - start
+            start = time.perf_counter()
             reference = dense_line(model, s0, v, N0, b_M)
+            t_dense += time.perf_counter() - start
+            fallbacks += line.fallbacks
             worst = max(worst, float(np.abs(line.largest_real_part
                                             - reference.largest_real_part).max()))
             counts_equal &= bool(np.array_equal(line.flutter_pairs, reference.flutter_pairs)
                                  and np.array_equal(line.divergent_real, reference.divergent_real))
+            if args.method == "continuation":
+                spectra = continue_line(model, s0, v, N0, b_M).spectra
+                for s, spectrum in zip(s0, spectra, strict=True):
+                    dense = eigen_analysis(model, OperatingPoint(float(s), v, N0, b_M),
+                                           vectors=False).eigenvalues
+                    cost = np.abs(spectrum[:, None] - dense[None, :])
+                    rows, cols = linear_sum_assignment(cost)
+                    worst_eig = max(worst_eig, float((cost[rows, cols] / np.maximum(
+                        np.abs(dense[cols]), 1.0)).max()))
     print(f"accuracy on {args.check_lines} lines x {args.s0_points} points against a full "
           f"eigen-analysis: max |d largest real part| {worst:.2e} 1/s, flutter/divergent counts "
-          f"identical: {counts_equal}; outside-basis eigenvalues at the anchors <= "
-          f"{float(serial['outside_max_real_part'].max()):.3f} 1/s")
+          f"identical: {counts_equal}")
+    if args.method == "continuation":
+        print(f"  every eigenvalue within {worst_eig:.2e} relative (to max(|lambda|, 1 1/s)); "
+              f"fallbacks (points solved densely after failed checks, s0* included): "
+              f"{fallbacks} on {args.check_lines * args.s0_points} points")
+    else:
+        print(f"  outside-basis eigenvalues at the anchors <= "
+              f"{float(serial['outside_max_real_part'].max()):.3f} 1/s")
+    print(f"  the same lines timed in this run: s0_line {t_line:.2f} s, dense_line {t_dense:.2f} s "
+          f"-> a line costs {t_line / t_dense:.3f} of the dense line (both with s0* by Brent)")
 
     sobol = args.sobol_samples * (args.sobol_parameters + 2)
     print(f"\nprojection T(W) = tasks x (t_task + overhead) / W (t_task measured here, one core "

@@ -30,20 +30,24 @@ def setup():
     return parameters, build_model(parameters)
 
 
-@pytest.mark.parametrize(("v_kmh", "n0_factor", "b_M"), [
-    pytest.param(50.0, 1.0, None, marks=pytest.mark.slow), (160.0, 1.0, None),
-    pytest.param(240.0, 0.6, 0.0, marks=pytest.mark.slow)])
-def test_line_equals_dense_reference(setup, v_kmh, n0_factor, b_M):
+@pytest.mark.parametrize(("v_kmh", "n0_factor", "b_M", "method"), [
+    pytest.param(50.0, 1.0, None, "reduced", marks=pytest.mark.slow),
+    (160.0, 1.0, None, "reduced"), (160.0, 1.0, None, "continuation"),
+    pytest.param(240.0, 0.6, 0.0, "reduced", marks=pytest.mark.slow),
+    pytest.param(50.0, 1.0, None, "continuation", marks=pytest.mark.slow),
+    pytest.param(240.0, 0.6, 0.0, "continuation", marks=pytest.mark.slow)])
+def test_line_equals_dense_reference(setup, v_kmh, n0_factor, b_M, method):
     """Every point of an s0-line (largest real part, flutter pairs, divergent reals, verdict) as a
-    full eigen-analysis gives it, across the stability limit; s0* as on the dense grid."""
+    full eigen-analysis gives it, across the stability limit; s0* as on the dense grid; both
+    methods of s0_line (the continuation, the reduced model)."""
     parameters, model = setup
     N0 = parameters["wheel_force"] * n0_factor
     b_M = parameters["motor_slope"] if b_M is None else b_M
     s0 = np.linspace(0.001, 0.02, 17)
-    line = s0_line(model, s0, v_kmh * KMH, N0, b_M)
+    line = s0_line(model, s0, v_kmh * KMH, N0, b_M, method=method)
     reference = dense_line(model, s0, v_kmh * KMH, N0, b_M)
+    assert line.method == method
     assert np.count_nonzero(line.dense_points) < len(s0)  # the reduced model did the work
-    assert line.basis_size > 0
     np.testing.assert_allclose(line.largest_real_part, reference.largest_real_part, rtol=0,
                                atol=GROWTH_ATOL)
     np.testing.assert_array_equal(line.flutter_pairs, reference.flutter_pairs)
@@ -52,7 +56,12 @@ def test_line_equals_dense_reference(setup, v_kmh, n0_factor, b_M):
     assert line.stable[0]
     assert not line.stable[-1]
     assert abs(line.s0_limit - reference.s0_limit) <= LIMIT_ATOL
-    assert line.outside_max_real_part < -5.0  # eigenvalues outside the basis: damped at the ends
+    if method == "reduced":
+        assert line.basis_size > 0
+        assert line.outside_max_real_part < -5.0  # outside the basis: damped at the ends
+    else:
+        # grid points solved densely: the first anchor and the fallbacks there (s0* may add more)
+        assert line.fallbacks >= np.count_nonzero(line.dense_points) - 1
 
 
 def test_line_limit_equals_stability_limit(setup):

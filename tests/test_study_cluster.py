@@ -102,6 +102,19 @@ def test_cluster_equals_serial(cluster, study_and_reference, tmp_path):
     _assert_equal_to_reference(tmp_path / "m.zarr", reference)
 
 
+def test_cluster_equals_serial_continuation(cluster, tmp_path):
+    """The same with s0_line's exact continuation (model.continuation): bitwise identical."""
+    parameters = load_parameters()
+    study = MapStudy(np.linspace(0.002, 0.016, 30), np.linspace(60, 220, 3) * KMH,
+                     [parameters["wheel_force"]], [parameters["motor_slope"]],
+                     method="continuation")
+    reference = run_serial(study, parameters)
+    with StudyEngine(scheduler=cluster, connect_timeout=30) as engine:
+        run = run_into_store(study, parameters, tmp_path / "c.zarr", engine.map_unordered)
+    assert run.computed == len(reference)
+    _assert_equal_to_reference(tmp_path / "c.zarr", reference)
+
+
 def test_worker_killed_mid_study(cluster, study_and_reference, tmp_path):
     """SIGKILL to one worker process after the first chunk arrived: Dask reschedules its task
     on the surviving worker (the nanny restarts the dead one); nothing finished is lost and the
