@@ -80,3 +80,12 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
                  liveness=True, title=TITLE)
     except KeyboardInterrupt:
         print("bogie serve: stopped", file=sys.stderr)
+        from .workers import stop_all
+
+        # nothing to save: computations queued or running for sessions that are gone are
+        # dropped (Python would otherwise join every worker thread at exit, and a reaction-time
+        # search at the lowest priority can run for a minute)
+        stop_all()
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(0)
