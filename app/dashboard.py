@@ -38,6 +38,7 @@ from . import compute
 from .fig6 import Fig6Plot
 from .modes_view import ModeClickThrough
 from .nonlinear_view import NonlinearView  # issue 10
+from .panel_fixes import skip_detached_markup_models
 from .plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
 from .sensitivity_view import SensitivityView  # issue 12: sensitivity tornado
 from .serve import limit_blas_threads
@@ -46,6 +47,10 @@ from .variant_view import VariantView
 from .workers import FIRST_ANSWER_POOL, FOLLOW_UP_POOL, SIDE_VIEW_POOL
 
 log = logging.getLogger(__name__)
+skip_detached_markup_models()  # the views' tabs are dynamic (app/panel_fixes.py)
+# the page loads the script of each extension model up front: the mode table (Tabulator) sits in
+# a tab that reaches the browser only when it is opened
+pn.extension("tabulator")
 ASSETS = Path(__file__).resolve().parent.parent / "assets"
 MODEL_ERRORS = (OperatingPointError, ParameterError, NoStabilityLimit, ValueError,
                 np.linalg.LinAlgError)
@@ -280,11 +285,10 @@ class BogieDashboard(pn.viewable.Viewer):
         self.variant_view = VariantView(self)
         self.click = ModeClickThrough(self)  # tapped locus points and table rows -> mode views
         # the views below the status and the root locus, one tab each; other modules add theirs
-        # with ``self.tabs.append((title, view))``.  The views of a hidden tab are brought up to
-        # date when it is opened (``when_shown``): updating all of them at every change made the
-        # browser re-style and re-render the hidden views too.  (Panel's dynamic tabs would keep
-        # them out of the browser altogether, but a pane of a closed tab keeps its detached
-        # model, and its next update switched the stylesheets every pane shares to Panel's CDN.)
+        # with ``self.tabs.append((title, view))``.  Only the open tab is in the browser
+        # (dynamic; app/panel_fixes.py), and the views of a hidden tab are brought up to date
+        # when it is opened (``when_shown``): with every view in the page and updated at every
+        # change, the browser re-styled and re-rendered the hidden ones too
         self.tabs = pn.Tabs(
             ("Response", pn.Column(
                 pn.Row(bokeh_pane(self.creep_plot.figure), pn.Column(self.peaks, width=520),
@@ -317,7 +321,7 @@ class BogieDashboard(pn.viewable.Viewer):
             ("Variant", self.variant_view),
             ("Schematic", pn.pane.SVG(schematic, width=640)
              if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*")),
-            dynamic=False, css_classes=["views"], sizing_mode="stretch_width")
+            dynamic=True, css_classes=["views"], sizing_mode="stretch_width")
         self.main = pn.Column(
             self.notice, self.input_notice, self.nonlinear.notice,  # issue 10
             pn.Row(pn.Column(self.status, self.busy, self.details, self.nonlinear.status,

@@ -40,6 +40,7 @@ WHEEL_COLORS = {"ID1.rim12": "#8c564b", "ID1.rim14": "#e377c2", "ID2.rim12": "#1
                 "ID2.rim14": "#bcbd22"}
 REACTION_DELAYS = np.linspace(0.0, 0.5, 11)  # [s] delay grid of the dashboard's reaction time
 REACTION_FS = 5_000.0  # [Hz] its sampling (the CLI's default is 10 kHz)
+REACTION_QUIET_MS = 1000  # [ms] the search starts when the operating point has stayed this long
 PATH_POINTS = 1500  # points of each wheel's creepage path sent to the browser
 # the views alive in this process: a reaction search that no view wants any more (superseded by
 # another operating point, or its session closed) stops between its runs instead of holding the
@@ -315,8 +316,18 @@ class NonlinearView:
 
         # workers of their own (app.workers), at a lower priority than the linear first answer;
         # a request superseded before it starts is skipped
-        executor = SEARCH_POOL if apply == self._apply_reaction else NONLINEAR_POOL
-        future = executor.submit(if_current)
+        if apply == self._apply_reaction:
+            # a reaction-time search (tens of nonlinear runs, mostly Python: it holds the GIL
+            # most of the time, which thread priorities cannot take away) starts only when the
+            # operating point has stayed for REACTION_QUIET_MS: not while a slider is stepped
+            def start_if_quiet() -> None:
+                if self._current(key, apply):
+                    future = SEARCH_POOL.submit(if_current)
+                    future.add_done_callback(partial(self._done, doc, key, apply))
+
+            doc.add_timeout_callback(start_if_quiet, REACTION_QUIET_MS)
+            return
+        future = NONLINEAR_POOL.submit(if_current)
         future.add_done_callback(partial(self._done, doc, key, apply))
 
     def _current(self, key, apply) -> bool:

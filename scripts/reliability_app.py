@@ -317,7 +317,8 @@ def fuzz_session(url: str) -> dict:
     from bokeh.client import pull_session
 
     _register_panel_models()
-    session = pull_session(url=f"{url}/app")
+    # the Variant tab open: its upload widget reaches the client only then (dynamic tabs)
+    session = pull_session(url=f"{url}/app", arguments={"tab": "variant"})
     failures: list[str] = []
     sent = 0
     try:

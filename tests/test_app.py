@@ -213,19 +213,29 @@ def test_sessions_do_not_share_state(dash):
 
 @pytest.mark.slow
 def test_render_whole_layout(dash):
+    import panel as pn
     from bokeh.document import Document
     from bokeh.models import Plot
 
     from app.serve import create_app
 
     doc = Document()
-    doc.add_root(create_app().get_root(doc))
+    app = create_app()
+    doc.add_root(app.get_root(doc))
     models = list(doc.models)
     classes = {c for model in models for c in (getattr(model, "css_classes", None) or [])}
     for name in CONTROLS:
         assert f"ctl-{name}" in classes, name
     assert "stability-status" in classes
-    plots = [model for model in models if isinstance(model, Plot)]
+    # only the open tab is in the document (dynamic tabs): the locus and the Response tab's
+    # creep, 2 torques, forces, M_C; each other tab's plots join when it is opened
+    assert sum(isinstance(model, Plot) for model in doc.models) == 6
+    (tabs,) = [t for t in app.select(pn.Tabs) if "views" in t.css_classes]
+    plots = {}
+    for index in range(len(tabs)):
+        tabs.active = index
+        plots.update({model.id: model for model in doc.models if isinstance(model, Plot)})
+    plots = list(plots.values())
     # locus, creep, 2 torques, forces, M_C, side and top view, Fig. 6 (Im, Re, real), variant s0*,
     # sensitivity tornado, study heat map
     assert len(plots) == 14
