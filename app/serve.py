@@ -37,9 +37,18 @@ def create_app(params: str | None = None):
     """Build the dashboard for one session: ``params`` is a parameter file (TOML) or ``None``
     for the calibrated default set."""
     import panel as pn
+    from panel.io.resources import get_dist_path
 
     from .dashboard import BogieDashboard
 
+    doc = pn.state.curdoc
+    if doc is not None:
+        # the address of Panel's own static files, before any pane is made: Panel sets it only
+        # when it renders a browser's page, so the documents built without a page (the liveness
+        # probe's, a protocol client's) took Panel's CDN for the stylesheet objects, which the
+        # sessions of a server share (a browser page then asked the CDN for loading.css: seen
+        # with protocol clients beside a page, and possible with a container's health check)
+        doc._template_variables.setdefault("dist_url", get_dist_path())
     dashboard = BogieDashboard(params_path=params)
     header = pn.pane.Markdown(
         f"## {TITLE} — stability and short-circuit load of the wheelset drives\n"
