@@ -72,11 +72,14 @@ class ModeTable:
     def _frame(modes):
         import pandas as pd
 
-        return pd.DataFrame({"nu": [m.number for m in modes],
-                             "im_hz": [m.im_hz for m in modes],
-                             "re": [m.eigenvalue.real for m in modes],
-                             "zeta": [m.damping_ratio for m in modes],
-                             "description": [m.description for m in modes]})
+        # explicit column types: the table takes its columns' formatters from the first frame,
+        # which is empty (an empty column is float: ν shown as 1.0, the descriptions as NaN)
+        return pd.DataFrame({"nu": pd.Series([m.number for m in modes], dtype="int64"),
+                             "im_hz": pd.Series([m.im_hz for m in modes], dtype="float64"),
+                             "re": pd.Series([m.eigenvalue.real for m in modes], dtype="float64"),
+                             "zeta": pd.Series([m.damping_ratio for m in modes], dtype="float64"),
+                             "description": pd.Series([m.description for m in modes],
+                                                      dtype="object")})
 
     @property
     def descriptions(self) -> list[str]:

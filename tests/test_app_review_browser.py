@@ -88,6 +88,11 @@ def test_variant_upload_comparison_click_through_and_report(own_server, chromium
 
     # click-through: a row of the mode table shows that mode's description and energy shares
     _tab(page, "Modes")
+    # the table shows ν as an integer and each mode's description (not a number column's NaN)
+    first_row = page.locator(".mode-table .tabulator-row").first.inner_text()
+    assert first_row.startswith("1\n"), first_row
+    assert "NaN" not in first_row, first_row
+    assert any(c.isalpha() for c in first_row), first_row
     page.locator(".mode-table .tabulator-row").nth(2).click()
     detail = page.locator(".mode-detail")
     detail.filter(has_text="ν = 3").wait_for(timeout=60_000)
