@@ -339,6 +339,34 @@ def null_vectors(model: BogieModel, B_total: np.ndarray, lam: complex,
     return x / np.linalg.norm(x), y / np.linalg.norm(y)
 
 
+def _real_eigenvalue_nearest_zero(model: BogieModel, op: OperatingPoint,
+                                  iterations: int = 12) -> float | None:
+    """The eigenvalue nearest to 0 [1/s] of the state matrix at ``op`` with the rigid-body zeros
+    deflated, by inverse iteration on it (one real LU); None unless the iteration settles on a
+    real eigenvector (a complex pair nearest to 0, or no convergence)."""
+    from .eigen import bogie_system
+
+    A22 = bogie_system(model, op).reduced[1]
+    with warnings.catch_warnings():  # an exactly zero pivot: 0 is the eigenvalue; perturb it
+        warnings.simplefilter("ignore", sla.LinAlgWarning)
+        lu, piv = sla.lu_factor(A22, check_finite=False)
+    tiny = np.finfo(float).eps * np.abs(A22).max()
+    small = np.abs(np.diagonal(lu)) < tiny
+    if np.any(small):
+        lu[np.flatnonzero(small), np.flatnonzero(small)] = tiny
+    x = np.random.default_rng(1).standard_normal(len(A22))
+    x /= np.linalg.norm(x)
+    for _ in range(iterations):
+        y = sla.lu_solve((lu, piv), x, check_finite=False)
+        y /= np.linalg.norm(y)
+        if y @ x < 0:
+            y = -y
+        if np.linalg.norm(y - x) <= 1e-10:
+            return float(y @ (A22 @ y))
+        x = y
+    return None
+
+
 def _subsystem_of(model: BogieModel) -> np.ndarray:
     names = model.dofs.names
     return np.array([0 if n.startswith("ID1.") else 2 if n.startswith("ID2.") else 1 for n in names])
@@ -486,19 +514,35 @@ def limit_sensitivity(model: BogieModel, v: float, N0: float, b_M: float,
     if s0_limit is None:
         s0_limit = stability_limit(model, v, N0, b_M).s0_limit
     op = OperatingPoint(s0_limit, v, N0, b_M)
-    result = eigen_analysis(model, op, vectors=False)  # the critical vector by inverse iteration
-    critical = int(np.argmax(result.eigenvalues.real))
-    lam_c = complex(result.eigenvalues[critical])
     law = _law(model.parameters.values, N0)
     s_max, _ = law.maximum(v)
     dmu = float(law.dmu_ds(s0_limit, v))
-    q, _ = null_vectors(model, damping_matrix(model, op), lam_c,
-                        np.random.default_rng(0).standard_normal(model.n))
+    at_maximum = abs(s0_limit - s_max) <= CREEP_MAXIMUM_RTOL * s_max
+    B_total = damping_matrix(model, op)
+    guess = np.random.default_rng(0).standard_normal(model.n)
+    # at the creep maximum the critical eigenvalue is expected to be the real one crossing 0 (a
+    # drivetrain's spin): found by shift-invert iteration at 0, without the full analysis; the
+    # full analysis decides when it is not that (checked below by its mode shape)
+    nearest = _real_eigenvalue_nearest_zero(model, op) if at_maximum else None
+    result = None
+    if nearest is None:
+        result = eigen_analysis(model, op, vectors=False)  # the critical vector: inverse iteration
+        critical = int(np.argmax(result.eigenvalues.real))
+        lam_c = complex(result.eigenvalues[critical])
+    else:
+        lam_c = complex(nearest)
+    q, _ = null_vectors(model, B_total, lam_c, guess)
     spin = lam_c.imag == 0 and _rigid_spin_mac(model, q)[0] > RIGID_SPIN_MAC
+    if not (spin and at_maximum) and result is None:
+        result = eigen_analysis(model, op, vectors=False)
+        critical = int(np.argmax(result.eigenvalues.real))
+        lam_c = complex(result.eigenvalues[critical])
+        q, _ = null_vectors(model, B_total, lam_c, guess)
+        spin = lam_c.imag == 0 and _rigid_spin_mac(model, q)[0] > RIGID_SPIN_MAC
     names = (*tuple(wanted), "v", "N0", "b_M")
     units = (*tuple(SCHEMA[name][0] for name in wanted), "m/s", "N", "N m s/rad")
     values = np.array([model.parameters[name] for name in wanted] + [v, N0, b_M])
-    if spin and abs(s0_limit - s_max) <= CREEP_MAXIMUM_RTOL * s_max:
+    if spin and at_maximum:
         # s0* is the creep maximum: d/dp [∂μ/∂s (s*, p)] = 0  =>  ds*/dp = −μ′_p/μ′_s
         base = _creep_inputs(model.parameters, OperatingPoint(s_max, v, N0, b_M))
 

@@ -215,6 +215,30 @@ def test_limit_is_creep_maximum_and_structure_cannot_move_it(setup):
     assert d["polach_B"] == pytest.approx((up - down) / (2 * h), rel=1e-5)
 
 
+def test_limit_sensitivity_finds_the_critical_eigenvalue_without_the_full_analysis(setup,
+                                                                                 monkeypatch):
+    """At the creep maximum λc is found by inverse iteration at 0 on the deflated state matrix:
+    the same derivatives and mechanism as with the full eigen-analysis, and λc the eigenvalue of
+    that analysis nearest to 0 (both are at rounding level: |λc| ≤ 1e-3 1/s, while the next real
+    eigenvalue is ≈ -0.02 1/s)."""
+    import model.sensitivity as sensitivity
+    from model import eigen_analysis
+
+    parameters, model = setup
+    v, N0, b_M = 200 * KMH, parameters["wheel_force"], parameters["motor_slope"]
+    fast = sensitivity.limit_sensitivity(model, v, N0, b_M)
+    full_eigenvalues = eigen_analysis(model, OperatingPoint(fast.s0_limit, v, N0, b_M),
+                                      vectors=False).eigenvalues
+    nearest = full_eigenvalues[np.argmin(np.abs(full_eigenvalues))]
+    assert abs(nearest) < 1e-3
+    assert fast.critical_eigenvalue.imag == 0.0
+    assert abs(fast.critical_eigenvalue) < 1e-3
+    monkeypatch.setattr(sensitivity, "_real_eigenvalue_nearest_zero", lambda *args, **kw: None)
+    full = sensitivity.limit_sensitivity(model, v, N0, b_M)
+    assert full.mechanism == fast.mechanism == "creep maximum"
+    np.testing.assert_array_equal(full.derivatives, fast.derivatives)
+
+
 def test_unknown_parameter(setup):
     parameters, model = setup
     with pytest.raises(SensitivityError, match="unknown parameter 'nope'"):
