@@ -497,6 +497,7 @@ class BogieDashboard(pn.viewable.Viewer):
                 need_locus = self._shown_locus != (state.locus_key, True)
                 locus_future = (loop.run_in_executor(FIRST_ANSWER_POOL, self._locus, state)
                                 if need_locus else None)
+                self.nonlinear.prefetch(state)  # issue 10: the nonlinear history, if shown
                 try:
                     fast = await loop.run_in_executor(FIRST_ANSWER_POOL, self.compute_fast, state)
                 except MODEL_ERRORS as error:

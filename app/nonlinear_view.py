@@ -256,6 +256,17 @@ class NonlinearView:
             return
         self.update()
 
+    def prefetch(self, state) -> None:
+        """Served: start the nonlinear history of ``state`` beside the linear first answer (it
+        waits for, then shares, the operating point's eigendecomposition; its result is cached
+        for :meth:`on_fast`).  Before, it started only once the linear answer was shown."""
+        if self.creep.value != "nonlinear":
+            return
+        key = (*state.point, state.M0, state.f, state.D, state.dt, state.t_end, self.valid)
+        if key != self._shown_key:
+            future = NONLINEAR_POOL.submit(nonlinear_histories, *key)
+            future.add_done_callback(lambda f: f.cancelled() or f.exception())  # on_fast reports
+
     def on_fast(self, state) -> None:
         """Hook: the dashboard has shown the linear result for ``state``."""
         self._state = state
