@@ -262,7 +262,7 @@ class NonlinearView:
         for :meth:`on_fast`).  Before, it started only once the linear answer was shown."""
         if self.creep.value != "nonlinear":
             return
-        key = (*state.point, state.M0, state.f, state.D, state.dt, state.t_end, self.valid)
+        key = self._key(state)
         if key != self._shown_key:
             future = NONLINEAR_POOL.submit(nonlinear_histories, *key)
             future.add_done_callback(lambda f: f.cancelled() or f.exception())  # on_fast reports
@@ -272,8 +272,9 @@ class NonlinearView:
         self._state = state
         self.update()
 
-    def _key(self):
-        s = self._state
+    def _key(self, state=None):
+        """The nonlinear history's cache key for ``state`` (default: the one shown)."""
+        s = self._state if state is None else state
         return (*s.point, s.M0, s.f, s.D, s.dt, s.t_end, self.valid)
 
     def update(self) -> None:

@@ -320,19 +320,24 @@ class EigenSensitivities:
             raise SensitivityError(f"unknown parameter '{name}'") from None
 
 
+def _lu_for_inverse_iteration(matrix: np.ndarray):
+    """LU factors of a matrix that is singular up to rounding at the shift (the point of inverse
+    iteration): an exactly zero pivot (the shift is an exact eigenvalue) is replaced by
+    eps·max|matrix|, so the solve amplifies that direction instead of failing."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", sla.LinAlgWarning)
+        lu, piv = sla.lu_factor(matrix, check_finite=False)
+    tiny = np.finfo(float).eps * np.abs(matrix).max()
+    small = np.flatnonzero(np.abs(np.diagonal(lu)) < tiny)
+    lu[small, small] = tiny
+    return lu, piv
+
+
 def null_vectors(model: BogieModel, B_total: np.ndarray, lam: complex,
                  guess: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Right and left null vectors (x, y) of ``λ²M + λB + K`` by one step of inverse iteration
     (unit 2-norm).  ``guess``: the eigen-analysis' displacement vector (start for x)."""
-    Q = lam * lam * model.M + lam * B_total + model.K
-    with warnings.catch_warnings():  # an exactly zero pivot: the eigenvalue is exact; perturb it
-        warnings.simplefilter("ignore", sla.LinAlgWarning)
-        lu, piv = sla.lu_factor(Q, check_finite=False)
-    tiny = np.finfo(float).eps * np.abs(Q).max()
-    diagonal = np.diagonal(lu).copy()
-    small = np.abs(diagonal) < tiny
-    if np.any(small):
-        lu[np.flatnonzero(small), np.flatnonzero(small)] = tiny
+    lu, piv = _lu_for_inverse_iteration(lam * lam * model.M + lam * B_total + model.K)
     x = sla.lu_solve((lu, piv), model.M @ guess, check_finite=False)
     start = model.M @ guess.conj()
     y = sla.lu_solve((lu, piv), start, trans=2, check_finite=False)
@@ -347,13 +352,7 @@ def _real_eigenvalue_nearest_zero(model: BogieModel, op: OperatingPoint,
     from .eigen import bogie_system
 
     A22 = bogie_system(model, op).reduced[1]
-    with warnings.catch_warnings():  # an exactly zero pivot: 0 is the eigenvalue; perturb it
-        warnings.simplefilter("ignore", sla.LinAlgWarning)
-        lu, piv = sla.lu_factor(A22, check_finite=False)
-    tiny = np.finfo(float).eps * np.abs(A22).max()
-    small = np.abs(np.diagonal(lu)) < tiny
-    if np.any(small):
-        lu[np.flatnonzero(small), np.flatnonzero(small)] = tiny
+    lu, piv = _lu_for_inverse_iteration(A22)
     x = np.random.default_rng(1).standard_normal(len(A22))
     x /= np.linalg.norm(x)
     for _ in range(iterations):
