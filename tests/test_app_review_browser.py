@@ -24,8 +24,11 @@ WIDGET_VALUE = """(cls) => { const doc = Bokeh.documents[0];
 
 
 def _tab(page, title: str) -> None:
-    page.locator(".bk-tab", has_text=title).first.click()
-    page.wait_for_timeout(500)
+    """Open a tab and wait until the browser shows it active (its view is rendered then)."""
+    tab = page.locator(".bk-tab", has_text=title).first
+    tab.click()
+    page.wait_for_function("(el) => el.classList.contains('bk-active')", arg=tab.element_handle(),
+                           timeout=60_000)
 
 
 def test_shared_link_restores_state_dense_locus_and_fig6(own_server, chromium):
@@ -89,6 +92,9 @@ def test_variant_upload_comparison_click_through_and_report(own_server, chromium
     # click-through: a row of the mode table shows that mode's description and energy shares
     _tab(page, "Modes")
     # the table shows ν as an integer and each mode's description (not a number column's NaN)
+    # (the tab's view is created when it is opened and filled by the server then: under the CI
+    # run's load that took longer than Playwright's default 30 s once, so wait as for the rest)
+    page.locator(".mode-table .tabulator-row").first.wait_for(timeout=120_000)
     first_row = page.locator(".mode-table .tabulator-row").first.inner_text()
     assert first_row.startswith("1\n"), first_row
     assert "NaN" not in first_row, first_row
