@@ -19,6 +19,11 @@ Method — a reduced model whose error is estimated at every point and bounded b
    many, or the MAC tracking is ambiguous, the point is solved densely (exact there).
    The reduced eigenproblems of the inner points are independent of each other and are solved
    first, on ``workers`` threads; tracking and error control then run through them in order.
+   The start of a sweep (the exact end points, the basis and the projected matrices) and the
+   reduced solutions of a short sweep are kept (:class:`_SweepStart`, a few per process): a
+   denser sweep over the same range — the dashboard's dense locus after its coarse one — reuses
+   them and solves only its new points (same basis, so bitwise the same values where both have
+   a point).
 4. Branches are continued from point to point by an optimal assignment on ``1 − MAC`` plus the
    normalized eigenvalue distance, so branches do not swap at near-crossings.
 
@@ -30,6 +35,7 @@ from __future__ import annotations
 
 import os
 import threading
+from collections import OrderedDict
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 
@@ -138,6 +144,36 @@ class _Reduced:
                 / np.maximum(np.abs(lam), 1e-300))
 
 
+@dataclass
+class _SweepStart:
+    """What a sweep over a range starts from: the exact end points (eigenvalues, unit
+    displacement vectors), the reduced model built on them, and reduced solutions by their
+    creep coefficients (those of the last short sweep over the range)."""
+
+    model: BogieModel
+    first: tuple[np.ndarray, np.ndarray]
+    last: tuple[np.ndarray, np.ndarray]
+    reduced: _Reduced
+    solutions: dict[bytes, tuple[np.ndarray, np.ndarray]]
+
+
+_SWEEP_STARTS: OrderedDict[tuple, _SweepStart] = OrderedDict()
+_SWEEP_STARTS_KEPT = 8  # sweep starts kept per process (≈ 5 MB each with 32 kept solutions)
+_SOLUTIONS_KEPT = 32  # a sweep with at most this many inner points keeps its solutions
+_SWEEP_STARTS_LOCK = threading.Lock()
+
+
+def _sweep_start_key(model: BogieModel, first: OperatingPoint, last: OperatingPoint,
+                     radius: float) -> tuple:
+    return (id(model), first, last, radius)
+
+
+def clear_sweep_starts() -> None:
+    """Forget the kept sweep starts (tests; the cache is bounded anyway)."""
+    with _SWEEP_STARTS_LOCK:
+        _SWEEP_STARTS.clear()
+
+
 _POOLS: dict[tuple[int, int], ThreadPoolExecutor] = {}
 _POOLS_LOCK = threading.Lock()
 
@@ -201,15 +237,44 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
         chosen = Q[:, np.abs(lam) < radius]
         return [chosen.real, chosen.imag]
 
-    first, last = exact(0), exact(n_points - 1)
-    reduced = _Reduced(model, op, patterns,
-                       [model.rigid_body_modes, *modes(*first), *modes(*last)])
+    key = _sweep_start_key(model, points[0], points[-1], radius)
+    with _SWEEP_STARTS_LOCK:
+        start = _SWEEP_STARTS.get(key)
+        if start is not None and start.model is model:
+            _SWEEP_STARTS.move_to_end(key)
+        else:
+            start = None
+    if start is None:
+        # the two exact end points at once (they decide the basis; numpy releases the GIL)
+        if workers > 1:
+            last_future = _solver_pool(workers).submit(exact, n_points - 1)
+            first = exact(0)
+            last = last_future.result()
+        else:
+            first, last = exact(0), exact(n_points - 1)
+        reduced = _Reduced(model, op, patterns,
+                           [model.rigid_body_modes, *modes(*first), *modes(*last)])
+        start = _SweepStart(model, first, last, reduced, {})
+    first, last, reduced = start.first, start.last, start.reduced
     # the reduced eigenproblems of the inner points do not depend on each other: solve them on
-    # ``workers`` threads (numpy's LAPACK calls release the GIL), then track and check in order
+    # ``workers`` threads (numpy's LAPACK calls release the GIL), then track and check in order;
+    # a point the kept start has solved already is not solved again
+    inner = coefficients[1:-1]
+    keys = [c.tobytes() for c in inner]
+    missing = [i for i, k in enumerate(keys) if k not in start.solutions]
     if workers > 1:
-        solutions = list(_solver_pool(workers).map(reduced.solve, coefficients[1:-1]))
+        found = list(_solver_pool(workers).map(reduced.solve, inner[missing]))
     else:
-        solutions = [reduced.solve(c) for c in coefficients[1:-1]]
+        found = [reduced.solve(c) for c in inner[missing]]
+    solved = dict(zip(missing, found, strict=True))
+    solutions = [solved[i] if i in solved else start.solutions[k] for i, k in enumerate(keys)]
+    with _SWEEP_STARTS_LOCK:
+        if len(inner) <= _SOLUTIONS_KEPT:
+            start = _SweepStart(model, first, last, reduced, dict(zip(keys, solutions, strict=True)))
+        _SWEEP_STARTS[key] = start
+        _SWEEP_STARTS.move_to_end(key)
+        while len(_SWEEP_STARTS) > _SWEEP_STARTS_KEPT:
+            _SWEEP_STARTS.popitem(last=False)
     tracked = np.flatnonzero(np.abs(first[0]) < radius)
     eigenvalues = np.zeros((n_points, len(tracked)), dtype=complex)
     errors = np.zeros((n_points, len(tracked)))

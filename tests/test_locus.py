@@ -3,11 +3,13 @@ the speed sweep, bad input."""
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 
 from model import OperatingPointError, build_model, default_operating_point, load_parameters
-from model.locus import dense_generalized_eigenvalues, root_locus
+from model.locus import clear_sweep_starts, dense_generalized_eigenvalues, root_locus
 
 CONTROLLED = 1.5 * 2 * np.pi * 20.0  # |λ| inside which the tolerance is enforced [1/s]
 
@@ -31,6 +33,34 @@ def test_tracked_eigenvalues_equal_dense_solution(setup):
         for value in locus.eigenvalues[i]:
             if abs(value) < CONTROLLED:
                 assert np.min(np.abs(reference - value)) <= 1e-6 * abs(value)
+
+
+def test_denser_sweep_reuses_the_start_and_gives_the_same_values(setup, monkeypatch):
+    """A denser sweep over the same range (the dashboard's dense locus after its coarse one)
+    reuses the kept end points, basis and short sweep's solutions: it solves only its new points
+    and gives bitwise the same eigenvalues as the same sweep computed from scratch."""
+    import model.locus as locus_module
+
+    model, op, _, _ = setup
+    solves = []
+    solve = locus_module._Reduced.solve
+    monkeypatch.setattr(locus_module._Reduced, "solve",
+                        lambda self, c: solves.append(1) or solve(self, c))
+    coarse_s0 = np.linspace(0.002, 0.016, 8)
+    dense_s0 = np.concatenate([np.linspace(a, b, 4)[:-1] for a, b in pairwise(coarse_s0)]
+                              + [coarse_s0[-1:]])
+    clear_sweep_starts()
+    coarse = root_locus(model, op, "s0", coarse_s0)
+    solves.clear()
+    reused = root_locus(model, op, "s0", dense_s0)
+    assert len(solves) == (len(dense_s0) - 2) - (len(coarse_s0) - 2)  # only the new inner points
+    clear_sweep_starts()
+    fresh = root_locus(model, op, "s0", dense_s0)
+    assert np.array_equal(reused.eigenvalues, fresh.eigenvalues)
+    assert np.array_equal(reused.error_estimate, fresh.error_estimate)
+    # another operating point does not reuse this start
+    other = root_locus(model, op.__class__(op.s0, op.v, op.N0, 2 * op.b_M + 1.0), "s0", coarse_s0)
+    assert not np.array_equal(other.eigenvalues, coarse.eigenvalues)
 
 
 def test_branches_do_not_swap(setup):
