@@ -25,13 +25,13 @@ from functools import partial
 
 import numpy as np
 import panel as pn
-from bokeh.models import ColumnDataSource
 
 from model.antislip import required_reaction_time
 from model.nonlinear import AntiSlip, NonlinearError, nonlinear_response
 from model.response import ShortCircuit
 
 from . import compute
+from .plots import SeriesSource
 from .workers import NONLINEAR_POOL, SEARCH_POOL
 
 log = logging.getLogger(__name__)
@@ -198,39 +198,32 @@ class NonlinearView:
 
     def _add_glyphs(self) -> None:
         plots = self.dash.response_plots
-        self.sources = {name: ColumnDataSource({"t": [], "y": []}, name=f"nonlinear:{name}")
-                        for name in compute.RESPONSE_OUTPUTS}
+        self.sources = SeriesSource(compute.RESPONSE_OUTPUTS, name="nonlinear")
         self.renderers = []
         for drive in ("ID1", "ID2"):
             fig = plots.torque[drive]
             for quantity, color in zip(compute.TORQUES, ("#0b3d66", "#7a1010"), strict=True):
                 label = {"driving_shaft.torque": "M_DS nonlinear",
                          "disc_clutch.torque": "M_xDC nonlinear"}[quantity]
-                self.renderers.append(fig.line("t", "y", source=self.sources[f"{drive}.{quantity}"],
-                                               color=color, line_width=1.5, line_dash="solid",
-                                               alpha=0.8, legend_label=label))
+                self.renderers.append(self.sources.line(
+                    fig, f"{drive}.{quantity}", color=color, line_width=1.5, line_dash="solid",
+                    alpha=0.8, legend_label=label))
         creep_fig = self.dash.creep_plot.figure
-        self.paths = {rim: ColumnDataSource({"s": [], "mu": []}, name=f"creep_path:{rim}")
-                      for rim in WHEEL_COLORS}
+        self.paths = SeriesSource(WHEEL_COLORS, name="creep_path", x="s", y="mu")
         for rim, color in WHEEL_COLORS.items():
-            self.renderers.append(creep_fig.line("s", "mu", source=self.paths[rim], color=color,
-                                                 line_width=1.2, alpha=0.8,
-                                                 legend_label=f"{rim} path (nonlinear)"))
+            self.renderers.append(self.paths.line(creep_fig, rim, color=color, line_width=1.2,
+                                                  alpha=0.8, legend_label=f"{rim} path (nonlinear)"))
 
     def _clear(self) -> None:
-        for source in self.sources.values():
-            source.data = {"t": [], "y": []}
-        for source in self.paths.values():
-            source.data = {"s": [], "mu": []}
+        self.sources.clear()
+        self.paths.clear()
         self.histories = None
         self._shown_key = None
 
     def _show(self, key, histories: NonlinearHistories) -> None:
         self.histories, self._shown_key = histories, key
-        for name, (t, y) in histories.plot.items():
-            self.sources[name].data = {"t": t, "y": y}
-        for rim, (s, mu) in histories.paths.items():
-            self.paths[rim].data = {"s": s, "mu": mu}
+        self.sources.update(histories.plot)
+        self.paths.update(histories.paths)
         self._progress = self._describe(histories)
         self._render_status()
 

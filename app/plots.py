@@ -48,6 +48,51 @@ def _figure(title: str, x_label: str, y_label: str, **kwargs):
     return fig
 
 
+class SeriesSource:
+    """Several named (x, y) series in one Bokeh source: columns ``"<x>:<name>"`` and
+    ``"<y>:<name>"``, each series on its own points, padded with NaN to the longest (a line
+    ends at the first NaN of its own columns).  A change of all series reaches the browser as one
+    message, drawn once (one source per series sent one message each: eleven per slider step
+    for the time histories).  ``name=`` names the Bokeh source (browser tests find it)."""
+
+    def __init__(self, names, name: str, x: str = "t", y: str = "y"):
+        self.names, self.x, self.y = tuple(names), x, y
+        self.source = ColumnDataSource({self.column(axis, series): []
+                                        for series in self.names for axis in (x, y)}, name=name)
+
+    def column(self, axis: str, series: str) -> str:
+        return f"{axis}:{series}"
+
+    def line(self, fig, series: str, **kwargs):
+        """A line glyph of ``series`` on ``fig`` (keyword arguments as for ``fig.line``)."""
+        return fig.line(self.column(self.x, series), self.column(self.y, series),
+                        source=self.source, **kwargs)
+
+    def update(self, series: dict[str, tuple[np.ndarray, np.ndarray]]) -> None:
+        """Show these series (others: none) in one change of the source."""
+        length = max((len(x) for x, _ in series.values()), default=0)
+        empty = np.full(length, np.nan)
+        data = {}
+        for name in self.names:
+            x, y = series.get(name, (empty, empty))
+            pad = np.full(length - len(x), np.nan)
+            data[self.column(self.x, name)] = np.concatenate([np.asarray(x, float), pad])
+            data[self.column(self.y, name)] = np.concatenate([np.asarray(y, float), pad])
+        self.source.data = data  # numpy: binary buffers, not JSON
+
+    def clear(self) -> None:
+        """Show no series (nothing is sent when none is shown already)."""
+        if any(len(column) for column in self.source.data.values()):
+            self.update({})
+
+    def series(self, name: str) -> dict[str, np.ndarray]:
+        """One series as shown, without the padding: ``{x: …, y: …}``."""
+        x = np.asarray(self.source.data[self.column(self.x, name)], dtype=float)
+        y = np.asarray(self.source.data[self.column(self.y, name)], dtype=float)
+        keep = ~np.isnan(x)
+        return {self.x: x[keep], self.y: y[keep]}
+
+
 class RootLocusPlot:
     """Eigenvalues in the complex plane: tracked branches coloured by the swept parameter, the
     current point's eigenvalues highlighted, the unstable half-plane shaded."""
@@ -157,7 +202,11 @@ class CreepPlot:
         fig.y_range.start = 0.0
 
     def update_point(self, result: PointResult) -> None:
-        self.curve.data = {"s": result.creep_s, "mu": result.creep_mu}
+        shown = self.curve.data
+        if not (np.array_equal(shown["s"], result.creep_s)
+                and np.array_equal(shown["mu"], result.creep_mu)):
+            # μ(s, v) depends on v and the creep law, not on s0: not sent again on an s0 step
+            self.curve.data = {"s": result.creep_s, "mu": result.creep_mu}
         s0 = result.key[2]
         self.point.data = {"s": [s0], "mu": [result.mu0]}
         self.maximum.location = result.s_max
@@ -175,9 +224,8 @@ class ResponsePlots:
     """Torques of both drives with ±M_ad, disc clutch forces, and M_C(t)."""
 
     def __init__(self):
-        # one source per series: each is min/max-decimated on its own time points
-        self.sources = {name: ColumnDataSource({"t": [], "y": []}, name=f"response:{name}")
-                        for name in (*RESPONSE_OUTPUTS, "M_C")}
+        # every series (each min/max-decimated on its own time points) in one source
+        self.sources = SeriesSource((*RESPONSE_OUTPUTS, "M_C"), name="response")
         self.torque = {}
         self.ad_spans = []
         shared_x = None
@@ -188,8 +236,7 @@ class ResponsePlots:
             for quantity, color in zip(TORQUES, ("#1f77b4", "#d62728"), strict=True):
                 label = {"driving_shaft.torque": "driving shaft M_DS",
                          "disc_clutch.torque": "disc clutch M_xDC"}[quantity]
-                fig.line("t", "y", source=self.sources[f"{drive}.{quantity}"], color=color,
-                         legend_label=label)
+                self.sources.line(fig, f"{drive}.{quantity}", color=color, legend_label=label)
             for sign in (1, -1):
                 span = Span(location=0.0, dimension="width", line_color="black",
                             line_dash="dashed")
@@ -203,15 +250,15 @@ class ResponsePlots:
                               "force [N]", x_range=shared_x)
         for quantity, color in zip(FORCES, Category10_10[2:5], strict=True):
             axis = quantity[-1]
-            self.forces.line("t", "y", source=self.sources[f"ID1.{quantity}"], color=color,
-                             legend_label=f"F_{axis} ID1")
-            self.forces.line("t", "y", source=self.sources[f"ID2.{quantity}"], color=color,
-                             line_dash="dashed", legend_label=f"F_{axis} ID2")
+            self.sources.line(self.forces, f"ID1.{quantity}", color=color,
+                              legend_label=f"F_{axis} ID1")
+            self.sources.line(self.forces, f"ID2.{quantity}", color=color, line_dash="dashed",
+                              legend_label=f"F_{axis} ID2")
         self.forces.legend.click_policy = "hide"
         self.forces.legend.label_text_font_size = "10px"
         self.excitation = _figure("Short-circuit torque M_C(t) on ID1's rotor", "t [s]",
                                   "M_C [N m]", x_range=shared_x)
-        self.excitation.line("t", "y", source=self.sources["M_C"], color="black")
+        self.sources.line(self.excitation, "M_C", color="black")
         self.ad_label = Label(x=60, y=5, x_units="screen", y_units="screen", text="",
                               text_font_size="10px")
         self.torque["ID1"].add_layout(self.ad_label)
@@ -221,8 +268,7 @@ class ResponsePlots:
         return [self.torque["ID1"], self.torque["ID2"], self.forces, self.excitation]
 
     def update(self, response: ResponseView) -> None:
-        for name, (t, y) in response.plot.items():
-            self.sources[name].data = {"t": t, "y": y}  # numpy: binary buffers, not JSON
+        self.sources.update(response.plot)
         for sign, span in self.ad_spans:
             span.location = sign * response.M_ad
         self.ad_label.text = f"dashed: ±M_ad = ±{response.M_ad:,.0f} N m"

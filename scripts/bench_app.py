@@ -49,7 +49,7 @@ ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-f
         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 DATA = """(name, col) => { const d = Bokeh.documents[0].get_model_by_name(name).data;
   const v = d instanceof Map ? d.get(col) : d[col]; return Array.from(v).slice(0, 60).join(','); }"""
-FAST = f"() => ({DATA})('locus_current', 'x') + '|' + ({DATA})('response:ID1.disc_clutch.torque', 'y')"
+FAST = f"() => ({DATA})('locus_current', 'x') + '|' + ({DATA})('response', 'y:ID1.disc_clutch.torque')"
 SLOW = f"() => ({DATA})('locus_points', 'x')"
 LOCUS_TITLE = "() => Bokeh.documents[0].get_model_by_name('root-locus').title.text"
 
@@ -190,7 +190,7 @@ def protocol_clients(url: str, count: int) -> None:
                 return elapsed
 
             fast = [doc.get_model_by_name("locus_current"),
-                    doc.get_model_by_name("response:ID1.disc_clutch.torque")]
+                    doc.get_model_by_name("response")]
             locus = [doc.get_model_by_name("locus_points")]
             s0, n0 = control("s0"), control("N0")
             change(n0, 60.0 + index, locus)  # own wheel force [kN]: no shared cache hits

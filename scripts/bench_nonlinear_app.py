@@ -24,7 +24,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_app import ARGS, CHROMIUM, DATA, FAST, free_port, log, open_page, settle_n0, start_server
 
-NONLINEAR = f"() => ({DATA})('nonlinear:ID1.disc_clutch.torque', 'y')"
+NONLINEAR = f"() => ({DATA})('nonlinear', 'y:ID1.disc_clutch.torque')"
 
 
 async def press(page, key: str = "ArrowRight", timeout: float = 120_000) -> tuple[float, float]:

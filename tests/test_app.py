@@ -115,8 +115,8 @@ def test_time_histories_change_with_the_excitation(dash):
     dash.param.update(s0=0.005, v=120.0, M0=50.0)
     before = dict(dash.response.peaks)
     sources = dash.response_plots.sources
-    assert {"M_C", "ID1.disc_clutch.torque", "ID2.driving_shaft.torque"} <= set(sources)
-    shown = sources["ID1.disc_clutch.torque"].data
+    assert {"M_C", "ID1.disc_clutch.torque", "ID2.driving_shaft.torque"} <= set(sources.names)
+    shown = sources.series("ID1.disc_clutch.torque")
     assert len(shown["t"]) == len(shown["y"]) > 100
     # the decimated curve keeps the extremes of the full-resolution history
     full = dash.response.outputs["ID1.disc_clutch.torque"]

@@ -22,7 +22,7 @@ FINGERPRINT = """() => {
   const get = (name, col) => { const d = doc.get_model_by_name(name).data;
                                 const v = d instanceof Map ? d.get(col) : d[col];
                                 return Array.from(v).slice(0, 40).join(','); };
-  return get('locus_current', 'x') + '|' + get('response:ID1.disc_clutch.torque', 'y');
+  return get('locus_current', 'x') + '|' + get('response', 'y:ID1.disc_clutch.torque');
 }"""
 PLOTS = """() => {
   const doc = Bokeh.documents[0];

@@ -50,19 +50,19 @@ def dash():
 def test_creep_switch_overlays_and_paths(dash):
     view = dash.nonlinear
     dash.param.update(s0=0.005, v=120.0)
-    assert len(view.sources["ID2.disc_clutch.torque"].data["t"]) == 0  # linear: nothing extra
+    assert len(view.sources.series("ID2.disc_clutch.torque")["t"]) == 0  # linear: nothing extra
     view.creep.value = "nonlinear"
-    t, y = view.sources["ID2.disc_clutch.torque"].data["t"], view.sources[
-        "ID2.disc_clutch.torque"].data["y"]
+    shown = view.sources.series("ID2.disc_clutch.torque")
+    t, y = shown["t"], shown["y"]
     assert len(t) > 100
     assert np.abs(y).max() == pytest.approx(abs(view.histories.peaks["ID2.disc_clutch.torque"]),
                                             rel=1e-6)
-    assert len(view.paths["ID2.rim12"].data["s"]) > 100
+    assert len(view.paths.series("ID2.rim12")["s"]) > 100
     assert "nonlinear creep shown" in view.status.object
     # the linear result is still there beside it
-    assert len(dash.response_plots.sources["ID2.disc_clutch.torque"].data["t"]) > 100
+    assert len(dash.response_plots.sources.series("ID2.disc_clutch.torque")["t"]) > 100
     view.creep.value = "linear"
-    assert len(view.sources["ID2.disc_clutch.torque"].data["t"]) == 0
+    assert len(view.sources.series("ID2.disc_clutch.torque")["t"]) == 0
 
 
 @pytest.mark.slow
