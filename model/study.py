@@ -62,6 +62,7 @@ from scipy.optimize import brentq
 from .assembly import BogieModel, build_model
 from .continuation import LineContinuation
 from .eigen import eigen_analysis
+from .linear_system import Deflation
 from .locus import _coefficients, _newton, _Reduced, creep_patterns
 from .operating_point import OperatingPoint, damping_matrix
 from .parameters import Parameters, parameter_hash
@@ -159,11 +160,70 @@ def _limit_on_grid(s0_values, growth, function, xtol: float) -> float:
     return float(brentq(function, s0_values[i - 1], s0_values[i], xtol=xtol, rtol=1e-12))
 
 
+def _crossing_estimate(s0_values, growth, i: int) -> float:
+    """Where ``growth`` crosses 0 between grid points i − 1 and i (growth[i − 1] ≤ 0 <
+    growth[i]): the root of the cubic through the grid values at i − 2 … i + 1 when it lies in
+    the bracket (the largest real part is smooth there unless branches swap), else the secant."""
+    a, b = s0_values[i - 1], s0_values[i]
+    secant = a - growth[i - 1] * (b - a) / (growth[i] - growth[i - 1])
+    if i < 2 or i + 1 >= len(s0_values):
+        return float(secant)
+    x, y = s0_values[i - 2:i + 2], growth[i - 2:i + 2]
+    roots = np.roots(np.polyfit((x - a) / (b - a), y, 3))
+    inside = [a + (b - a) * t.real for t in roots if abs(t.imag) < 1e-12 and 0 <= t.real <= 1]
+    return float(min(inside, key=lambda t: abs(t - secant))) if inside else float(secant)
+
+
+def _reduced_limit(line_model, s0_values, growth, xtol: float, evaluations: int = 8) -> float:
+    """s0* on the reduced evaluation g(s) (its largest real part) between the first two grid
+    points where ``growth`` turns from ≤ 0 to > 0, to the same tolerance as Brent's method: a
+    bracket [lo, hi] with g(lo) ≤ 0 < g(hi) no wider than ``xtol``, and the secant root inside.
+
+    g is the maximum over branches: below s0* its top is often another, nearly flat branch, so
+    Brent's method from the grid bracket took ≈ 10 evaluations.  Here the secant steps follow
+    the real part of the crossing branch (at each evaluation the eigenvalue nearest to the
+    previous one, starting from the top one at the grid point above the crossing), starting at
+    the interpolated crossing; each step stays inside the bracket and is at least xtol/4 long, so
+    that the bracket closes once the iterate has converged: 3–5 evaluations.  Brent's method on
+    the remaining bracket after ``evaluations``."""
+    unstable = np.flatnonzero(growth > 0)
+    if len(unstable) == 0 or unstable[0] == 0:
+        return float("nan")
+    i = unstable[0]
+    lo, g_lo, hi, g_hi = s0_values[i - 1], growth[i - 1], s0_values[i], growth[i]
+    top = line_model.top_values
+    known = (s0_values[i], top[i])  # a point of the crossing branch: (s0, eigenvalue)
+    slope = 0.0  # d(eigenvalue)/ds0 of the branch, from the top at the next grid point if any
+    if i + 1 < len(s0_values):
+        slope = (top[i + 1] - top[i]) / (s0_values[i + 1] - s0_values[i])
+    x = known[0] - known[1].real / slope.real if slope.real > 0 else np.nan
+    if not lo < x < hi:
+        x = lo - g_lo * (hi - lo) / (g_hi - g_lo)  # regula falsi on the grid bracket
+    for _ in range(evaluations):
+        gx = line_model.point(x)[0][0]
+        values = line_model.values
+        branch = values[np.argmin(np.abs(values - (known[1] + slope * (x - known[0]))))]
+        slope, known = (branch - known[1]) / (x - known[0]), (x, branch)
+        if gx > 0:
+            hi, g_hi = x, gx
+        else:
+            lo, g_lo = x, gx
+        if hi - lo <= xtol:
+            return float(lo - g_lo * (hi - lo) / (g_hi - g_lo))
+        following = x - branch.real / slope.real if slope.real != 0 else np.nan
+        if not lo < following < hi:
+            following = lo - g_lo * (hi - lo) / (g_hi - g_lo)  # regula falsi: inside
+        if abs(following - x) < 0.25 * xtol:  # toward the crossing: x is an end of the bracket
+            following = x + 0.25 * xtol if gx <= 0 else x - 0.25 * xtol
+        x = float(np.clip(following, lo + 0.1 * xtol, hi - 0.1 * xtol))
+    return float(brentq(lambda s: line_model.point(s)[0][0], lo, hi, xtol=xtol, rtol=1e-12))
+
+
 def _line_limit(model, line_model, s0_values, growth, v, N0, b_M, xtol) -> float:
-    """s0* on the reduced evaluation; the dense one if the reduced evaluation at the bracket's
-    ends (solved densely on the grid) does not change sign."""
+    """s0* on the reduced evaluation (:func:`_reduced_limit`); the dense one if the reduced
+    evaluation does not change sign where the grid did."""
     try:
-        return _limit_on_grid(s0_values, growth, lambda s: line_model.point(s)[0][0], xtol)
+        return _reduced_limit(line_model, s0_values, growth, xtol)
     except ValueError:
         return _limit_on_grid(s0_values, growth, lambda s: _dense_point(
             model, OperatingPoint(s, v, N0, b_M)).max_real_part, xtol)
@@ -190,11 +250,28 @@ class _LineModel:
         basis = U[:, sigma > BASIS_CUTOFF * sigma[0]]
         self.reduced = _Reduced(model, anchors[0].operating_point, patterns, [basis])
         self.newton = 0
-        self.n_rigid = model.rigid_body_modes.shape[1]
-        r = self.reduced.size
-        self._A = np.zeros((2 * r, 2 * r))  # first-order reduced matrix; damping block per point
-        self._A[:r, r:] = np.eye(r)
-        self._A[r:, :r] = -self.reduced.K_r
+        red, r = self.reduced, self.reduced.size
+        # The first-order reduced matrix [[0, I], [−K_r, −C]] is affine in the creep
+        # coefficients c: C = C0_r + Σ c_k P_k,r.  The basis holds the rigid-body modes, whose
+        # reduced coordinates y_R = Lᵀ Φᵀ R give the exact eigenpairs (0, [y_R; 0]) of the reduced
+        # model (K_r y_R = 0) whatever C: that invariant subspace is deflated once per line as in
+        # the full model (model.linear_system.Deflation), and each point solves the eigenvalues of
+        # the rest, A22(c) = base + Σ c_k D_k (2r − n_rigid unknowns), only.
+        rigid = sla.solve_triangular(red.Linv.T, red.Phi.T @ model.rigid_body_modes,
+                                     lower=False, check_finite=False)
+        deflation = Deflation(np.vstack([rigid, np.zeros_like(rigid)]))
+        n_rigid = rigid.shape[1]
+
+        def first_order(K, C):
+            A = np.zeros((2 * r, 2 * r))
+            A[:r, r:] = np.eye(r) if K is not None else 0.0
+            if K is not None:
+                A[r:, :r] = -K
+            A[r:, r:] = -C
+            return deflation.project(A)[n_rigid:, n_rigid:]
+
+        self._base = first_order(red.K_r, red.C0_r)
+        self._parts = [first_order(None, P) for P in red.P_r]
         self._start = np.random.default_rng(0).standard_normal(r)  # inverse iteration start
         self._eye = np.eye(r)
 
@@ -210,17 +287,23 @@ class _LineModel:
         X = red.Linv.T @ X
         return X / np.linalg.norm(X, axis=0)
 
-    def point(self, s0: float) -> tuple[tuple[float, int, int], bool]:
-        """(summary, solved densely) at creepage s0."""
+    def _result(self, values: np.ndarray, dense: bool) -> tuple[tuple[float, int, int], bool]:
+        self.values = values  # the last point's eigenvalues (refined Ritz values or dense)
+        return spectrum_summary(values), dense
+
+    def point(self, s0: float, c: np.ndarray | None = None) -> tuple[tuple[float, int, int], bool]:
+        """(summary, solved densely) at creepage s0; ``c``: its creep coefficients (b11, b22,
+        b23, b33) if already known."""
         op = OperatingPoint(float(s0), self.v, self.N0, self.b_M)
-        c = _coefficients(self.model, op)
-        red, r = self.reduced, self.reduced.size
+        if c is None:
+            c = _coefficients(self.model, op)
+        red = self.reduced
         C = red.C0_r + sum(ck * Pk for ck, Pk in zip(c, red.P_r, strict=True))
-        self._A[r:, r:] = -C
-        lam = sla.eigvals(self._A, check_finite=False)  # eigenvalues only: no vectors
-        # the basis holds the rigid-body modes: their exact zeros (K r = 0) are the n_rigid
-        # Ritz values closest to 0 (a spin eigenvalue closer to 0 than them is 0 too)
-        lam = lam[np.argsort(np.abs(lam), kind="stable")[self.n_rigid:]]
+        A22 = self._base.copy()
+        for ck, D in zip(c, self._parts, strict=True):
+            A22 += ck * D
+        # eigenvalues only (no vectors) of the non-rigid part (the rigid zeros are deflated)
+        lam = sla.eigvals(A22, overwrite_a=True, check_finite=False)
         lam = lam[lam.imag >= -IMAG_TOL * np.abs(lam)]  # one of each pair, and the reals
         # Only Ritz values with Re λ ≥ min(top, 0) − BAND can decide the summary; their vectors
         # and first-order errors (from the full residual) are computed.  Beyond the controlled
@@ -229,7 +312,7 @@ class _LineModel:
         # anchors (outside_max_real_part).
         checked = np.zeros(len(lam), dtype=bool)
         error = np.full(len(lam), np.inf)
-        vectors = np.zeros((r, len(lam)), dtype=complex)  # of the checked Ritz values
+        vectors = np.zeros((red.size, len(lam)), dtype=complex)  # of the checked Ritz values
         while True:
             candidates = np.flatnonzero(~checked & (lam.real >= min(lam.real.max(), 0.0) - BAND))
             if len(candidates) == 0:
@@ -237,7 +320,7 @@ class _LineModel:
             try:
                 X = self._ritz_vectors(lam[candidates], C)
             except np.linalg.LinAlgError:  # a Ritz value exact to the last bit: no inverse step
-                return spectrum_summary(_dense_point(self.model, op).eigenvalues), True
+                return self._result(_dense_point(self.model, op).eigenvalues, True)
             relative = red.error_estimate(c, lam[candidates], X)
             checked[candidates] = True
             error[candidates] = relative * np.abs(lam[candidates])
@@ -257,18 +340,21 @@ class _LineModel:
         needs &= checked & (error > self.rtol * np.maximum(np.abs(lam), 1.0))
         failing = np.flatnonzero(needs)
         if len(failing) > MAX_NEWTON:
-            return spectrum_summary(_dense_point(self.model, op).eigenvalues), True
+            return self._result(_dense_point(self.model, op).eigenvalues, True)
         if len(failing):
             C_full = damping_matrix(self.model, op)
             lam = lam.copy()
             for b in failing:
+                # converged to rtol·max(|λ|, 1 1/s), the accuracy asked of every decisive
+                # value (relative to |λ| alone, a real eigenvalue crossing 0 near s0* never
+                # converges and sent the point to a full eigen-analysis)
                 value, _, step = _newton(self.model.M, C_full, self.model.K, lam[b],
-                                         red.Phi @ vectors[:, b], self.rtol)
+                                         red.Phi @ vectors[:, b], self.rtol, floor=1.0)
                 if not step <= self.rtol:
-                    return spectrum_summary(_dense_point(self.model, op).eigenvalues), True
+                    return self._result(_dense_point(self.model, op).eigenvalues, True)
                 lam[b] = value
             self.newton += len(failing)
-        return spectrum_summary(np.concatenate([lam, lam[lam.imag > 0].conj()])), False
+        return self._result(np.concatenate([lam, lam[lam.imag > 0].conj()]), False)
 
 
 def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
@@ -334,7 +420,8 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     points = [OperatingPoint(float(s), v, N0, b_M) for s in s0_values]
     # anchors (solved densely, their eigenvectors span the basis): both ends and the creepage of
     # the most negative b11 (the steepest falling creep slope: the most destabilizing point)
-    b11 = np.array([_coefficients(model, op)[0] for op in points])
+    coefficients = [_coefficients(model, op) for op in points]
+    b11 = np.array([c[0] for c in coefficients])
     anchor_index = sorted({0, int(np.argmin(b11)), n - 1})
     anchors = {i: _dense_point(model, points[i], vectors=True) for i in anchor_index}
     radius = 2 * np.pi * max_frequency_hz
@@ -347,13 +434,17 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     line_model = _LineModel(model, v, N0, b_M, list(anchors.values()), max_frequency_hz, rtol)
     rows = []
     dense = np.zeros(n, dtype=bool)
+    line_model.top_values = np.zeros(n, dtype=complex)  # the top eigenvalue at each point
     for i in range(n):
         if i in anchors:
-            rows.append(spectrum_summary(anchors[i].eigenvalues))
+            values = anchors[i].eigenvalues
+            rows.append(spectrum_summary(values))
             dense[i] = True
         else:
-            summary, dense[i] = line_model.point(s0_values[i])
+            summary, dense[i] = line_model.point(s0_values[i], coefficients[i])
             rows.append(summary)
+            values = line_model.values
+        line_model.top_values[i] = values[np.argmax(values.real)]
     growth = np.array([r[0] for r in rows])
     limit = _line_limit(model, line_model, s0_values, growth, v, N0, b_M, s0_limit_xtol)
     return LineResult(s0_values, v, N0, b_M, growth, np.array([r[1] for r in rows]),
