@@ -16,10 +16,14 @@ the same continuation.  Against a full eigen-analysis at every point of 100-poin
 
 The first method of issue 13, :func:`reduced_s0_line` (method "reduced", the default: it is
 cheaper, see BENCHMARKS.md), reuses one Galerkin-reduced model (:class:`model.locus._Reduced`,
-the root locus's projection on exact eigenvectors at a few *anchor* creepages) and costs two or
-three dense eigen-analyses plus one small eigenproblem per point.  The anchors are both ends
-and the grid creepage of the most negative b11 (the steepest falling creep slope, the most
-destabilizing point), when it lies inside the line.  Its properties:
+the root locus's projection on exact eigenvectors at a few *anchor* creepages) and costs two
+dense eigen-analyses with vectors (the anchors: both ends), one without at the grid creepage of
+the most negative b11 (the steepest falling creep slope, the most destabilizing point) when it
+lies inside the line, and one small eigenproblem per point (2r − 2 unknowns: the rigid-body
+zeros of the reduced model are deflated once per line).  The dense eigenvalues at that creepage
+check the basis: every eigenvalue there that the selection below would take must have a Ritz
+value within 10⁻⁴·max(|λ|, 1 1/s); if one has none, its eigenvectors join the basis (a third
+anchor; before the fourth session it always was one).  Its properties:
 
 What a point reports is a property of **all** eigenvalues, not only of tracked branches:
 
@@ -34,8 +38,9 @@ What a point reports is a property of **all** eigenvalues, not only of tracked b
   first-order error from the full-model residual (as in the root locus) must be below
   ``rtol``·max(|λ|, 1 1/s), else it is refined by Newton's method on the full model; if more than
   a few need it, the point is solved densely (exact).
-* The eigenvalues outside the basis are damped by more than 5 1/s at every anchor (by the
-  selection); each line records their largest real part there (``outside_max_real_part``).
+* The eigenvalues outside the basis are damped by more than 5 1/s at every anchor and at the
+  checked creepage (by the selection and the check); each line records their largest real part
+  there (``outside_max_real_part``).
   That they stay below the top in between is an **assumption**, not a theorem: a real part is
   not monotone in b11 (modes interact).  With a margin of 2 1/s instead of 5 it failed (at
   40 km/h modes damped by 2–5 1/s at the anchors turn unstable between s0 = 0.0137 and 0.0144,
@@ -76,6 +81,7 @@ BASIS_CUTOFF = 1e-12  # singular values of the basis vectors below this (relativ
 # off by 2 against the dense reference: measured), so the root locus's cut-off is kept
 SPURIOUS = 1e-3  # relative error estimate above which a Ritz value outside the disc is dropped
 MAX_NEWTON = 4  # more Ritz values failing the tolerance at a point: solve the point densely
+MATCH = 1e-4  # a Ritz value this close (relative) to an eigenvalue represents it in the basis check
 IMAG_TOL = 1e-9  # |Im λ| ≤ IMAG_TOL·|λ|: a real eigenvalue
 
 
@@ -113,7 +119,8 @@ class LineResult:
     s0_limit: float  # smallest s0* in [s0[0], s0[-1]] where the bogie turns unstable [-]; nan: none
     dense_points: np.ndarray  # (n,) bool: solved by a full eigen-analysis
     newton_refinements: int  # Ritz values refined by Newton's method on the full model
-    outside_max_real_part: float  # largest Re outside the basis at the anchors [1/s]
+    outside_max_real_part: float  # largest Re outside the basis at the anchors and the
+    # checked creepage [1/s]
     basis_size: int  # columns of the reduction basis (0: dense or continuation)
     fallbacks: int = 0  # continuation: points where its checks failed (solved densely there)
     method: str = "dense"  # "continuation", "reduced" or "dense"
@@ -229,6 +236,16 @@ def _line_limit(model, line_model, s0_values, growth, v, N0, b_M, xtol) -> float
             model, OperatingPoint(s, v, N0, b_M)).max_real_part, xtol)
 
 
+def _missing_modes(eigenvalues: np.ndarray, ritz: np.ndarray, radius: float) -> bool:
+    """Whether an eigenvalue that the selection takes (:func:`basis_modes`, ``radius`` [1/s]) has
+    no Ritz value within ``MATCH``·max(|λ|, 1 1/s): the basis misses that mode."""
+    wanted = eigenvalues[basis_modes(eigenvalues, radius)]
+    if len(wanted) == 0:
+        return False
+    distance = np.abs(wanted[:, None] - ritz[None, :]).min(axis=1, initial=np.inf)
+    return bool(np.any(distance > MATCH * np.maximum(np.abs(wanted), 1.0)))
+
+
 class _LineModel:
     """The reduced model of one line and its error-controlled point evaluation."""
 
@@ -287,6 +304,14 @@ class _LineModel:
         X = red.Linv.T @ X
         return X / np.linalg.norm(X, axis=0)
 
+    def ritz_values(self, c: np.ndarray) -> np.ndarray:
+        """All non-rigid Ritz values [1/s] at creep coefficients ``c`` (eigenvalues only; the
+        rigid zeros are deflated)."""
+        A22 = self._base.copy()
+        for ck, D in zip(c, self._parts, strict=True):
+            A22 += ck * D
+        return sla.eigvals(A22, overwrite_a=True, check_finite=False)
+
     def _result(self, values: np.ndarray, dense: bool) -> tuple[tuple[float, int, int], bool]:
         self.values = values  # the last point's eigenvalues (refined Ritz values or dense)
         return spectrum_summary(values), dense
@@ -299,11 +324,7 @@ class _LineModel:
             c = _coefficients(self.model, op)
         red = self.reduced
         C = red.C0_r + sum(ck * Pk for ck, Pk in zip(c, red.P_r, strict=True))
-        A22 = self._base.copy()
-        for ck, D in zip(c, self._parts, strict=True):
-            A22 += ck * D
-        # eigenvalues only (no vectors) of the non-rigid part (the rigid zeros are deflated)
-        lam = sla.eigvals(A22, overwrite_a=True, check_finite=False)
+        lam = self.ritz_values(c)
         lam = lam[lam.imag >= -IMAG_TOL * np.abs(lam)]  # one of each pair, and the reals
         # Only Ritz values with Re λ ≥ min(top, 0) − BAND can decide the summary; their vectors
         # and first-order errors (from the full residual) are computed.  Beyond the controlled
@@ -409,7 +430,8 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     """The Galerkin-reduced line (issue 13's first method, ``s0_line``'s default): largest
     real part, flutter pairs and divergent reals at every creepage of ``s0_values``
     (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
-    [N m s/rad]; and s0* inside the line's range by Brent's method on the same evaluation.
+    [N m s/rad]; and s0* inside the line's range on the same evaluation (secant steps in a
+    closing bracket, :func:`_reduced_limit`; Brent's method if they do not close it).
 
     ``max_frequency_hz``: the reduction basis holds the exact eigenvectors with |λ| < 2π·f (and
     those with Re λ > −5 1/s) at the anchors (see the module docstring for what is assumed of
@@ -418,26 +440,38 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     s0_values = _check_s0(s0_values)
     n = len(s0_values)
     points = [OperatingPoint(float(s), v, N0, b_M) for s in s0_values]
-    # anchors (solved densely, their eigenvectors span the basis): both ends and the creepage of
-    # the most negative b11 (the steepest falling creep slope: the most destabilizing point)
+    # anchors (solved densely, their eigenvectors span the basis): both ends.  The grid creepage
+    # of the most negative b11 (the steepest falling creep slope, the most destabilizing point) is
+    # solved densely too (eigenvalues only) and checks the basis: every eigenvalue there that the
+    # selection would take (basis_modes) must have a Ritz value of the reduced model next to it;
+    # if one has none, that point's eigenvectors join the basis (a third anchor, as before)
     coefficients = [_coefficients(model, op) for op in points]
     b11 = np.array([c[0] for c in coefficients])
-    anchor_index = sorted({0, int(np.argmin(b11)), n - 1})
-    anchors = {i: _dense_point(model, points[i], vectors=True) for i in anchor_index}
+    middle = int(np.argmin(b11))
+    anchors = {i: _dense_point(model, points[i], vectors=True) for i in sorted({0, n - 1})}
     radius = 2 * np.pi * max_frequency_hz
-    outside = max(float(r.eigenvalues.real[~basis_modes(r.eigenvalues, radius)].max(
-        initial=-np.inf)) for r in anchors.values())
     if n < 3:
+        outside = max(float(r.eigenvalues.real[~basis_modes(r.eigenvalues, radius)].max(
+            initial=-np.inf)) for r in anchors.values())
         line = dense_line(model, s0_values, v, N0, b_M, s0_limit_xtol)
         return LineResult(**{**line.__dict__, "outside_max_real_part": outside,
                              "method": "reduced"})
     line_model = _LineModel(model, v, N0, b_M, list(anchors.values()), max_frequency_hz, rtol)
+    solved = {i: r.eigenvalues for i, r in anchors.items()}  # grid points solved densely
+    if middle not in anchors:
+        solved[middle] = _dense_point(model, points[middle]).eigenvalues
+        if _missing_modes(solved[middle], line_model.ritz_values(coefficients[middle]), radius):
+            anchors[middle] = _dense_point(model, points[middle], vectors=True)
+            line_model = _LineModel(model, v, N0, b_M, [anchors[i] for i in sorted(anchors)],
+                                    max_frequency_hz, rtol)
+    outside = max(float(lam.real[~basis_modes(lam, radius)].max(initial=-np.inf))
+                  for lam in solved.values())
     rows = []
     dense = np.zeros(n, dtype=bool)
     line_model.top_values = np.zeros(n, dtype=complex)  # the top eigenvalue at each point
     for i in range(n):
-        if i in anchors:
-            values = anchors[i].eigenvalues
+        if i in solved:
+            values = solved[i]
             rows.append(spectrum_summary(values))
             dense[i] = True
         else:
