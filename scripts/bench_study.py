@@ -203,7 +203,7 @@ def main() -> None:
         print(f"  outside-basis eigenvalues at the anchors <= "
               f"{float(serial['outside_max_real_part'].max()):.3f} 1/s")
     print(f"  the same lines timed in this run: s0_line {t_line:.2f} s, dense_line {t_dense:.2f} s "
-          f"-> a line costs {t_line / t_dense:.3f} of the dense line (both with s0* by Brent)")
+          f"-> a line costs {t_line / t_dense:.3f} of the dense line (both with s0*)")
 
     sobol = args.sobol_samples * (args.sobol_parameters + 2)
     print(f"\nprojection T(W) = tasks x (t_task + overhead) / W (t_task measured here, one core "
