@@ -224,6 +224,35 @@ def _line_limit(model, line_model, s0_values, growth, v, N0, b_M, xtol) -> float
             model, OperatingPoint(s, v, N0, b_M)).max_real_part, xtol)
 
 
+def _newton_without_rigid(M, C, K, R, lam: complex, x: np.ndarray, rtol: float,
+                          iterations: int = 6):
+    """Newton's method (nonlinear inverse iteration, as :func:`model.locus._newton`) for a
+    non-rigid eigenpair of ``(λ² M + λ C + K) x = 0`` near 0: with ``K R = 0`` (R: the rigid-body
+    modes, orthonormal or not) the rows Rᵀ of the equation are λ Rᵀ(λ M + C) x, so they are
+    divided by λ: S(λ) = [Rᵀ(λ M + C); Zᵀ(λ² M + λ C + K)] (Z: the orthogonal complement of R)
+    has the non-rigid eigenpairs of the problem and no rigid zeros, which spoil the iteration for
+    the real eigenvalue crossing 0 at s0*.  Returns (λ, unit x, last step relative to
+    max(|λ|, 1 1/s))."""
+    n_rigid = R.shape[1]
+    Q = np.linalg.qr(R, mode="complete")[0]
+    Rt, Zt = Q[:, :n_rigid].T, Q[:, n_rigid:].T
+    RM, RC, ZM, ZC, ZK = Rt @ M, Rt @ C, Zt @ M, Zt @ C, Zt @ K
+    v = x.conj()
+    x = x / (v @ x)
+    step = np.inf
+    for _ in range(iterations):
+        S = np.vstack([lam * RM + RC, lam * lam * ZM + lam * ZC + ZK])
+        derivative = np.vstack([RM, 2 * lam * ZM + ZC])
+        u = sla.lu_solve(sla.lu_factor(S, check_finite=False), derivative @ x, check_finite=False)
+        correction = (v @ x) / (v @ u)
+        lam = lam - correction
+        x = u / (v @ u)
+        step = abs(correction) / max(abs(lam), 1.0)
+        if step < 0.01 * rtol:
+            break
+    return lam, x / np.linalg.norm(x), step
+
+
 def _missing_modes(eigenvalues: np.ndarray, ritz: np.ndarray, radius: float) -> bool:
     """Whether an eigenvalue that the selection takes (:func:`basis_modes`, ``radius`` [1/s]) has
     no Ritz value within ``MATCH``·max(|λ|, 1 1/s): the basis misses that mode."""
@@ -365,8 +394,13 @@ class _LineModel:
                 # converged to rtol·max(|λ|, 1 1/s), the accuracy asked of every decisive
                 # value (relative to |λ| alone, a real eigenvalue crossing 0 near s0* never
                 # converges and sent the point to a full eigen-analysis)
-                value, _, step = _newton(self.model.M, C_full, self.model.K, lam[b],
-                                         red.Phi @ vectors[:, b], self.rtol, floor=1.0)
+                if abs(lam[b]) < 1.0:  # near the rigid zeros: their rows divided by λ
+                    value, _, step = _newton_without_rigid(
+                        self.model.M, C_full, self.model.K, self.model.rigid_body_modes, lam[b],
+                        red.Phi @ vectors[:, b], self.rtol)
+                else:
+                    value, _, step = _newton(self.model.M, C_full, self.model.K, lam[b],
+                                             red.Phi @ vectors[:, b], self.rtol, floor=1.0)
                 if not step <= self.rtol:
                     return self._result(_dense_point(self.model, op).eigenvalues, True)
                 lam[b] = value

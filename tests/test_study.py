@@ -320,3 +320,28 @@ def test_line_limit_few_evaluations(setup, monkeypatch):
     assert len(calls) - grid_calls <= 8
     reference = dense_line(model, s0, v, N0, b_M)
     assert abs(line.s0_limit - reference.s0_limit) <= LIMIT_ATOL
+
+
+def test_point_at_the_crossing_needs_no_full_analysis(setup):
+    """At s0* the crossing eigenvalue is real and ≈ 0, next to the rigid-body zeros: its Newton
+    refinement divides the rigid rows by λ and converges; the point is not sent to a full
+    eigen-analysis, and its largest real part is the dense one within rtol = 1e-6 1/s."""
+    from model.eigen import eigen_analysis
+    from model.locus import _coefficients
+    from model.operating_point import OperatingPoint
+    from model.study import _dense_point, _LineModel
+
+    parameters, model = setup
+    v, N0, b_M = 250 * KMH, parameters["wheel_force"], parameters["motor_slope"]
+    reference = dense_line(model, np.linspace(0.001, 0.02, 17), v, N0, b_M)
+    s0_limit = reference.s0_limit
+    ends = [_dense_point(model, OperatingPoint(s, v, N0, b_M), vectors=True)
+            for s in (0.001, 0.02)]
+    line_model = _LineModel(model, v, N0, b_M, ends, 10.0, 1e-6)
+    for s in (s0_limit - 2e-7, s0_limit + 2e-7):
+        op = OperatingPoint(s, v, N0, b_M)
+        (growth, _, _), dense = line_model.point(s, _coefficients(model, op))
+        assert not dense
+        dense_growth = eigen_analysis(model, op, vectors=False).max_real_part
+        assert abs(growth) < 1e-2  # the crossing eigenvalue: ≈ 0
+        assert abs(growth - dense_growth) <= 1e-6
