@@ -309,9 +309,11 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     return RootLocus(parameter, values, eigenvalues, errors, dense, op, reduced.size, refined)
 
 
-def _newton(M, C, K, lam: complex, x: np.ndarray, rtol: float, iterations: int = 6):
+def _newton(M, C, K, lam: complex, x: np.ndarray, rtol: float, iterations: int = 6,
+            floor: float = 1e-300):
     """Newton's method (nonlinear inverse iteration) for ``(λ² M + λ C + K) x = 0`` from a close
-    start; returns (λ, unit x, relative size of the last step)."""
+    start; returns (λ, unit x, size of the last step relative to max(|λ|, ``floor``) [floor in
+    1/s]; the default measures it relative to |λ|)."""
     v = x.conj()
     x = x / (v @ x)
     step = np.inf
@@ -322,7 +324,7 @@ def _newton(M, C, K, lam: complex, x: np.ndarray, rtol: float, iterations: int =
         correction = (v @ x) / (v @ u)
         lam = lam - correction
         x = u / (v @ u)
-        step = abs(correction) / max(abs(lam), 1e-300)
+        step = abs(correction) / max(abs(lam), floor)
         if step < 0.01 * rtol:
             break
     return lam, x / np.linalg.norm(x), step

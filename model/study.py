@@ -16,10 +16,14 @@ the same continuation.  Against a full eigen-analysis at every point of 100-poin
 
 The first method of issue 13, :func:`reduced_s0_line` (method "reduced", the default: it is
 cheaper, see BENCHMARKS.md), reuses one Galerkin-reduced model (:class:`model.locus._Reduced`,
-the root locus's projection on exact eigenvectors at a few *anchor* creepages) and costs two or
-three dense eigen-analyses plus one small eigenproblem per point.  The anchors are both ends
-and the grid creepage of the most negative b11 (the steepest falling creep slope, the most
-destabilizing point), when it lies inside the line.  Its properties:
+the root locus's projection on exact eigenvectors at a few *anchor* creepages) and costs two
+dense eigen-analyses with vectors (the anchors: both ends), one without at the grid creepage of
+the most negative b11 (the steepest falling creep slope, the most destabilizing point) when it
+lies inside the line, and one small eigenproblem per point (2r − 2 unknowns: the rigid-body
+zeros of the reduced model are deflated once per line).  The dense eigenvalues at that creepage
+check the basis: every eigenvalue there that the selection below would take must have a Ritz
+value within 10⁻⁴·max(|λ|, 1 1/s); if one has none, its eigenvectors join the basis (a third
+anchor; before the fourth session it always was one).  Its properties:
 
 What a point reports is a property of **all** eigenvalues, not only of tracked branches:
 
@@ -34,8 +38,9 @@ What a point reports is a property of **all** eigenvalues, not only of tracked b
   first-order error from the full-model residual (as in the root locus) must be below
   ``rtol``·max(|λ|, 1 1/s), else it is refined by Newton's method on the full model; if more than
   a few need it, the point is solved densely (exact).
-* The eigenvalues outside the basis are damped by more than 5 1/s at every anchor (by the
-  selection); each line records their largest real part there (``outside_max_real_part``).
+* The eigenvalues outside the basis are damped by more than 5 1/s at every anchor and at the
+  checked creepage (by the selection and the check); each line records their largest real part
+  there (``outside_max_real_part``).
   That they stay below the top in between is an **assumption**, not a theorem: a real part is
   not monotone in b11 (modes interact).  With a margin of 2 1/s instead of 5 it failed (at
   40 km/h modes damped by 2–5 1/s at the anchors turn unstable between s0 = 0.0137 and 0.0144,
@@ -62,6 +67,7 @@ from scipy.optimize import brentq
 from .assembly import BogieModel, build_model
 from .continuation import LineContinuation
 from .eigen import eigen_analysis
+from .linear_system import Deflation
 from .locus import _coefficients, _newton, _Reduced, creep_patterns
 from .operating_point import OperatingPoint, damping_matrix
 from .parameters import Parameters, parameter_hash
@@ -75,6 +81,7 @@ BASIS_CUTOFF = 1e-12  # singular values of the basis vectors below this (relativ
 # off by 2 against the dense reference: measured), so the root locus's cut-off is kept
 SPURIOUS = 1e-3  # relative error estimate above which a Ritz value outside the disc is dropped
 MAX_NEWTON = 4  # more Ritz values failing the tolerance at a point: solve the point densely
+MATCH = 1e-4  # a Ritz value this close (relative) to an eigenvalue represents it in the basis check
 IMAG_TOL = 1e-9  # |Im λ| ≤ IMAG_TOL·|λ|: a real eigenvalue
 
 
@@ -112,7 +119,8 @@ class LineResult:
     s0_limit: float  # smallest s0* in [s0[0], s0[-1]] where the bogie turns unstable [-]; nan: none
     dense_points: np.ndarray  # (n,) bool: solved by a full eigen-analysis
     newton_refinements: int  # Ritz values refined by Newton's method on the full model
-    outside_max_real_part: float  # largest Re outside the basis at the anchors [1/s]
+    outside_max_real_part: float  # largest Re outside the basis at the anchors and the
+    # checked creepage [1/s]
     basis_size: int  # columns of the reduction basis (0: dense or continuation)
     fallbacks: int = 0  # continuation: points where its checks failed (solved densely there)
     method: str = "dense"  # "continuation", "reduced" or "dense"
@@ -159,14 +167,100 @@ def _limit_on_grid(s0_values, growth, function, xtol: float) -> float:
     return float(brentq(function, s0_values[i - 1], s0_values[i], xtol=xtol, rtol=1e-12))
 
 
+def _reduced_limit(line_model, s0_values, growth, xtol: float, evaluations: int = 8) -> float:
+    """s0* on the reduced evaluation g(s) (its largest real part) between the first two grid
+    points where ``growth`` turns from ≤ 0 to > 0, to the same tolerance as Brent's method: a
+    bracket [lo, hi] with g(lo) ≤ 0 < g(hi) no wider than ``xtol``, and the secant root inside.
+
+    g is the maximum over branches: below s0* its top is often another, nearly flat branch, so
+    Brent's method from the grid bracket took 9–12 evaluations.  Here the secant steps follow
+    the real part of the crossing branch: the top eigenvalue at the grid point above the
+    crossing, extrapolated linearly (slope from the next grid point, then from the last two
+    evaluations), and at each evaluation the eigenvalue nearest to the extrapolation.  Each step
+    stays inside the bracket (regula falsi on g where the branch's secant leaves it) and is at
+    least xtol/4 long, so that the bracket closes once the iterate has converged: 3–8
+    evaluations measured.  Brent's method on the remaining bracket after ``evaluations``."""
+    unstable = np.flatnonzero(growth > 0)
+    if len(unstable) == 0 or unstable[0] == 0:
+        return float("nan")
+    i = unstable[0]
+    lo, g_lo, hi, g_hi = s0_values[i - 1], growth[i - 1], s0_values[i], growth[i]
+    top = line_model.top_values
+    known = (s0_values[i], top[i])  # a point of the crossing branch: (s0, eigenvalue)
+    slope = 0.0  # d(eigenvalue)/ds0 of the branch, from the top at the next grid point if any
+    if i + 1 < len(s0_values):
+        slope = (top[i + 1] - top[i]) / (s0_values[i + 1] - s0_values[i])
+    x = known[0] - known[1].real / slope.real if slope.real > 0 else np.nan
+    if not lo < x < hi:
+        x = lo - g_lo * (hi - lo) / (g_hi - g_lo)  # regula falsi on the grid bracket
+    for _ in range(evaluations):
+        gx = line_model.point(x)[0][0]
+        values = line_model.values
+        branch = values[np.argmin(np.abs(values - (known[1] + slope * (x - known[0]))))]
+        if x != known[0]:
+            slope, known = (branch - known[1]) / (x - known[0]), (x, branch)
+        if gx > 0:
+            hi, g_hi = x, gx
+        else:
+            lo, g_lo = x, gx
+        if hi - lo <= xtol:
+            return float(lo - g_lo * (hi - lo) / (g_hi - g_lo))
+        following = x - branch.real / slope.real if slope.real != 0 else np.nan
+        if not lo < following < hi:
+            following = lo - g_lo * (hi - lo) / (g_hi - g_lo)  # regula falsi: inside
+        if abs(following - x) < 0.25 * xtol:  # toward the crossing: x is an end of the bracket
+            following = x + 0.25 * xtol if gx <= 0 else x - 0.25 * xtol
+        x = float(np.clip(following, lo + 0.1 * xtol, hi - 0.1 * xtol))
+    return float(brentq(lambda s: line_model.point(s)[0][0], lo, hi, xtol=xtol, rtol=1e-12))
+
+
 def _line_limit(model, line_model, s0_values, growth, v, N0, b_M, xtol) -> float:
-    """s0* on the reduced evaluation; the dense one if the reduced evaluation at the bracket's
-    ends (solved densely on the grid) does not change sign."""
+    """s0* on the reduced evaluation (:func:`_reduced_limit`); the dense one if the reduced
+    evaluation does not change sign where the grid did."""
     try:
-        return _limit_on_grid(s0_values, growth, lambda s: line_model.point(s)[0][0], xtol)
+        return _reduced_limit(line_model, s0_values, growth, xtol)
     except ValueError:
         return _limit_on_grid(s0_values, growth, lambda s: _dense_point(
             model, OperatingPoint(s, v, N0, b_M)).max_real_part, xtol)
+
+
+def _newton_without_rigid(M, C, K, R, lam: complex, x: np.ndarray, rtol: float,
+                          iterations: int = 6):
+    """Newton's method (nonlinear inverse iteration, as :func:`model.locus._newton`) for a
+    non-rigid eigenpair of ``(λ² M + λ C + K) x = 0`` near 0: with ``K R = 0`` (R: the rigid-body
+    modes, orthonormal or not) the rows Rᵀ of the equation are λ Rᵀ(λ M + C) x, so they are
+    divided by λ: S(λ) = [Rᵀ(λ M + C); Zᵀ(λ² M + λ C + K)] (Z: the orthogonal complement of R)
+    has the non-rigid eigenpairs of the problem and no rigid zeros, which spoil the iteration for
+    the real eigenvalue crossing 0 at s0*.  Returns (λ, unit x, last step relative to
+    max(|λ|, 1 1/s))."""
+    n_rigid = R.shape[1]
+    Q = np.linalg.qr(R, mode="complete")[0]
+    Rt, Zt = Q[:, :n_rigid].T, Q[:, n_rigid:].T
+    RM, RC, ZM, ZC, ZK = Rt @ M, Rt @ C, Zt @ M, Zt @ C, Zt @ K
+    v = x.conj()
+    x = x / (v @ x)
+    step = np.inf
+    for _ in range(iterations):
+        S = np.vstack([lam * RM + RC, lam * lam * ZM + lam * ZC + ZK])
+        derivative = np.vstack([RM, 2 * lam * ZM + ZC])
+        u = sla.lu_solve(sla.lu_factor(S, check_finite=False), derivative @ x, check_finite=False)
+        correction = (v @ x) / (v @ u)
+        lam = lam - correction
+        x = u / (v @ u)
+        step = abs(correction) / max(abs(lam), 1.0)
+        if step < 0.01 * rtol:
+            break
+    return lam, x / np.linalg.norm(x), step
+
+
+def _missing_modes(eigenvalues: np.ndarray, ritz: np.ndarray, radius: float) -> bool:
+    """Whether an eigenvalue that the selection takes (:func:`basis_modes`, ``radius`` [1/s]) has
+    no Ritz value within ``MATCH``·max(|λ|, 1 1/s): the basis misses that mode."""
+    wanted = eigenvalues[basis_modes(eigenvalues, radius)]
+    if len(wanted) == 0:
+        return False
+    distance = np.abs(wanted[:, None] - ritz[None, :]).min(axis=1, initial=np.inf)
+    return bool(np.any(distance > MATCH * np.maximum(np.abs(wanted), 1.0)))
 
 
 class _LineModel:
@@ -190,37 +284,72 @@ class _LineModel:
         basis = U[:, sigma > BASIS_CUTOFF * sigma[0]]
         self.reduced = _Reduced(model, anchors[0].operating_point, patterns, [basis])
         self.newton = 0
-        self.n_rigid = model.rigid_body_modes.shape[1]
-        r = self.reduced.size
-        self._A = np.zeros((2 * r, 2 * r))  # first-order reduced matrix; damping block per point
-        self._A[:r, r:] = np.eye(r)
-        self._A[r:, :r] = -self.reduced.K_r
+        red, r = self.reduced, self.reduced.size
+        # The first-order reduced matrix [[0, I], [−K_r, −C]] is affine in the creep
+        # coefficients c: C = C0_r + Σ c_k P_k,r.  The basis holds the rigid-body modes, whose
+        # reduced coordinates y_R = Lᵀ Φᵀ R give the exact eigenpairs (0, [y_R; 0]) of the reduced
+        # model (K_r y_R = 0) whatever C: that invariant subspace is deflated once per line as in
+        # the full model (model.linear_system.Deflation), and each point solves the eigenvalues of
+        # the rest, A22(c) = base + Σ c_k D_k (2r − n_rigid unknowns), only.
+        rigid = sla.solve_triangular(red.Linv.T, red.Phi.T @ model.rigid_body_modes,
+                                     lower=False, check_finite=False)
+        deflation = Deflation(np.vstack([rigid, np.zeros_like(rigid)]))
+        n_rigid = rigid.shape[1]
+
+        def first_order(K, C):
+            A = np.zeros((2 * r, 2 * r))
+            A[:r, r:] = np.eye(r) if K is not None else 0.0
+            if K is not None:
+                A[r:, :r] = -K
+            A[r:, r:] = -C
+            return deflation.project(A)[n_rigid:, n_rigid:]
+
+        self._base = first_order(red.K_r, red.C0_r)
+        self._parts = [first_order(None, P) for P in red.P_r]
         self._start = np.random.default_rng(0).standard_normal(r)  # inverse iteration start
-        self._eye = np.eye(r)
+        self.values = np.zeros(0, dtype=complex)  # the last point's eigenvalues [1/s]
+        self.top_values = np.zeros(0, dtype=complex)  # the top eigenvalue at each grid point
+        # [1/s] (set by reduced_s0_line; the s0* search follows the crossing branch from it)
 
     def _ritz_vectors(self, lam: np.ndarray, C: np.ndarray) -> np.ndarray:
         """Unit displacement vectors (Φ coordinates) of Ritz values ``lam`` of the reduced
         quadratic problem ``(λ² I + λ C + K_r) y = 0`` by one step of inverse iteration each."""
-        red = self.reduced
-        shift = lam * (1 + 1e-13)  # never an exactly singular matrix
-        T = ((shift * shift)[:, None, None] * self._eye + shift[:, None, None] * C
-             + red.K_r)
-        X = np.linalg.solve(T, np.broadcast_to(self._start, (len(lam), len(self._start)))[..., None])
-        X = X[..., 0].T
+        red, r = self.reduced, self.reduced.size
+        X = np.zeros((r, len(lam)), dtype=complex)
+        real = lam.imag == 0  # real Ritz values: real arithmetic (a quarter of the work)
+        for group, values in ((real, lam.real[real]), (~real, lam[~real])):
+            if len(values) == 0:
+                continue
+            shift = values * (1 + 1e-13)  # never an exactly singular matrix
+            T = np.multiply.outer(shift, C)
+            T += red.K_r
+            T.reshape(len(shift), -1)[:, ::r + 1] += (shift * shift)[:, None]
+            start = np.broadcast_to(self._start, (len(shift), r))[..., None]
+            X[:, group] = np.linalg.solve(T, start)[..., 0].T
         X = red.Linv.T @ X
         return X / np.linalg.norm(X, axis=0)
 
-    def point(self, s0: float) -> tuple[tuple[float, int, int], bool]:
-        """(summary, solved densely) at creepage s0."""
+    def ritz_values(self, c: np.ndarray) -> np.ndarray:
+        """All non-rigid Ritz values [1/s] at creep coefficients ``c`` (eigenvalues only; the
+        rigid zeros are deflated)."""
+        A22 = self._base.copy()
+        for ck, D in zip(c, self._parts, strict=True):
+            A22 += ck * D
+        return sla.eigvals(A22, overwrite_a=True, check_finite=False)
+
+    def _result(self, values: np.ndarray, dense: bool) -> tuple[tuple[float, int, int], bool]:
+        self.values = values  # the last point's eigenvalues (refined Ritz values or dense)
+        return spectrum_summary(values), dense
+
+    def point(self, s0: float, c: np.ndarray | None = None) -> tuple[tuple[float, int, int], bool]:
+        """(summary, solved densely) at creepage s0; ``c``: its creep coefficients (b11, b22,
+        b23, b33) if already known."""
         op = OperatingPoint(float(s0), self.v, self.N0, self.b_M)
-        c = _coefficients(self.model, op)
-        red, r = self.reduced, self.reduced.size
+        if c is None:
+            c = _coefficients(self.model, op)
+        red = self.reduced
         C = red.C0_r + sum(ck * Pk for ck, Pk in zip(c, red.P_r, strict=True))
-        self._A[r:, r:] = -C
-        lam = sla.eigvals(self._A, check_finite=False)  # eigenvalues only: no vectors
-        # the basis holds the rigid-body modes: their exact zeros (K r = 0) are the n_rigid
-        # Ritz values closest to 0 (a spin eigenvalue closer to 0 than them is 0 too)
-        lam = lam[np.argsort(np.abs(lam), kind="stable")[self.n_rigid:]]
+        lam = self.ritz_values(c)
         lam = lam[lam.imag >= -IMAG_TOL * np.abs(lam)]  # one of each pair, and the reals
         # Only Ritz values with Re λ ≥ min(top, 0) − BAND can decide the summary; their vectors
         # and first-order errors (from the full residual) are computed.  Beyond the controlled
@@ -229,7 +358,7 @@ class _LineModel:
         # anchors (outside_max_real_part).
         checked = np.zeros(len(lam), dtype=bool)
         error = np.full(len(lam), np.inf)
-        vectors = np.zeros((r, len(lam)), dtype=complex)  # of the checked Ritz values
+        vectors = np.zeros((red.size, len(lam)), dtype=complex)  # of the checked Ritz values
         while True:
             candidates = np.flatnonzero(~checked & (lam.real >= min(lam.real.max(), 0.0) - BAND))
             if len(candidates) == 0:
@@ -237,7 +366,7 @@ class _LineModel:
             try:
                 X = self._ritz_vectors(lam[candidates], C)
             except np.linalg.LinAlgError:  # a Ritz value exact to the last bit: no inverse step
-                return spectrum_summary(_dense_point(self.model, op).eigenvalues), True
+                return self._result(_dense_point(self.model, op).eigenvalues, True)
             relative = red.error_estimate(c, lam[candidates], X)
             checked[candidates] = True
             error[candidates] = relative * np.abs(lam[candidates])
@@ -257,18 +386,26 @@ class _LineModel:
         needs &= checked & (error > self.rtol * np.maximum(np.abs(lam), 1.0))
         failing = np.flatnonzero(needs)
         if len(failing) > MAX_NEWTON:
-            return spectrum_summary(_dense_point(self.model, op).eigenvalues), True
+            return self._result(_dense_point(self.model, op).eigenvalues, True)
         if len(failing):
             C_full = damping_matrix(self.model, op)
             lam = lam.copy()
             for b in failing:
-                value, _, step = _newton(self.model.M, C_full, self.model.K, lam[b],
-                                         red.Phi @ vectors[:, b], self.rtol)
+                # converged to rtol·max(|λ|, 1 1/s), the accuracy asked of every decisive
+                # value (relative to |λ| alone, a real eigenvalue crossing 0 near s0* never
+                # converges and sent the point to a full eigen-analysis)
+                if abs(lam[b]) < 1.0:  # near the rigid zeros: their rows divided by λ
+                    value, _, step = _newton_without_rigid(
+                        self.model.M, C_full, self.model.K, self.model.rigid_body_modes, lam[b],
+                        red.Phi @ vectors[:, b], self.rtol)
+                else:
+                    value, _, step = _newton(self.model.M, C_full, self.model.K, lam[b],
+                                             red.Phi @ vectors[:, b], self.rtol, floor=1.0)
                 if not step <= self.rtol:
-                    return spectrum_summary(_dense_point(self.model, op).eigenvalues), True
+                    return self._result(_dense_point(self.model, op).eigenvalues, True)
                 lam[b] = value
             self.newton += len(failing)
-        return spectrum_summary(np.concatenate([lam, lam[lam.imag > 0].conj()])), False
+        return self._result(np.concatenate([lam, lam[lam.imag > 0].conj()]), False)
 
 
 def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
@@ -323,7 +460,8 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     """The Galerkin-reduced line (issue 13's first method, ``s0_line``'s default): largest
     real part, flutter pairs and divergent reals at every creepage of ``s0_values``
     (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
-    [N m s/rad]; and s0* inside the line's range by Brent's method on the same evaluation.
+    [N m s/rad]; and s0* inside the line's range on the same evaluation (secant steps in a
+    closing bracket, :func:`_reduced_limit`; Brent's method if they do not close it).
 
     ``max_frequency_hz``: the reduction basis holds the exact eigenvectors with |λ| < 2π·f (and
     those with Re λ > −5 1/s) at the anchors (see the module docstring for what is assumed of
@@ -332,28 +470,45 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     s0_values = _check_s0(s0_values)
     n = len(s0_values)
     points = [OperatingPoint(float(s), v, N0, b_M) for s in s0_values]
-    # anchors (solved densely, their eigenvectors span the basis): both ends and the creepage of
-    # the most negative b11 (the steepest falling creep slope: the most destabilizing point)
-    b11 = np.array([_coefficients(model, op)[0] for op in points])
-    anchor_index = sorted({0, int(np.argmin(b11)), n - 1})
-    anchors = {i: _dense_point(model, points[i], vectors=True) for i in anchor_index}
+    # anchors (solved densely, their eigenvectors span the basis): both ends.  The grid creepage
+    # of the most negative b11 (the steepest falling creep slope, the most destabilizing point) is
+    # solved densely too (eigenvalues only) and checks the basis: every eigenvalue there that the
+    # selection would take (basis_modes) must have a Ritz value of the reduced model next to it;
+    # if one has none, that point's eigenvectors join the basis (a third anchor, as before)
+    coefficients = [_coefficients(model, op) for op in points]
+    b11 = np.array([c[0] for c in coefficients])
+    middle = int(np.argmin(b11))
+    anchors = {i: _dense_point(model, points[i], vectors=True) for i in sorted({0, n - 1})}
     radius = 2 * np.pi * max_frequency_hz
-    outside = max(float(r.eigenvalues.real[~basis_modes(r.eigenvalues, radius)].max(
-        initial=-np.inf)) for r in anchors.values())
     if n < 3:
+        outside = max(float(r.eigenvalues.real[~basis_modes(r.eigenvalues, radius)].max(
+            initial=-np.inf)) for r in anchors.values())
         line = dense_line(model, s0_values, v, N0, b_M, s0_limit_xtol)
         return LineResult(**{**line.__dict__, "outside_max_real_part": outside,
                              "method": "reduced"})
     line_model = _LineModel(model, v, N0, b_M, list(anchors.values()), max_frequency_hz, rtol)
+    solved = {i: r.eigenvalues for i, r in anchors.items()}  # grid points solved densely
+    if middle not in anchors:
+        solved[middle] = _dense_point(model, points[middle]).eigenvalues
+        if _missing_modes(solved[middle], line_model.ritz_values(coefficients[middle]), radius):
+            anchors[middle] = _dense_point(model, points[middle], vectors=True)
+            line_model = _LineModel(model, v, N0, b_M, [anchors[i] for i in sorted(anchors)],
+                                    max_frequency_hz, rtol)
+    outside = max(float(lam.real[~basis_modes(lam, radius)].max(initial=-np.inf))
+                  for lam in solved.values())
     rows = []
     dense = np.zeros(n, dtype=bool)
+    line_model.top_values = np.zeros(n, dtype=complex)  # the top eigenvalue at each point
     for i in range(n):
-        if i in anchors:
-            rows.append(spectrum_summary(anchors[i].eigenvalues))
+        if i in solved:
+            values = solved[i]
+            rows.append(spectrum_summary(values))
             dense[i] = True
         else:
-            summary, dense[i] = line_model.point(s0_values[i])
+            summary, dense[i] = line_model.point(s0_values[i], coefficients[i])
             rows.append(summary)
+            values = line_model.values
+        line_model.top_values[i] = values[np.argmax(values.real)]
     growth = np.array([r[0] for r in rows])
     limit = _line_limit(model, line_model, s0_values, growth, v, N0, b_M, s0_limit_xtol)
     return LineResult(s0_values, v, N0, b_M, growth, np.array([r[1] for r in rows]),

@@ -10,7 +10,9 @@ N0 and b_M of the set.  In the same run:
 
 1. one eigen-analysis (``eigen_analysis``, eigenvalues only and with vectors; best of 5), the
    reference of the cost per map point (issue target: a map point ≤ 1/5 of it);
-2. the map serially in this process (one BLAS thread): wall time, cost per point;
+2. the map serially in this process (one BLAS thread): wall time, cost per point, also against
+   the reference interleaved with the map (one eigenvalues-only analysis after each line, wall
+   and CPU time: on a shared machine the least disturbed ratio);
 3. the same map on the default local cluster (as many single-thread worker processes as cores;
    or ``--scheduler``): wall time without the cluster's start (reported apart), parallel
    efficiency = serial time / (workers × cluster time) (target ≥ 80 %); results checked
@@ -94,10 +96,25 @@ def main() -> None:
         t_values = best_of(5, lambda: eigen_analysis(model, op, vectors=False), cold)
         t_vectors = best_of(5, lambda: eigen_analysis(model, op), cold)
         t_limit = best_of(2, lambda: stability_limit(model, 120 * KMH, N0, b_M, xtol=1e-7), cold)
+        # the reference interleaved with the map: one cold eigenvalues-only analysis after each
+        # line (wall and CPU time), so that map and reference see the same load; excluded from
+        # the map's time
+        reference_wall, reference_cpu = [], []
+
+        def serial_with_reference(function, items):
+            for index, result in serial_map_unordered(function, items):
+                cold()
+                wall, cpu = time.perf_counter(), time.process_time()
+                eigen_analysis(model, op, vectors=False)
+                reference_cpu.append(time.process_time() - cpu)
+                reference_wall.append(time.perf_counter() - wall)
+                yield index, result
+
         with tempfile.TemporaryDirectory() as folder:
-            start = time.perf_counter()
-            run_into_store(study, parameters, Path(folder) / "serial.zarr", serial_map_unordered)
-            t_serial = time.perf_counter() - start
+            start, start_cpu = time.perf_counter(), time.process_time()
+            run_into_store(study, parameters, Path(folder) / "serial.zarr", serial_with_reference)
+            t_serial = time.perf_counter() - start - sum(reference_wall)
+            cpu_serial = time.process_time() - start_cpu - sum(reference_cpu)
             serial = open_study(Path(folder) / "serial.zarr")
 
     t_chunk = t_serial / len(study.chunks())
@@ -109,6 +126,12 @@ def main() -> None:
     print(f"serial map: {t_serial:.2f} s, {t_chunk * 1e3:.0f} ms per s0-line, "
           f"{per_point * 1e3:.2f} ms per point = {per_point / t_values:.3f} of an eigen-analysis "
           f"(eigenvalues only), {per_point / t_vectors:.3f} (with vectors); target <= 0.2")
+    print(f"  against the reference interleaved with the map (one eigenvalues-only analysis after "
+          f"each line, median of {len(reference_wall)}: {np.median(reference_wall) * 1e3:.1f} ms "
+          f"wall, {np.median(reference_cpu) * 1e3:.1f} ms CPU): a point costs "
+          f"{per_point / np.median(reference_wall):.3f} (wall), "
+          f"{cpu_serial / points / np.median(reference_cpu):.3f} (CPU time of this process, "
+          f"the measure least disturbed by other processes)")
 
     start = time.perf_counter()
     engine = StudyEngine(args.scheduler, args.workers, connect_timeout=30)
@@ -180,7 +203,7 @@ def main() -> None:
         print(f"  outside-basis eigenvalues at the anchors <= "
               f"{float(serial['outside_max_real_part'].max()):.3f} 1/s")
     print(f"  the same lines timed in this run: s0_line {t_line:.2f} s, dense_line {t_dense:.2f} s "
-          f"-> a line costs {t_line / t_dense:.3f} of the dense line (both with s0* by Brent)")
+          f"-> a line costs {t_line / t_dense:.3f} of the dense line (both with s0*)")
 
     sobol = args.sobol_samples * (args.sobol_parameters + 2)
     print(f"\nprojection T(W) = tasks x (t_task + overhead) / W (t_task measured here, one core "

@@ -269,3 +269,79 @@ def test_in_order_yields_in_item_order_as_soon_as_possible():
         out.append((value, len(seen)))
     # 0 is ready after two finished tasks, 1 and 2 after three, 3 and 4 after five
     assert out == [(0, 2), (10, 3), (20, 3), (30, 5), (40, 5)]
+
+
+def test_basis_check_at_the_most_destabilizing_point(setup):
+    """The reduced line's basis comes from the two ends; at the creepage of the most negative
+    b11 the dense eigenvalues check it: with both ends every eigenvalue the selection takes there
+    has a Ritz value next to it, with the first end alone (the ≈ 50 Hz rim modes are damped by
+    more than 5 1/s there and not in the basis) some have none and the check fails."""
+    from model.locus import _coefficients
+    from model.operating_point import OperatingPoint
+    from model.study import _dense_point, _LineModel, _missing_modes
+
+    parameters, model = setup
+    v, N0, b_M = 120 * KMH, parameters["wheel_force"], parameters["motor_slope"]
+    s0 = np.linspace(0.001, 0.02, 100)
+    points = [OperatingPoint(float(s), v, N0, b_M) for s in s0]
+    b11 = [_coefficients(model, op)[0] for op in points]
+    middle = int(np.argmin(b11))
+    assert 0 < middle < len(s0) - 1
+    c = _coefficients(model, points[middle])
+    eigenvalues = _dense_point(model, points[middle]).eigenvalues
+    radius = 2 * np.pi * 10.0
+    ends = [_dense_point(model, points[i], vectors=True) for i in (0, len(s0) - 1)]
+    both = _LineModel(model, v, N0, b_M, ends, 10.0, 1e-6)
+    first = _LineModel(model, v, N0, b_M, ends[:1], 10.0, 1e-6)
+    assert not _missing_modes(eigenvalues, both.ritz_values(c), radius)
+    assert _missing_modes(eigenvalues, first.ritz_values(c), radius)
+
+
+def test_line_limit_few_evaluations(setup, monkeypatch):
+    """s0* of a reduced line takes at most 8 reduced evaluations (secant steps on the crossing
+    branch, bracket closed within xtol; Brent's method from the grid bracket took 9-12) and
+    agrees with the dense line's Brent search within both tolerances."""
+    from model import study
+
+    parameters, model = setup
+    calls = []
+    point = study._LineModel.point
+
+    def counted(self, s0, c=None):
+        calls.append(s0)
+        return point(self, s0, c)
+
+    s0 = np.linspace(0.001, 0.02, 40)
+    v, N0, b_M = 250 * KMH, parameters["wheel_force"], parameters["motor_slope"]
+    monkeypatch.setattr(study._LineModel, "point", counted)
+    line = s0_line(model, s0, v, N0, b_M)
+    monkeypatch.undo()
+    grid_calls = len(s0) - np.count_nonzero(line.dense_points)
+    assert len(calls) - grid_calls <= 8
+    reference = dense_line(model, s0, v, N0, b_M)
+    assert abs(line.s0_limit - reference.s0_limit) <= LIMIT_ATOL
+
+
+def test_point_at_the_crossing_needs_no_full_analysis(setup):
+    """At s0* the crossing eigenvalue is real and ≈ 0, next to the rigid-body zeros: its Newton
+    refinement divides the rigid rows by λ and converges; the point is not sent to a full
+    eigen-analysis, and its largest real part is the dense one within rtol = 1e-6 1/s."""
+    from model.eigen import eigen_analysis
+    from model.locus import _coefficients
+    from model.operating_point import OperatingPoint
+    from model.study import _dense_point, _LineModel
+
+    parameters, model = setup
+    v, N0, b_M = 250 * KMH, parameters["wheel_force"], parameters["motor_slope"]
+    reference = dense_line(model, np.linspace(0.001, 0.02, 17), v, N0, b_M)
+    s0_limit = reference.s0_limit
+    ends = [_dense_point(model, OperatingPoint(s, v, N0, b_M), vectors=True)
+            for s in (0.001, 0.02)]
+    line_model = _LineModel(model, v, N0, b_M, ends, 10.0, 1e-6)
+    for s in (s0_limit - 2e-7, s0_limit + 2e-7):
+        op = OperatingPoint(s, v, N0, b_M)
+        (growth, _, _), dense = line_model.point(s, _coefficients(model, op))
+        assert not dense
+        dense_growth = eigen_analysis(model, op, vectors=False).max_real_part
+        assert abs(growth) < 1e-2  # the crossing eigenvalue: ≈ 0
+        assert abs(growth - dense_growth) <= 1e-6
