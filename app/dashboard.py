@@ -521,17 +521,25 @@ class BogieDashboard(pn.viewable.Viewer):
                     self._post(doc, self._apply_locus, state, locus)
                     dense = loop.run_in_executor(FOLLOW_UP_POOL, self._dense_if_current, state)
                     dense.add_done_callback(partial(self._dense_done, doc, state))
-                # s0*(v) (≈ 0.7 s) is not waited for: a change arriving meanwhile starts at
-                # once; the limit is shown when ready if it still belongs to the parameters.  It
-                # yields to the dense locus (which has a target: ≤ 2 s after a speed change)
-                limit = loop.run_in_executor(SIDE_VIEW_POOL, self._limit_if_current, state)
-                limit.add_done_callback(partial(self._limit_done, doc, state))
+                    # s0*(v) after the dense locus (which has a target: ≤ 2 s after a speed
+                    # change): at a lower priority beside it, its full eigen-analyses still
+                    # took ≈ 1.3 CPU-s of the two cores while the dense sweep ran (py-spy)
+                    dense.add_done_callback(lambda _f, s=state: self._start_limit(doc, s))
+                else:
+                    self._start_limit(doc, state)
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")
             self._post(doc, self._reject, error)
         finally:
             self._busy = False
             self._post(doc, self._done)
+
+    def _start_limit(self, doc, state: State) -> None:
+        """s0*(v) (≈ 0.7 s when not cached) is not waited for: a change arriving meanwhile
+        starts at once; the limit is shown when ready if it still belongs to the parameters."""
+        limit = asyncio.get_running_loop().run_in_executor(SIDE_VIEW_POOL, self._limit_if_current,
+                                                           state)
+        limit.add_done_callback(partial(self._limit_done, doc, state))
 
     def _limit_current(self, state: State) -> bool:
         """Whether s0*(v) for ``state`` is still the one to show (same v, N0, b_M, rail)."""
