@@ -314,12 +314,21 @@ def _newton(M, C, K, lam: complex, x: np.ndarray, rtol: float, iterations: int =
     """Newton's method (nonlinear inverse iteration) for ``(λ² M + λ C + K) x = 0`` from a close
     start; returns (λ, unit x, size of the last step relative to max(|λ|, ``floor``) [floor in
     1/s]; the default measures it relative to |λ|)."""
+    return nonlinear_inverse_iteration(lambda lam: lam * lam * M + lam * C + K,
+                                       lambda lam: 2 * lam * M + C, lam, x, rtol, iterations,
+                                       floor)
+
+
+def nonlinear_inverse_iteration(matrix, derivative, lam: complex, x: np.ndarray, rtol: float,
+                                iterations: int = 6, floor: float = 1e-300):
+    """Newton's method for ``matrix(λ) x = 0`` (``derivative(λ)`` = d matrix / dλ, both square)
+    from a close start (λ [1/s], x); stops when a step is below 0.01·rtol relative to
+    max(|λ|, ``floor``).  Returns (λ, unit x, last step relative to max(|λ|, floor))."""
     v = x.conj()
     x = x / (v @ x)
     step = np.inf
     for _ in range(iterations):
-        T = lam * lam * M + lam * C + K
-        u = sla.lu_solve(sla.lu_factor(T, check_finite=False), (2 * lam * M + C) @ x,
+        u = sla.lu_solve(sla.lu_factor(matrix(lam), check_finite=False), derivative(lam) @ x,
                          check_finite=False)
         correction = (v @ x) / (v @ u)
         lam = lam - correction

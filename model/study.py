@@ -68,7 +68,13 @@ from .assembly import BogieModel, build_model
 from .continuation import LineContinuation
 from .eigen import eigen_analysis
 from .linear_system import Deflation
-from .locus import _coefficients, _newton, _Reduced, creep_patterns
+from .locus import (
+    _coefficients,
+    _newton,
+    _Reduced,
+    creep_patterns,
+    nonlinear_inverse_iteration,
+)
 from .operating_point import OperatingPoint, damping_matrix
 from .parameters import Parameters, parameter_hash
 from .stability import NoStabilityLimit, stability_limit
@@ -237,20 +243,15 @@ def _newton_without_rigid(M, C, K, R, lam: complex, x: np.ndarray, rtol: float,
     Q = np.linalg.qr(R, mode="complete")[0]
     Rt, Zt = Q[:, :n_rigid].T, Q[:, n_rigid:].T
     RM, RC, ZM, ZC, ZK = Rt @ M, Rt @ C, Zt @ M, Zt @ C, Zt @ K
-    v = x.conj()
-    x = x / (v @ x)
-    step = np.inf
-    for _ in range(iterations):
-        S = np.vstack([lam * RM + RC, lam * lam * ZM + lam * ZC + ZK])
-        derivative = np.vstack([RM, 2 * lam * ZM + ZC])
-        u = sla.lu_solve(sla.lu_factor(S, check_finite=False), derivative @ x, check_finite=False)
-        correction = (v @ x) / (v @ u)
-        lam = lam - correction
-        x = u / (v @ u)
-        step = abs(correction) / max(abs(lam), 1.0)
-        if step < 0.01 * rtol:
-            break
-    return lam, x / np.linalg.norm(x), step
+    return nonlinear_inverse_iteration(
+        lambda lam: np.vstack([lam * RM + RC, lam * lam * ZM + lam * ZC + ZK]),
+        lambda lam: np.vstack([RM, 2 * lam * ZM + ZC]), lam, x, rtol, iterations, floor=1.0)
+
+
+def _outside_max_real_part(spectra, radius: float) -> float:
+    """Largest real part [1/s] of the eigenvalues outside the basis selection
+    (:func:`basis_modes`, ``radius`` [1/s]) over the densely solved ``spectra``."""
+    return max(float(lam.real[~basis_modes(lam, radius)].max(initial=-np.inf)) for lam in spectra)
 
 
 def _missing_modes(eigenvalues: np.ndarray, ritz: np.ndarray, radius: float) -> bool:
@@ -480,22 +481,19 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     middle = int(np.argmin(b11))
     anchors = {i: _dense_point(model, points[i], vectors=True) for i in sorted({0, n - 1})}
     radius = 2 * np.pi * max_frequency_hz
-    if n < 3:
-        outside = max(float(r.eigenvalues.real[~basis_modes(r.eigenvalues, radius)].max(
-            initial=-np.inf)) for r in anchors.values())
-        line = dense_line(model, s0_values, v, N0, b_M, s0_limit_xtol)
-        return LineResult(**{**line.__dict__, "outside_max_real_part": outside,
-                             "method": "reduced"})
-    line_model = _LineModel(model, v, N0, b_M, list(anchors.values()), max_frequency_hz, rtol)
     solved = {i: r.eigenvalues for i, r in anchors.items()}  # grid points solved densely
+    if n < 3:
+        line = dense_line(model, s0_values, v, N0, b_M, s0_limit_xtol)
+        return LineResult(**{**line.__dict__, "method": "reduced",
+                             "outside_max_real_part": _outside_max_real_part(solved.values(),
+                                                                             radius)})
+    line_model = _LineModel(model, v, N0, b_M, list(anchors.values()), max_frequency_hz, rtol)
     if middle not in anchors:
         solved[middle] = _dense_point(model, points[middle]).eigenvalues
         if _missing_modes(solved[middle], line_model.ritz_values(coefficients[middle]), radius):
             anchors[middle] = _dense_point(model, points[middle], vectors=True)
             line_model = _LineModel(model, v, N0, b_M, [anchors[i] for i in sorted(anchors)],
                                     max_frequency_hz, rtol)
-    outside = max(float(lam.real[~basis_modes(lam, radius)].max(initial=-np.inf))
-                  for lam in solved.values())
     rows = []
     dense = np.zeros(n, dtype=bool)
     line_model.top_values = np.zeros(n, dtype=complex)  # the top eigenvalue at each point
@@ -512,7 +510,8 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     growth = np.array([r[0] for r in rows])
     limit = _line_limit(model, line_model, s0_values, growth, v, N0, b_M, s0_limit_xtol)
     return LineResult(s0_values, v, N0, b_M, growth, np.array([r[1] for r in rows]),
-                      np.array([r[2] for r in rows]), limit, dense, line_model.newton, outside,
+                      np.array([r[2] for r in rows]), limit, dense, line_model.newton,
+                      _outside_max_real_part(solved.values(), radius),
                       line_model.reduced.size, 0, "reduced")
 
 
