@@ -6,7 +6,10 @@ Starts ``bogie serve`` on a free port (a separate process, as users run it), the
 
 1. single session: keyboard steps on the s0 slider handle (each a new value, so no cache
    hit); latency = key press → the browser holds new eigenvalues (root-locus current point)
-   *and* new time histories (both must have changed; the status is sent with the eigenvalues);
+   *and* new time histories (both must have changed; the status is sent with the eigenvalues).
+   The steps follow each other at once (the next key press as soon as the previous result is
+   in: a held arrow key); ``--isolated`` more steps are each taken after the session is idle
+   (1 b: a reviewer moves a slider and looks);
 2. root-locus refresh: keyboard steps on the speed slider (new v → new s0*(v) and a new locus
    over s0); latency = key press → new (coarse, 25-point) locus branches in the browser, and
    key press → the dense 200-point locus has replaced it (its title no longer says
@@ -47,8 +50,16 @@ from served_app import free_port  # noqa: E402 - also used by bench_nonlinear_ap
 CHROMIUM = "/usr/bin/chromium"
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
-DATA = """(name, col) => { const d = Bokeh.documents[0].get_model_by_name(name).data;
-  const v = d instanceof Map ? d.get(col) : d[col]; return Array.from(v).slice(0, 60).join(','); }"""
+# the probe runs every 5 ms on the page's main thread while a step is measured, beside the work
+# it measures: it looks each model up once (``get_model_by_name`` searches all ≈ 440 models) and
+# copies 60 values, not the column (a JavaScript profile of four steps with the first probe,
+# which did both each time, counted ≈ 50 ms of main-thread time per step in it)
+DATA = """(name, col) => { const cache = window.__bench_models || (window.__bench_models = {});
+  let model = cache[name];
+  if (model === undefined || model.document == null) {
+    model = cache[name] = Bokeh.documents[0].get_model_by_name(name); }
+  const d = model.data; const v = d instanceof Map ? d.get(col) : d[col];
+  return Array.prototype.slice.call(v, 0, 60).join(','); }"""
 FAST = f"() => ({DATA})('locus_current', 'x') + '|' + ({DATA})('response', 'y:ID1.disc_clutch.torque')"
 SLOW = f"() => ({DATA})('locus_points', 'x')"
 LOCUS_TITLE = "() => Bokeh.documents[0].get_model_by_name('root-locus').title.text"
@@ -286,6 +297,13 @@ async def run(args) -> dict:
             await settle_n0(page, 1)
             log("single session: s0 steps, then speed steps")  # own N0 = 99 kN: nothing cached from earlier runs
             fast = [await step(page, "ctl-s0", "ArrowRight", FAST) for _ in range(args.presses)]
+            # the same steps one at a time: each after the previous one's work is done (its
+            # s0*, locus, ranges and drawing), as a reviewer moves a slider and looks
+            isolated = []
+            for _ in range(args.isolated):
+                await wait_idle(page)
+                isolated.append(await step(page, "ctl-s0", "ArrowRight", FAST))
+            results["single_isolated_s"] = isolated
             speeds = [await speed_step(page) for _ in range(args.locus_presses)]
             results["single_fast_s"] = fast
             results["locus_refresh_s"] = [coarse for coarse, _ in speeds]
@@ -377,6 +395,8 @@ async def page_among_clients(browser, url: str, args, results: dict) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--presses", type=int, default=15)
+    parser.add_argument("--isolated", type=int, default=5,
+                        help="s0 steps each after the session is idle (1 b)")
     parser.add_argument("--locus-presses", type=int, default=5)
     parser.add_argument("--sessions", type=int, default=10)
     parser.add_argument("--concurrent-presses", type=int, default=5)
@@ -400,6 +420,11 @@ def main() -> None:
     if args.only_screenshots:
         return
     single = statistics.median(results["single_fast_s"])
+    if results["single_isolated_s"]:
+        isolated = results["single_isolated_s"]
+        print(f"slider change, one at a time (session idle before each): median "
+              f"{statistics.median(isolated) * 1e3:.0f} ms (n = {len(isolated)}, "
+              f"max {max(isolated) * 1e3:.0f})")
     locus = statistics.median(results["locus_refresh_s"])
     print(f"slider change -> eigenvalues, status, time histories: median {single * 1e3:.0f} ms "
           f"(n = {len(results['single_fast_s'])}, max {max(results['single_fast_s']) * 1e3:.0f})")
