@@ -29,6 +29,7 @@ from model.calibration import (
     MOTOR_TORQUE,
     STABILITY_LIMIT,
     TABLE1_IM_HZ,
+    TABLE1_RE,
     V_REF,
     driving_shaft_mode,
     match_table1_modes,
@@ -62,6 +63,59 @@ def test_table1_imaginary_part_within_3_percent(calibrated, k):
     _, _, result, matched = calibrated
     achieved = result.eigenvalues[matched[k - 1]].imag / (2 * np.pi)
     assert achieved == pytest.approx(TABLE1_IM_HZ[k - 1], rel=0.03)
+
+
+# --- Table 1 row by row (issue 11) ---------------------------------------------------------------
+# The k-th complex pair *by rank* (ascending Im, as Table 1 lists them) must lie within 5 % of the
+# published k-th (the issue's acceptance limit; its aim is 3 %) and be the mode that carries
+# Table 2's k-th character (a pair that matches in frequency but moves other parts is no match).
+# The current set was calibrated by character, not by rank: it has 16 complex pairs below
+# 12.6 Hz against the study's ten, so from row 6 on the rows belong to other modes.  Misses are
+# strict xfails with the values achieved (v = 120 km/h, N0 and b_M of the set).
+MISSED_BY_RANK: dict[int, str] = {
+    6: "6th pair −2.080 ± i 7.429 Hz (−12.6 %), the frame's roll, not Table 2's 6th character",
+    7: "7th pair −0.346 ± i 7.523 Hz (−12.4 %), the motors' longitudinal motion in opposite "
+       "phase, not Table 2's 7th character",
+    8: "8th pair −3.212 ± i 8.477 Hz (−7.7 %), Table 2's 6th character",
+    9: "9th pair −1.796 ± i 8.632 Hz (−29.3 %), Table 2's 7th character",
+    10: "10th pair −3.385 ± i 9.055 Hz (−28.0 %), Table 2's 8th character",
+}
+# Re of the modes the issue names, each taken as the mode with Table 2's character: within 30 %,
+# or within 0.05 1/s where the published |Re| < 0.2 1/s (two or three digits published; damping
+# was not a calibration target of the current set)
+MISSED_REAL_PARTS: dict[int, str] = {
+    1: "Re −0.100 1/s against −0.032 (car body bounce: primary and secondary vertical dampers)",
+    3: "Re −2.367 1/s against −0.199 (frame pitch with the gears: yaw dampers against a fixed car "
+       "body)",
+    4: "Re −0.646 1/s against −0.056 (frame bounce with both motors)",
+    9: "Re −21.9 1/s against −3.958 (wheelset 2's longitudinal–yaw mode)",
+    10: "Re −8.74 1/s against −4.010 (wheelset 1's longitudinal–yaw mode)",
+}
+
+
+def _by_rank_mark(k: int, missed: dict[int, str]):
+    if k in missed:
+        return pytest.mark.xfail(strict=True, reason="documented miss (issue 11): " + missed[k])
+    return ()
+
+
+@pytest.mark.parametrize("k", [pytest.param(k, marks=_by_rank_mark(k, MISSED_BY_RANK))
+                               for k in range(1, 11)])
+def test_table1_by_rank_within_5_percent_with_its_character(calibrated, k):
+    _, _, result, matched = calibrated
+    index = result.complex_index[k - 1]
+    assert result.eigenvalues[index].imag / (2 * np.pi) == pytest.approx(TABLE1_IM_HZ[k - 1],
+                                                                          rel=0.05)
+    assert index == matched[k - 1], "the k-th pair by rank has another mode's character"
+
+
+@pytest.mark.parametrize("k", [pytest.param(k, marks=_by_rank_mark(k, MISSED_REAL_PARTS))
+                               for k in (1, 3, 4, 8, 9, 10)])
+def test_table1_real_part(calibrated, k):
+    _, _, result, matched = calibrated
+    published = TABLE1_RE[k - 1]
+    tolerance = 0.05 if abs(published) < 0.2 else 0.3 * abs(published)
+    assert result.eigenvalues[matched[k - 1]].real == pytest.approx(published, abs=tolerance)
 
 
 def test_driving_shaft_mode_within_3_percent(calibrated):
