@@ -141,6 +141,16 @@ async def wait_idle(page) -> None:
     await asyncio.sleep(2.0)
 
 
+async def wait_settled(page) -> None:
+    """Wait until the follow-ups of a change of speed, N0 or b_M are done: the dense root locus
+    and s0*(v) (else they run beside the steps measured next: steps 5-7 after an N0 change took
+    1.6-2.2 s instead of 0.7 s, the time of s0*'s search, not of the steps)."""
+    await page.wait_for_function(f"() => !({LOCUS_TITLE})().includes('computing')",
+                                 timeout=300_000)
+    await page.get_by_text("s0*(v): computing").first.wait_for(state="hidden", timeout=300_000)
+    await asyncio.sleep(1.0)
+
+
 async def settle_n0(page, presses: int) -> None:
     for _ in range(presses):
         await step(page, "ctl-N0", "ArrowLeft", SLOW, timeout=300_000)
@@ -295,6 +305,7 @@ async def run(args) -> dict:
             page = await open_page(browser, url)
             log("single session: own wheel force")
             await settle_n0(page, 1)
+            await wait_settled(page)
             log("single session: s0 steps, then speed steps")  # own N0 = 99 kN: nothing cached from earlier runs
             fast = [await step(page, "ctl-s0", "ArrowRight", FAST) for _ in range(args.presses)]
             # the same steps one at a time: each after the previous one's work is done (its

@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_app import ARGS, CHROMIUM, DATA, FAST, free_port, log, open_page, settle_n0, start_server
+from bench_app import ARGS, CHROMIUM, DATA, FAST, free_port, log, open_page, settle_n0, start_server, wait_settled
 
 NONLINEAR = f"() => ({DATA})('nonlinear', 'y:ID1.disc_clutch.torque')"
 
@@ -58,7 +58,8 @@ async def run(args) -> dict:
             await page.locator(".ctl-creep button", has_text="nonlinear").click()
             await page.wait_for_function(f"() => ({NONLINEAR})().length > 0", timeout=120_000)
             await settle_n0(page, 1)
-            await page.wait_for_timeout(3000)
+            await wait_settled(page)  # the N0 change's dense root locus and s0*(v)
+            await page.wait_for_timeout(2000)  # and its nonlinear history
             times = [await press(page) for _ in range(args.presses)]
             errors = list(page.errors)
             await browser.close()
