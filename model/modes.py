@@ -97,7 +97,7 @@ class _ComponentLayout:
 def _layouts(model: BogieModel) -> dict[str, _ComponentLayout]:
     """Per component (:func:`merge_rims`), built once per model: the per-axis sums of
     :func:`characterize` then take one ``bincount`` instead of a Python loop over coordinates
-    (≈ 30 ms of the dashboard's 170 ms per slider step went to that loop)."""
+    (ten modes' descriptions, a part of the dashboard's fast stage: 12–14 ms instead of 18–20)."""
     cached = model.__dict__.get("_mode_layouts")
     if cached is None:
         cached = {}
