@@ -67,7 +67,6 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
     """
     import faulthandler
     import signal
-    import sys
 
     import panel as pn
 
@@ -79,22 +78,35 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
     origins = allow_websocket_origin or os.environ.get(
         "BOGIE_ALLOWED_ORIGINS", f"localhost:{port},127.0.0.1:{port}").split(",")
     if threading.current_thread() is threading.main_thread():
-        # a container stops its PID 1 with SIGTERM, which Python would otherwise ignore there
-        signal.signal(signal.SIGTERM, signal.default_int_handler)
+        # SIGTERM (a container stops its PID 1 with it; Python would otherwise ignore it there)
+        # stops the server from the signal handler itself.  Raising KeyboardInterrupt there
+        # instead was lost once in a test run: the signal arrived while the main thread ran a
+        # weakref callback, which swallows exceptions ("Exception ignored in … remove"), and the
+        # server went on running until it was killed 30 s later.  Ctrl-C: Panel's own handler
+        # stops the IO loop, and pn.serve returns
+        signal.signal(signal.SIGTERM, _stop_now)
     print(f"bogie serve: dashboard on http://{address}:{port}/app "
           f"(liveness: /liveness?endpoint=/app)", flush=True)
     try:
         pn.serve({"app": lambda: create_app(params)}, port=port, address=address,
                  websocket_origin=[o.strip() for o in origins if o.strip()], show=False,
                  liveness=True, title=TITLE)
-    except KeyboardInterrupt:
-        print("bogie serve: stopped", file=sys.stderr)
-        from .workers import stop_all
+    except KeyboardInterrupt:  # Ctrl-C before Panel's handler was in place
+        pass
+    _stop_now()
 
-        # nothing to save: computations queued or running for sessions that are gone are
-        # dropped (Python would otherwise join every worker thread at exit, and a reaction-time
-        # search at the lowest priority can run for a minute)
-        stop_all()
+
+def _stop_now(*_signal) -> None:
+    """Stop the server process at once.  Nothing to save: the computations queued or running for
+    sessions that are gone are dropped (``os._exit``: Python would otherwise join every worker
+    thread at exit, and a reaction-time search at the lowest priority can run for a minute).
+    Called from the signal handler: the message may wait for another thread's write to stderr
+    (that thread goes on and releases it); one interrupted in this thread is skipped."""
+    import sys
+
+    try:
+        print("bogie serve: stopped", file=sys.stderr, flush=True)
         sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(0)
+    except (OSError, RuntimeError, ValueError):  # a closed or busy stream: stop anyway
+        pass
+    os._exit(0)

@@ -39,8 +39,3 @@ SIDE_VIEW_POOL = prioritized_pool(2, SIDE_VIEW, "bogie-side-view")
 NONLINEAR_POOL = prioritized_pool(1, FOLLOW_UP, "bogie-nonlinear")
 SEARCH_POOL = prioritized_pool(1, SEARCH, "bogie-reaction")
 
-
-def stop_all() -> None:
-    """Drop the computations still queued in every pool (the server stops)."""
-    for pool in (FIRST_ANSWER_POOL, FOLLOW_UP_POOL, SIDE_VIEW_POOL, NONLINEAR_POOL, SEARCH_POOL):
-        pool.shutdown(wait=False, cancel_futures=True)

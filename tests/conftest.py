@@ -108,6 +108,7 @@ def own_server(tmp_path_factory):
             process.wait(timeout=30)
         except subprocess.TimeoutExpired:
             process.kill()
+            process.wait(timeout=10)  # reaped: no "still running" warning at teardown
 
 
 @pytest.fixture(scope="session")

@@ -131,9 +131,11 @@ def test_serve_origins_from_the_environment(monkeypatch):
 
     monkeypatch.setattr(app.serve, "limit_blas_threads", lambda: None, raising=False)
 
-    calls, handlers = [], {}
+    calls, handlers, stops = [], {}, []
     monkeypatch.setattr(pn, "serve", lambda *args, **kwargs: calls.append(kwargs))
     monkeypatch.setattr(signal, "signal", handlers.__setitem__)  # leave pytest's handlers alone
+    # the process ends (os._exit) when pn.serve returns or on SIGTERM: not this one
+    monkeypatch.setattr(app.serve, "_stop_now", lambda *args: stops.append(args))
 
     monkeypatch.delenv("BOGIE_ALLOWED_ORIGINS", raising=False)
     serve(port=5123.0, address="0.0.0.0")  # the command line gives a float
@@ -142,7 +144,8 @@ def test_serve_origins_from_the_environment(monkeypatch):
     assert calls[-1]["address"] == "0.0.0.0"
     assert calls[-1]["port"] == 5123
     assert isinstance(calls[-1]["port"], int)
-    assert handlers == {signal.SIGTERM: signal.default_int_handler}  # docker stop ends it cleanly
+    assert handlers == {signal.SIGTERM: app.serve._stop_now}  # docker stop ends it at once
+    assert len(stops) == 1  # and so does the end of pn.serve (Ctrl-C: Panel stops its loop)
 
     monkeypatch.setenv("BOGIE_ALLOWED_ORIGINS", " bogie.example.org , localhost:8080,")
     serve(port=5006)
