@@ -80,11 +80,9 @@ def app_server():
     thread.stop()
 
 
-@pytest.fixture(scope="module")
-def own_server(tmp_path_factory):
-    """(base URL, process id) of a ``bogie serve`` process started for one test module: a fresh
-    server as a reviewer gets it, sharing no state (sessions, caches, background work, Bokeh's
-    and Panel's process-wide settings) with the tests that ran before in this process."""
+def start_bogie_serve(log_dir: Path):
+    """(base URL, process) of a ``bogie serve`` process on a free port of 127.0.0.1, its stderr
+    in ``log_dir/serve.log``, answering its liveness endpoint."""
     import socket
     import subprocess
     import sys
@@ -92,8 +90,7 @@ def own_server(tmp_path_factory):
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
-    log = tmp_path_factory.mktemp("server") / "serve.log"
-    with open(log, "w") as stderr:
+    with open(log_dir / "serve.log", "w") as stderr:
         process = subprocess.Popen([sys.executable, "-m", "model", "serve", "--port", str(port)],
                                    cwd=Path(__file__).resolve().parent.parent,
                                    stdout=subprocess.DEVNULL, stderr=stderr,
@@ -101,14 +98,36 @@ def own_server(tmp_path_factory):
     url = f"http://127.0.0.1:{port}"
     try:
         wait_for_liveness(url, timeout=180)
-        yield url, process.pid
-    finally:
+    except BaseException:
+        stop_process(process)
+        raise
+    return url, process
+
+
+def stop_process(process, timeout: float = 30) -> None:
+    """SIGTERM, then SIGKILL after ``timeout`` s; the process is reaped either way (no "still
+    running" warning at teardown)."""
+    import subprocess
+
+    if process.poll() is None:
         process.terminate()
         try:
-            process.wait(timeout=30)
+            process.wait(timeout=timeout)
         except subprocess.TimeoutExpired:
             process.kill()
-            process.wait(timeout=10)  # reaped: no "still running" warning at teardown
+            process.wait(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def own_server(tmp_path_factory):
+    """(base URL, process id) of a ``bogie serve`` process started for one test module: a fresh
+    server as a reviewer gets it, sharing no state (sessions, caches, background work, Bokeh's
+    and Panel's process-wide settings) with the tests that ran before in this process."""
+    url, process = start_bogie_serve(tmp_path_factory.mktemp("server"))
+    try:
+        yield url, process.pid
+    finally:
+        stop_process(process)
 
 
 @pytest.fixture(scope="session")

@@ -72,36 +72,20 @@ def test_sigterm_stops_the_server_at_once(tmp_path):
     """``docker stop`` sends SIGTERM: the server ends within seconds, with exit status 0 and a
     line in its log, also while a session's computations run (a KeyboardInterrupt raised by the
     old handler was once swallowed by a weakref callback, and the server ran on until killed)."""
-    import os
     import signal
-    import socket
-    import subprocess
-    import sys
     import time
     import urllib.request
 
-    from conftest import wait_for_liveness
+    from conftest import start_bogie_serve, stop_process
 
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    log = tmp_path / "serve.log"
-    with open(log, "w") as stderr:
-        process = subprocess.Popen([sys.executable, "-m", "model", "serve", "--port", str(port)],
-                                   cwd=Path(__file__).resolve().parent.parent,
-                                   stdout=subprocess.DEVNULL, stderr=stderr,
-                                   env={**os.environ, "OPENBLAS_NUM_THREADS": "1"})
+    url, process = start_bogie_serve(tmp_path)
     try:
-        url = f"http://127.0.0.1:{port}"
-        wait_for_liveness(url, timeout=180)
         with urllib.request.urlopen(f"{url}/app?v=185", timeout=120) as page:  # a new session
             assert page.status == 200
         start = time.monotonic()
         process.send_signal(signal.SIGTERM)
         assert process.wait(timeout=20) == 0
         assert time.monotonic() - start < 10
-        assert "bogie serve: stopped" in log.read_text()
+        assert "bogie serve: stopped" in (tmp_path / "serve.log").read_text()
     finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait(timeout=10)
+        stop_process(process, timeout=0)
