@@ -83,34 +83,22 @@ class _Blocks:
         return self.full[:n, :n], self.triangular[:n, :n]
 
 
-_LAST_BLOCKS: tuple = ()  # (W, E, P0, P1, D1, blocks, SUB_STEPS) of the last step loop
-
-
-def _blocks_for(W, E, P0, P1, D1) -> _Blocks:
-    """The Toeplitz matrices for these arrays: a run calls :func:`march` once per output block
-    of 2 048 steps with the same arrays, and building them took ≈ 3.7 ms each time (≈ 3 % of a
-    2 s run).  Kept for the last arrays seen, recognised by identity (the tuple holds them, so
-    their ids are not reused; another thread's run replaces the tuple, it never changes it)."""
-    global _LAST_BLOCKS
-    last = _LAST_BLOCKS
-    if (last and last[6] == SUB_STEPS
-            and all(a is b for a, b in zip(last[:5], (W, E, P0, P1, D1), strict=True))):
-        return last[5]
-    blocks = _Blocks(W, E, E[:, None] * P1 + P0, D1)
-    _LAST_BLOCKS = (W, E, P0, P1, D1, blocks, SUB_STEPS)
-    return blocks
+def step_matrices(W, E, P0, P1, D1) -> _Blocks:
+    """The Toeplitz matrices of a run's step loop (Q = diag(E) P1 + P0), built once per run and
+    passed to every :func:`march` call of it (one per output block of 2 048 steps; building them
+    takes ≈ 3.7 ms, ≈ 3 % of a 2 s run when it was done per call)."""
+    return _Blocks(W, E, E[:, None] * P1 + P0, D1)
 
 
 def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, P1, p0_2,
           p1_2, W, D1, contact_scale, law_params, s0, v, N0, mu_s0, dmu_s0, tangent,
           detect_rows, threshold, det_state, M_step, delay, rate, floor, Z_out, z_out,
-          phi_out, u2_out, iterations, n_creep):
+          phi_out, u2_out, iterations, n_creep, blocks):
     """Steps k0 → k1 (exclusive of k0's state, which is given).  Writes the modal states,
     contact velocities, remainder forces and ΔM_2 of steps k0+1 … k1 into rows 0 … of the
-    outputs; updates zeta, phi, z, u2_now, det_state in place.  Returns 0, or the step at
-    which Newton failed (negative)."""
+    outputs; updates zeta, phi, z, u2_now, det_state in place; ``blocks``: the run's
+    :func:`step_matrices`.  Returns 0, or the step at which Newton failed (negative)."""
     nc = z.shape[0]
-    blocks = _blocks_for(W, E, P0, P1, D1)
     law = tuple(float(x) for x in law_params)
     creep = np.arange(nc) < n_creep
     detect = np.asarray(detect_rows, dtype=float)

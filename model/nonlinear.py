@@ -165,10 +165,11 @@ class AntiSlip:
 # --- step loop ---------------------------------------------------------------------------------------
 
 def _kernel():
-    """The step loop (:func:`model._nonlinear_kernel.march`)."""
-    from ._nonlinear_kernel import march
+    """The step loop (:func:`model._nonlinear_kernel.march`) and the matrices it takes
+    (:func:`model._nonlinear_kernel.step_matrices`)."""
+    from ._nonlinear_kernel import march, step_matrices
 
-    return march
+    return march, step_matrices
 
 
 
@@ -371,7 +372,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     rate = protection.rate if protection else 1.0
     floor = protection.floor if protection else 0.0
     law_params = np.array([law.mu0, law.A, law.B, law.kA, law.kS, law.slope])
-    march = _kernel()
+    march, step_matrices = _kernel()
     m = len(lam)
     nc = len(rims) + 1
     zeta = np.zeros(m, dtype=complex)
@@ -398,6 +399,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     u2_out = np.empty(block)
     u2_now = 0.0
     scale = max(op.s0 * op.v, 1e-3)
+    blocks = step_matrices(setup.W, setup.E, setup.P0, setup.P1, setup.D1)
     k = 0
     while k < n_steps:
         k1 = min(n_steps, k + block)
@@ -405,7 +407,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
                        complex(1.0), setup.P0, setup.P1, setup.p0_2, setup.p1_2, setup.W,
                        setup.D1, scale, law_params, op.s0, op.v, op.N0, mu_s0, dmu_s0,
                        creep == "tangent", detect_rows, threshold, det_state, step, delay, rate,
-                       floor, Z_out, z_out, phi_out, u2_out, iterations, len(rims))
+                       floor, Z_out, z_out, phi_out, u2_out, iterations, len(rims), blocks)
         if status < 0:
             raise NonlinearError(f"the creep-force iteration did not converge at t = "
                                  f"{-status * h:.6g} s")
