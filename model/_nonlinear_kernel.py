@@ -13,8 +13,12 @@ i folded into step i+1; ``ζ_i = ζ⁻_i + P1 r_i``).  The 5L equations are solv
 Jacobian ``T diag(r') − I`` less the within-step coupling between channels (≈ 10⁻⁸ of the
 diagonal, measured; the residual keeps it, so the solution is that of the coupled equations):
 that Jacobian is lower triangular, one ``solve_triangular`` per iteration, and the creep law is
-evaluated on all 4L contact values at once.  What stays per step in Python are two vectorised
-O(modes) recurrences (the block's forced state, then the state with the remainders).
+evaluated on all 4L contact values at once.  What stays per step in Python is one vectorised
+O(modes) recurrence (the block's forced state).  The outputs y = Re(V ζ) are formed the same way
+as the channels: ``y = Re(V ζ_forced) + T_V r`` with the Toeplitz ``T_V`` of V (``Re(V P1)`` on the
+diagonal, ``Re(V E^(l−1) Q)`` below), and the state carried to the next block is the block's last
+one only (``ζ_(L−1) = ζ_forced,(L−1) + Σ_j E^(L−2−j) Q r_j + P1 r_(L−1)``): the modal states of
+the steps inside a block are never formed.
 
 A block that does not converge is halved (down to one step, the plain one-step implicit
 scheme); a block in which the anti-slip protection trips is cut where the torque reduction
@@ -51,53 +55,73 @@ def polach(s: np.ndarray, v: float, mu0: float, A: float, B: float, kA: float, k
 
 
 def _toeplitz(W: np.ndarray, E: np.ndarray, Q: np.ndarray, D1: np.ndarray, L: int) -> np.ndarray:
-    """T (L·nc x L·nc): row block i, column block j holds D1 (i = j) or Re(W E^(i−j−1) Q)."""
-    nc = W.shape[0]
+    """T (L·rows x L·nc): row block i, column block j holds D1 (i = j) or Re(W E^(i−j−1) Q)
+    (W: rows x m, Q: m x nc, D1: rows x nc)."""
+    rows, nc = W.shape[0], Q.shape[1]
     powers = E[None, :] ** np.arange(L - 1)[:, None]  # (L−1) x m
-    lags = np.einsum("cm,lm,md->lcd", W, powers, Q).real  # (L−1) x nc x nc
-    T = np.zeros((L, nc, L, nc))
+    lags = np.einsum("cm,lm,md->lcd", W, powers, Q).real  # (L−1) x rows x nc
+    T = np.zeros((L, rows, L, nc))
     for i in range(L):
         T[i, :, i, :] = D1
         for j in range(i):
             T[i, :, j, :] = lags[i - j - 1]
-    return T.reshape(L * nc, L * nc)
+    return T.reshape(L * rows, L * nc)
 
 
 class _Blocks:
-    """The Toeplitz matrices of one step loop (per block length, built on first use)."""
+    """The matrices of one step loop, built once per run (≈ 4 ms): the channels' Toeplitz T and
+    its triangular part for Newton, the outputs' Toeplitz T_V, the powers of E and the index
+    patterns of a block."""
 
-    def __init__(self, W, E, Q, D1):
-        self.W, self.E, self.Q, self.D1 = W, E, Q, D1
-        self.full = _toeplitz(W, E, Q, D1, SUB_STEPS)
+    def __init__(self, W, E, Q, D1, P1, V, creep):
+        self.W, self.E, self.Q, self.D1, self.P1 = W, E, Q, D1, P1
         nc = W.shape[0]
+        self.rows_out = V.shape[0]
+        self.full = _toeplitz(W, E, Q, D1, SUB_STEPS)
         # the Newton matrix's part: T without the within-step coupling between channels
         self.triangular = np.tril(self.full)
         for i in range(SUB_STEPS):
             block = self.triangular[i * nc:(i + 1) * nc, i * nc:(i + 1) * nc]
             block[np.triu_indices(nc, 1)] = 0.0  # np.tril kept the lower part of D1 only
             block[np.tril_indices(nc, -1)] = 0.0
+        self.outputs = _toeplitz(V, E, Q, (V @ P1).real, SUB_STEPS)
+        self.projection = np.ascontiguousarray(np.vstack([W, V]).T)  # m x (nc + outputs)
+        self.powers = E[None, :] ** np.arange(SUB_STEPS)[:, None]  # E^k, k = 0 … L−1
+        self.doubling = [E]  # E^(2^k) for the doubling scan
+        while 2 ** len(self.doubling) < SUB_STEPS:
+            self.doubling.append(self.doubling[-1] * self.doubling[-1])
+        self.is_creep = np.tile(creep, SUB_STEPS)
+        self.trtrs = get_lapack_funcs("trtrs", (self.triangular,))
+        self._newton: dict[int, np.ndarray] = {}
 
-    def matrices(self, L: int) -> tuple[np.ndarray, np.ndarray]:
-        """(T, its triangular part) of the first L steps (a leading block of the longest)."""
+    def newton_matrix(self, L: int, slopes: np.ndarray) -> np.ndarray:
+        """Newton's Jacobian T_triangular diag(r') − I of the first L steps, in a buffer of the
+        run (overwritten by the next call)."""
         n = L * self.W.shape[0]
-        return self.full[:n, :n], self.triangular[:n, :n]
+        J = self._newton.get(L)
+        if J is None:
+            J = self._newton[L] = np.empty((n, n))
+        np.multiply(self.triangular[:n, :n], slopes[None, :], out=J)
+        J.flat[::n + 1] -= 1.0
+        return J
 
 
-def step_matrices(W, E, P0, P1, D1) -> _Blocks:
-    """The Toeplitz matrices of a run's step loop (Q = diag(E) P1 + P0), built once per run and
-    passed to every :func:`march` call of it (one per output block of 2 048 steps; building them
-    takes ≈ 3.7 ms, ≈ 3 % of a 2 s run when it was done per call)."""
-    return _Blocks(W, E, E[:, None] * P1 + P0, D1)
+def step_matrices(W, E, P0, P1, D1, V, n_creep) -> _Blocks:
+    """The matrices of a run's step loop (Q = diag(E) P1 + P0; V: outputs x m, y = Re(V ζ);
+    the first ``n_creep`` of the channels are creep channels), built once per run and passed to
+    every :func:`march` call of it (one per output block of 2 048 steps)."""
+    return _Blocks(W, E, E[:, None] * P1 + P0, D1, P1, V, np.arange(W.shape[0]) < n_creep)
 
 
 def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, P1, p0_2,
           p1_2, W, D1, contact_scale, law_params, s0, v, N0, mu_s0, dmu_s0, tangent,
-          detect_rows, threshold, det_state, M_step, delay, rate, floor, Z_out, z_out,
+          detect_rows, threshold, det_state, M_step, delay, rate, floor, Y_out, z_out,
           phi_out, u2_out, iterations, n_creep, blocks):
-    """Steps k0 → k1 (exclusive of k0's state, which is given).  Writes the modal states,
-    contact velocities, remainder forces and ΔM_2 of steps k0+1 … k1 into rows 0 … of the
-    outputs; updates zeta, phi, z, u2_now, det_state in place; ``blocks``: the run's
-    :func:`step_matrices`.  Returns 0, or the step at which Newton failed (negative)."""
+    """Steps k0 → k1 (exclusive of k0's state, which is given).  Writes the outputs Re(V ζ)
+    (``blocks``' V), contact velocities, remainder forces and ΔM_2 of steps k0+1 … k1 into rows
+    0 … of ``Y_out``, ``z_out``, ``phi_out``, ``u2_out``; updates zeta, phi, z, u2_now, det_state
+    in place; ``blocks``: the run's :func:`step_matrices`.  Returns 0, or the step at which Newton
+    failed (negative)."""
     nc = z.shape[0]
     law = tuple(float(x) for x in law_params)
     creep = np.arange(nc) < n_creep
@@ -108,13 +132,13 @@ def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, 
         slope[creep] = N0 / v * (polach(s0 + z[creep] / v, v, *law)[1] - dmu_s0)
     state = _LoopState(zeta.copy(), phi.copy(), z.copy(), float(u2_now), float(det_state[0]),
                        slope)
+    basis = np.vstack([cp, cm, p0_2, p1_2]).astype(complex)  # 4 x m
     row, L = 0, SUB_STEPS
     while row < k1 - k0:
         L = min(L, k1 - k0 - row)
-        done = _block(state, k0 + row, L, row, h, blocks, E, inc_step, cp, cm, g_step, g0, P0,
-                      P1, p0_2, p1_2, W, law, s0, v, N0, mu_s0, dmu_s0, tangent, creep, detect,
-                      threshold, M_step, delay, rate, floor, scale, Z_out, z_out, phi_out,
-                      u2_out, iterations)
+        done = _block(state, k0 + row, L, row, h, blocks, E, inc_step, basis, g_step, g0, P0,
+                      law, s0, v, N0, mu_s0, dmu_s0, tangent, creep, detect, threshold, M_step,
+                      delay, rate, floor, scale, Y_out, z_out, phi_out, u2_out, iterations)
         if done == 0:
             if L == 1:
                 return -(k0 + row + 1)
@@ -127,17 +151,17 @@ def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, 
     return 0
 
 
-def _recurrence(E: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """x_i = E x_(i−1) + f_i (x_(−1) = 0) for all rows i of f at once: a doubling scan (after the
-    round with shift d, row i holds the sum over f_(i−2d+1 … i)), log2(rows) vectorised rounds
-    instead of a Python step per row."""
-    x = f.copy()
-    power, d = E.copy(), 1
-    while d < len(x):
-        x[d:] += power * x[:-d]
-        power = power * power
+def _recurrence(doubling: list[np.ndarray], f: np.ndarray) -> np.ndarray:
+    """x_i = E x_(i−1) + f_i (x_(−1) = 0) for all rows i of f at once, in place: a doubling scan
+    (after the round with shift d, row i holds the sum over f_(i−2d+1 … i)), log2(rows)
+    vectorised rounds instead of a Python step per row; ``doubling``: E, E², E⁴, …"""
+    d = 1
+    for power in doubling:
+        if d >= len(f):
+            break
+        f[d:] += power * f[:-d]
         d *= 2
-    return x
+    return f
 
 
 class _LoopState:
@@ -152,9 +176,9 @@ class _LoopState:
         self.slope = slope  # r'(z) of the creep channels at the step [N s/m]
 
 
-def _block(state, kb, L, row0, h, blocks, E, inc_step, cp, cm, g_step, g0, P0, P1, p0_2, p1_2,
-           W, law, s0, v, N0, mu_s0, dmu_s0, tangent, creep, detect, threshold, M_step, delay,
-           rate, floor, scale, Z_out, z_out, phi_out, u2_out, iterations) -> int:
+def _block(state, kb, L, row0, h, blocks, E, inc_step, basis, g_step, g0, P0, law, s0, v, N0,
+           mu_s0, dmu_s0, tangent, creep, detect, threshold, M_step, delay, rate, floor, scale,
+           Y_out, z_out, phi_out, u2_out, iterations) -> int:
     """Solve steps kb+1 … kb+L from ``state``; returns the number of accepted steps (0: Newton
     did not converge) and advances ``state`` to the last of them."""
     nc = state.z.shape[0]
@@ -166,27 +190,30 @@ def _block(state, kb, L, row0, h, blocks, E, inc_step, cp, cm, g_step, g0, P0, P
     u2 = -M_step * reduction
     u2_before = np.concatenate([[state.u2], u2[:-1]])
     # forced modal states without the block's remainders: b_0 = E ζ + F + P0 φ, b_(i+1) = E b_i + …
-    g = g0 * np.power(complex(g_step), np.arange(kb, kb + L))
-    forcing = (inc_step[None, :] + g[:, None] * cp[None, :] + np.conj(g)[:, None] * cm[None, :]
-               + u2_before[:, None] * p0_2[None, :] + u2[:, None] * p1_2[None, :])
+    inputs = np.empty((L, 4), dtype=complex)  # the weights of cp, cm, p0_2, p1_2 (``basis``)
+    inputs[:, 0] = g0 * np.power(complex(g_step), np.arange(kb, kb + L))
+    inputs[:, 1] = inputs[:, 0].conj()
+    inputs[:, 2] = u2_before
+    inputs[:, 3] = u2
+    forcing = inputs @ basis
+    forcing += inc_step
     forcing[0] += E * state.zeta + P0 @ state.phi
-    forced = _recurrence(E, forcing)
-    a = (forced @ W.T).real.reshape(-1)  # L·nc
-    T, T_newton = blocks.matrices(L)
-    is_creep = np.tile(creep, L)
+    forced = _recurrence(blocks.doubling, forcing)
+    projected = (forced @ blocks.projection).real  # L x (channels, outputs)
+    a = projected[:, :nc].reshape(-1)  # L·nc
+    T = blocks.full[:L * nc, :L * nc]
+    is_creep = blocks.is_creep[:L * nc]
     slope_scale = -np.repeat(reduction, nc)[~is_creep]
     dr = np.zeros(L * nc)
     dr[~is_creep] = slope_scale
     tangent_slope = N0 * dmu_s0 / v
-    trtrs = get_lapack_funcs("trtrs", (T_newton,))
+    trtrs = blocks.trtrs
     # Newton's start: the block solved with the remainders linearized about the last step,
     # r ≈ r_last + r'_last (z − z_last) (one triangular solve, no evaluation of the law)
     dr[is_creep] = np.tile(state.slope[creep], L)
     offset = np.tile(state.phi - state.slope * state.z, L)
     offset[~is_creep] = 0.0
-    J = T_newton * dr[None, :]
-    J.flat[::L * nc + 1] -= 1.0
-    zf, info = trtrs(J, -(a + T @ offset), lower=1)
+    zf, info = trtrs(blocks.newton_matrix(L, dr), -(a + T @ offset), lower=1)
     if info != 0:
         return 0
     r = np.empty(L * nc)
@@ -201,9 +228,7 @@ def _block(state, kb, L, row0, h, blocks, E, inc_step, cp, cm, g_step, g0, P0, P
             dr[is_creep] = N0 / v * (dmu_v - dmu_s0)
         r[~is_creep] = slope_scale * zf[~is_creep]
         residual = a + T @ r - zf
-        J = T_newton * dr[None, :]
-        J.flat[::L * nc + 1] -= 1.0
-        step, info = trtrs(J, residual, lower=1)
+        step, info = trtrs(blocks.newton_matrix(L, dr), residual, lower=1)
         if info != 0:
             return 0
         zf = zf - step
@@ -232,15 +257,19 @@ def _block(state, kb, L, row0, h, blocks, E, inc_step, cp, cm, g_step, g0, P0, P
             late = np.flatnonzero(t1[i + 1:] > state.detection + delay)
             if len(late):
                 accepted = i + 1 + int(late[0])
-    # modal states with the remainders: ζ⁻_(i+1) = E ζ⁻_i + forcing + Q r_i, ζ_i = ζ⁻_i + P1 r_i
-    shifted = np.zeros((accepted, len(E)), dtype=complex)
-    shifted[1:] = rb[:accepted - 1] @ blocks.Q.T  # Q = diag(E) P1 + P0
-    out = Z_out[row0:row0 + accepted]
-    out[:] = forced[:accepted] + _recurrence(E, shifted) + rb[:accepted] @ P1.T
+    # outputs with the remainders: y_i = Re(V ζ_forced,i) + Σ_j Re(V E^(i−1−j) Q) r_j + Re(V P1) r_i;
+    # the last state: ζ_(n−1) = ζ_forced,(n−1) + Σ_(j < n−1) E^(n−2−j) Q r_j + P1 r_(n−1)
+    n_out = blocks.rows_out
+    Y_out[row0:row0 + accepted] = projected[:accepted, nc:] + (
+        blocks.outputs[:accepted * n_out, :accepted * nc] @ r[:accepted * nc]).reshape(accepted, n_out)
+    last = forced[accepted - 1] + blocks.P1 @ rb[accepted - 1]
+    if accepted > 1:
+        weights = blocks.powers[accepted - 2::-1].T @ rb[:accepted - 1]  # m x nc
+        last += (blocks.Q * weights).sum(axis=1)
     z_out[row0:row0 + accepted] = zb[:accepted]
     phi_out[row0:row0 + accepted] = rb[:accepted]
     u2_out[row0:row0 + accepted] = u2[:accepted]
-    state.zeta = out[accepted - 1].copy()
+    state.zeta = last
     state.phi = rb[accepted - 1].copy()
     state.slope = np.where(creep, dr.reshape(L, nc)[accepted - 1], 0.0)
     state.z = zb[accepted - 1].copy()

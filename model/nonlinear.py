@@ -43,8 +43,9 @@ error; at the tangent the linear part is exact, the remainder is O(Δs²), and `
 replaced by its tangent in the *same* loop: the remainder evaluates to rounding) reproduces the
 closed form to rounding. The loop is numpy and scipy (:mod:`model._nonlinear_kernel`): the
 remainders of a block of 32 steps are solved together by Newton with a triangular Jacobian (the
-creep law on all of the block's contact values at once), the block's modal states by a vectorised
-doubling scan; the outputs are formed after each block of steps by one matrix product. Every step
+creep law on all of the block's contact values at once), the block's forced modal states by a
+vectorised doubling scan, its outputs from them and the remainders by a Toeplitz matrix product
+(the modal states inside a block are never formed, only the last one, carried on). Every step
 the anti-slip logic sees the contact velocities (a block is cut where a reduction starts).
 
 Anti-slip protection (:class:`AntiSlip`): detection when the slip velocity of ID2's wheelset
@@ -385,21 +386,21 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     C = np.array([np.concatenate([matrices.C_q[matrices.index(nm)], matrices.C_v[matrices.index(nm)]])
                   for nm in loads]).reshape(len(loads), 2 * n)
     V = C @ setup.modal_to_state  # loads x m
-    V_real, V_imag = np.ascontiguousarray(V.real.T), np.ascontiguousarray(-V.imag.T)
+    if keep_states:  # the states x = Re(X ζ) as further outputs of the loop
+        V = np.vstack([V, setup.modal_to_state])
     Y = np.empty((n_points, V.shape[0]))
     Y[0] = 0.0
     z_hist = np.zeros((n_points, nc))
     r_hist = np.zeros((n_points, nc))
     u2_hist = np.zeros(n_points)
-    X_hist = np.zeros((n_points, 2 * n)) if keep_states else None
     block = BLOCK_STEPS - BLOCK_STEPS % substeps
-    Z_out = np.empty((block, m), dtype=complex)
+    Y_out = np.empty((block, V.shape[0]))
     z_out = np.empty((block, nc))
     phi_out = np.empty((block, nc))
     u2_out = np.empty(block)
     u2_now = 0.0
     scale = max(op.s0 * op.v, 1e-3)
-    blocks = step_matrices(setup.W, setup.E, setup.P0, setup.P1, setup.D1)
+    blocks = step_matrices(setup.W, setup.E, setup.P0, setup.P1, setup.D1, V, len(rims))
     k = 0
     while k < n_steps:
         k1 = min(n_steps, k + block)
@@ -407,22 +408,20 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
                        complex(1.0), setup.P0, setup.P1, setup.p0_2, setup.p1_2, setup.W,
                        setup.D1, scale, law_params, op.s0, op.v, op.N0, mu_s0, dmu_s0,
                        creep == "tangent", detect_rows, threshold, det_state, step, delay, rate,
-                       floor, Z_out, z_out, phi_out, u2_out, iterations, len(rims), blocks)
+                       floor, Y_out, z_out, phi_out, u2_out, iterations, len(rims), blocks)
         if status < 0:
             raise NonlinearError(f"the creep-force iteration did not converge at t = "
                                  f"{-status * h:.6g} s")
         sel = np.arange(substeps - 1, k1 - k, substeps)  # block rows that are samples
         samples = (k + sel + 1) // substeps
         u2_now = float(u2_out[k1 - k - 1])
-        Zs = Z_out[: k1 - k] if substeps == 1 else Z_out[sel]
-        Y[samples] = Zs.real @ V_real + Zs.imag @ V_imag  # Re(Z Vᵀ): two real products
+        Y[samples] = Y_out[sel]
         z_hist[samples] = z_out[sel]
         r_hist[samples] = phi_out[sel]
         u2_hist[samples] = u2_out[sel]
-        if keep_states:
-            X_hist[samples] = (Zs @ setup.modal_to_state.T).real
         k = k1
     t = np.arange(n_points) / fs
+    X_hist = Y[:, len(loads):] if keep_states else None
     if not np.all(np.isfinite(Y)) or not np.all(np.isfinite(z_hist)):
         raise NonlinearError("the nonlinear response is not finite")
     totals, units, steady = {}, {}, {}
