@@ -36,6 +36,10 @@ LOCUS_DENSE_POINTS = 200  # points of the dense sweep that replaces it
 LOCUS_UNIFORM_SHARE = 0.3  # share of the dense points spread evenly (the rest follow the motion)
 LOCUS_JUMP_FACTOR = 2.5  # a step this many times as fast as both neighbouring steps is a jump
 LOCUS_JUMP_MIN = 0.5  # ... and longer than this in plot units (Re [1/s], Im [Hz]): line broken
+LOCUS_JUMP_LONG = 0.04  # a step longer than this share of the plot (Re and Im spans of the
+LOCUS_JUMP_SIDE = 1.5  # sweep) is a jump already when it is this many times as fast as one
+# neighbouring step: a branch accelerating into a collision of eigenvalues (steps 10, 16, 50,
+# then 5 [1/s]) is not resolved by any grid
 LOCUS_S0 = (0.001, 0.02)  # s0 range of the creepage sweep [-]
 LIMIT_XTOL = 1e-6  # s0*(v) to 1e-6 (shown with 5 decimals)
 LOCUS_V_KMH = (40.0, 200.0)  # speed range of the speed sweep [km/h]
@@ -306,6 +310,16 @@ def dense_locus_result(params_path: str, rail: str, parameter: str, fixed: float
     return _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=True)
 
 
+def _plot_shares(eigenvalues: np.ndarray) -> np.ndarray:
+    """(n_points - 1, n_branches) step lengths as shares of the plot: Re and Im divided by the
+    sweep's spans of Re and Im (the axes' extent when the whole sweep is shown)."""
+    finite = eigenvalues[np.isfinite(eigenvalues)]
+    spans = [np.ptp(part) if finite.size and np.ptp(part) > 0 else 1.0
+             for part in (finite.real, finite.imag)]
+    steps = np.diff(eigenvalues, axis=0)
+    return np.hypot(steps.real / spans[0], steps.imag / spans[1])
+
+
 def _plot_steps(eigenvalues: np.ndarray) -> np.ndarray:
     """(n_points - 1, n_branches) step lengths in plot units (Re [1/s], Im [Hz])."""
     steps = np.diff(eigenvalues, axis=0)
@@ -337,15 +351,22 @@ def locus_jumps(values: np.ndarray, eigenvalues: np.ndarray) -> np.ndarray:
     """Steps that are jumps (a branch meeting another one and turning, or moving faster than the
     grid resolves): per unit of the swept parameter, more than LOCUS_JUMP_FACTOR times as fast
     as in both neighbouring steps of the same branch, and longer than LOCUS_JUMP_MIN plot units
-    (Re [1/s], Im [Hz]).  The plots break the line there instead of drawing a straight segment
-    across the plane."""
+    (Re [1/s], Im [Hz]); or longer than LOCUS_JUMP_LONG of the plot (Re and Im measured in
+    shares of the sweep's spans, as they appear on the plot) and more than LOCUS_JUMP_SIDE times
+    as fast as one of its neighbouring steps (a branch accelerating into a collision with
+    another one grows its steps geometrically, 10, 16, 50 [1/s], and no grid resolves the last
+    ones).  The plots break the line there instead of drawing a straight
+    segment across the plane; the points themselves stay."""
     steps = _plot_steps(eigenvalues)
     if len(steps) < 3:
         return np.zeros(steps.shape, dtype=bool)
     rate = steps / np.diff(np.asarray(values, dtype=float))[:, None]
     before = np.vstack([rate[1:2], rate[:-1]])  # the first / last step: their only neighbour
     after = np.vstack([rate[1:], rate[-2:-1]])
-    return (rate > LOCUS_JUMP_FACTOR * np.maximum(before, after)) & (steps > LOCUS_JUMP_MIN)
+    both = (rate > LOCUS_JUMP_FACTOR * np.maximum(before, after)) & (steps > LOCUS_JUMP_MIN)
+    one = (rate > LOCUS_JUMP_SIDE * np.minimum(before, after)) & \
+        (_plot_shares(eigenvalues) > LOCUS_JUMP_LONG)
+    return both | one
 
 
 def broken_columns(series: np.ndarray, jumps: np.ndarray | None) -> list[np.ndarray]:

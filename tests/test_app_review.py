@@ -62,6 +62,21 @@ def test_a_smooth_branch_has_no_jumps():
     assert not compute.locus_jumps(values, lam).any()
 
 
+def test_an_unresolved_acceleration_breaks_the_line():
+    """A branch running into a collision: its steps grow 4, 5, 7, 10, 16, 50 [1/s], then 5.
+    The two long, unresolved steps are breaks; the short ones before and after are not, nor
+    are the even steps of a second branch that sets the plot's spans (−250…0 1/s, 0…20 Hz:
+    each of its steps is 10 % of the plot, but no faster than its neighbours)."""
+    steps = np.array([4.0, 4.0, 5.0, 7.0, 10.0, 16.0, 50.0, 5.0, 3.0, 3.0])
+    lam = np.empty((len(steps) + 1, 2), dtype=complex)
+    lam[:, 0] = -80.0 - np.concatenate([[0.0], np.cumsum(steps)]) + 2j * math.pi * 10.0
+    lam[:, 1] = np.linspace(-250.0, 0.0, len(lam)) + 2j * math.pi * np.linspace(0.0, 20.0, len(lam))
+    values = np.linspace(0.001, 0.002, len(lam))
+    jumps = compute.locus_jumps(values, lam)
+    assert np.flatnonzero(jumps[:, 0]).tolist() == [5, 6]
+    assert not jumps[:, 1].any()
+
+
 def test_fig6_series_splits_complex_and_real_branches():
     values = np.linspace(0.001, 0.02, 20)
     lam = np.zeros((20, 3), dtype=complex)
