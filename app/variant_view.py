@@ -162,7 +162,7 @@ class VariantView(pn.viewable.Viewer):
                                     line_width=2, legend_label=label)
             self.limits_figure.scatter("v", "s0", source=source, color=color, size=7)
             self.limit_sources[label] = source
-        self.limits_figure.legend.location = "top_left"
+        self.limits_figure.legend.location = "top_right"  # s0* falls with v: top right is free
         self.comparison: tuple[Side, Side] | None = None
         # the comparison (s0*(v) at five speeds for both sets: seconds) is computed when the
         # view is shown or asked for, not for every session opened with a variant in its link
