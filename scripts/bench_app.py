@@ -296,6 +296,9 @@ async def screenshots(browser, url: str) -> None:
         await page.locator(".stability-status", has_text=word).wait_for()
         await page.wait_for_function(f"() => !({LOCUS_TITLE})().includes('computing')",
                                      polling=100, timeout=300_000)  # the dense locus is shown
+        if case == "unstable":  # the required anti-slip reaction time (≈ 20 nonlinear runs)
+            await page.locator(".reaction-status", has_text="after detection").wait_for(
+                timeout=300_000)
         await wait_idle(page)
         await page.screenshot(path=str(out / f"{case}.png"), full_page=True)
         if case == "stable":
