@@ -355,8 +355,8 @@ def locus_jumps(values: np.ndarray, eigenvalues: np.ndarray) -> np.ndarray:
     shares of the sweep's spans, as they appear on the plot) and more than LOCUS_JUMP_SIDE times
     as fast as one of its neighbouring steps (a branch accelerating into a collision with
     another one grows its steps geometrically, 10, 16, 50 [1/s], and no grid resolves the last
-    ones).  The plots break the line there instead of drawing a straight
-    segment across the plane; the points themselves stay."""
+    ones).  The plots break the line there instead of drawing a straight segment across the
+    plane; the points themselves stay."""
     steps = _plot_steps(eigenvalues)
     if len(steps) < 3:
         return np.zeros(steps.shape, dtype=bool)

@@ -113,8 +113,8 @@ def step_matrices(W, E, P0, P1, D1, V, n_creep) -> _Blocks:
     return _Blocks(W, E, E[:, None] * P1 + P0, D1, P1, V, np.arange(W.shape[0]) < n_creep)
 
 
-def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, P1, p0_2,
-          p1_2, W, D1, contact_scale, law_params, s0, v, N0, mu_s0, dmu_s0, tangent,
+def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, p0_2, p1_2,
+          contact_scale, law_params, s0, v, N0, mu_s0, dmu_s0, tangent,
           detect_rows, threshold, det_state, M_step, delay, rate, floor, Y_out, z_out,
           phi_out, u2_out, iterations, n_creep, blocks):
     """Steps k0 → k1 (exclusive of k0's state, which is given).  Writes the outputs Re(V ζ)
