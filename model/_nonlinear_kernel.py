@@ -41,17 +41,23 @@ def polach(s: np.ndarray, v: float, mu0: float, A: float, B: float, kA: float, k
            slope: float) -> tuple[np.ndarray, np.ndarray]:
     """Polach's μ(s, v) [-] and ∂μ/∂s [-] (as :class:`model.contact.PolachLaw`: odd in s,
     friction falling with the slip velocity |s|·v [m/s])."""
-    decay = np.exp(-B * v * np.abs(s))
-    mu_f = mu0 * ((1.0 - A) * decay + A)
-    dmu_f = -mu0 * (1.0 - A) * B * v * np.sign(s) * decay
-    eps = slope * s / mu_f
-    deps = slope / mu_f - eps * dmu_f / mu_f
+    Bv = B * v
+    decay = np.exp(-Bv * np.abs(s))
+    c1 = mu0 * (1.0 - A)
+    mu_f = c1 * decay + mu0 * A
+    dmu_f = np.copysign(decay, s)  # sign(s)·decay; at s = 0 its factor F is 0 either way
+    dmu_f *= -c1 * Bv
+    inverse = 1.0 / mu_f
+    eps = (slope * s) * inverse
+    deps = (slope - eps * dmu_f) * inverse
     a = kA * eps
     k = kS * eps
-    aa = 1.0 + a * a
+    a2 = a * a
+    aa = 1.0 + a2
     F = a / aa + np.arctan(k)
-    dF = kA * (1.0 - a * a) / (aa * aa) + kS / (1.0 + k * k)
-    return (2.0 / math.pi) * mu_f * F, (2.0 / math.pi) * (dmu_f * F + mu_f * dF * deps)
+    dF = kA * (1.0 - a2) / (aa * aa) + kS / (1.0 + k * k)
+    c = 2.0 / math.pi
+    return c * mu_f * F, c * (dmu_f * F + mu_f * dF * deps)
 
 
 def _toeplitz(W: np.ndarray, E: np.ndarray, Q: np.ndarray, D1: np.ndarray, L: int) -> np.ndarray:
