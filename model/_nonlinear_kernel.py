@@ -80,8 +80,9 @@ class _Blocks:
     patterns of a block."""
 
     def __init__(self, W, E, Q, D1, P1, V, creep):
-        self.W, self.E, self.Q, self.D1, self.P1 = W, E, Q, D1, P1
-        nc = W.shape[0]
+        self.Q, self.P1 = Q, P1
+        self.channels = nc = W.shape[0]
+        self.creep = creep  # channels: creep (True) or ID2's slope torque
         self.rows_out = V.shape[0]
         self.full = _toeplitz(W, E, Q, D1, SUB_STEPS)
         # the Newton matrix's part: T without the within-step coupling between channels
@@ -103,7 +104,7 @@ class _Blocks:
     def newton_matrix(self, L: int, slopes: np.ndarray) -> np.ndarray:
         """Newton's Jacobian T_triangular diag(r') − I of the first L steps, in a buffer of the
         run (overwritten by the next call)."""
-        n = L * self.W.shape[0]
+        n = L * self.channels
         J = self._newton.get(L)
         if J is None:
             J = self._newton[L] = np.empty((n, n))
@@ -122,7 +123,7 @@ def step_matrices(W, E, P0, P1, D1, V, n_creep) -> _Blocks:
 def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, p0_2, p1_2,
           contact_scale, law_params, s0, v, N0, mu_s0, dmu_s0, tangent,
           detect_rows, threshold, det_state, M_step, delay, rate, floor, Y_out, z_out,
-          phi_out, u2_out, iterations, n_creep, blocks):
+          phi_out, u2_out, iterations, blocks):
     """Steps k0 → k1 (exclusive of k0's state, which is given).  Writes the outputs Re(V ζ)
     (``blocks``' V), contact velocities, remainder forces and ΔM_2 of steps k0+1 … k1 into rows
     0 … of ``Y_out``, ``z_out``, ``phi_out``, ``u2_out``; updates zeta, phi, z, u2_now, det_state
@@ -130,7 +131,7 @@ def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, 
     failed (negative)."""
     nc = z.shape[0]
     law = tuple(float(x) for x in law_params)
-    creep = np.arange(nc) < n_creep
+    creep = blocks.creep
     detect = np.asarray(detect_rows, dtype=float)
     scale = float(contact_scale)
     slope = np.zeros(nc)  # r'(z) of the given step (Newton's start of the first block)

@@ -408,7 +408,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
                        complex(1.0), setup.P0, setup.p0_2, setup.p1_2, scale, law_params, op.s0,
                        op.v, op.N0, mu_s0, dmu_s0, creep == "tangent", detect_rows, threshold,
                        det_state, step, delay, rate, floor, Y_out, z_out, phi_out, u2_out,
-                       iterations, len(rims), blocks)
+                       iterations, blocks)
         if status < 0:
             raise NonlinearError(f"the creep-force iteration did not converge at t = "
                                  f"{-status * h:.6g} s")

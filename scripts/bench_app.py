@@ -39,6 +39,7 @@ import random
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -266,8 +267,6 @@ async def session(page, seed: int, presses: int) -> list[float]:
 async def variant_screenshot(page, path: Path) -> None:
     """The Variant tab with a variant (driving shaft 30 % softer) uploaded and compared with the
     baseline; then back to the baseline and the Response tab."""
-    import tempfile
-
     from model.parameters import dumps_parameters, load_parameters
 
     await page.locator(".bk-tab", has_text="Variant").first.click()
