@@ -250,9 +250,9 @@ class NonlinearView:
         self.update()
 
     def prefetch(self, state) -> None:
-        """Served: start the nonlinear history of ``state`` beside the linear first answer (it
-        waits for, then shares, the operating point's eigendecomposition; its result is cached
-        for :meth:`on_fast`).  Before, it started only once the linear answer was shown."""
+        """Served: start the nonlinear history of ``state`` as soon as the linear first answer
+        is computed (it shares the operating point's eigendecomposition; its result is cached for
+        :meth:`on_fast`), before that answer is sent and drawn."""
         if self.creep.value != "nonlinear":
             return
         key = self._key(state)
