@@ -216,7 +216,22 @@ def protocol_clients(url: str, count: int) -> None:
             locus = [doc.get_model_by_name("locus_points")]
             s0, n0 = control("s0"), control("N0")
             change(n0, 60.0 + index, locus)  # own wheel force [kN]: no shared cache hits
-            time.sleep(2.0)  # let the session's s0*(v) finish
+            # settled as the single session (wait_settled): the dense root locus and s0*(v) of
+            # the new N0 shown, else the first clients' steps are measured beside the other
+            # clients' follow-ups (≈ 3 CPU-s each), not beside their steps
+            title = doc.get_model_by_name("root-locus").title
+
+            def settled() -> bool:
+                texts = [getattr(m, "text", None) for m in doc.models]
+                return ("computing" not in title.text
+                        and not any(isinstance(t, str) and "s0*(v): computing" in t
+                                    for t in texts))
+            deadline = time.perf_counter() + 300.0
+            session._connection._loop_until(
+                lambda: settled() or time.perf_counter() > deadline)
+            if not settled():
+                raise TimeoutError(f"client {index}: the new N0's follow-ups not done in 300 s")
+            time.sleep(1.0)
         except Exception as error:  # reported; the run fails
             failures.append(repr(error))
             ready.abort()
@@ -371,7 +386,7 @@ async def pages_at_once(browser, url: str, args, results: dict) -> None:
     log(f"{args.sessions} sessions: own wheel forces")
     await asyncio.gather(*(settle_n0(pg, 2 + i) for i, pg in enumerate(pages)))
     for pg in pages:
-        await wait_idle(pg)
+        await wait_settled(pg)
 
     log(f"{args.sessions} sessions: s0 steps")
     cpu_server, cpu_browser = cpu_seconds("bogie serve"), cpu_seconds("chrom")
@@ -400,7 +415,7 @@ async def page_among_clients(browser, url: str, args, results: dict) -> None:
     try:
         page = await open_page(browser, url)
         await settle_n0(page, 2 + args.sessions)  # an N0 no other session has
-        await wait_idle(page)
+        await wait_settled(page)
         line = await asyncio.to_thread(load.stdout.readline)
         if line.strip() != "ready":
             raise SystemExit(f"bench_app: protocol clients failed: {line.strip()}")
