@@ -472,6 +472,7 @@ def main() -> None:
     results = asyncio.run(run(args))
     if args.only_screenshots:
         return
+    print(served_app.machine_yardstick())
     single = statistics.median(results["single_fast_s"])
     if results["single_isolated_s"]:
         isolated = results["single_isolated_s"]

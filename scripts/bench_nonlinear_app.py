@@ -22,6 +22,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import served_app
 from bench_app import ARGS, CHROMIUM, DATA, FAST, free_port, log, open_page, settle_n0, start_server, wait_settled
 
 NONLINEAR = f"() => ({DATA})('nonlinear', 'y:ID1.disc_clutch.torque')"
@@ -76,6 +77,7 @@ def main() -> None:
     args = parser.parse_args()
     results = asyncio.run(run(args))
     linear, nonlinear = results["linear_s"], results["nonlinear_s"]
+    print(served_app.machine_yardstick())
     print(f"one session, {args.presses} s0 steps with the creep model on nonlinear:")
     print(f"  linear result on screen:    median {1e3 * statistics.median(linear):.0f} ms "
           f"(min {1e3 * min(linear):.0f}, max {1e3 * max(linear):.0f})")

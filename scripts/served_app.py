@@ -51,3 +51,27 @@ def start_server(port: int, name: str) -> subprocess.Popen:
         process.kill()
         raise SystemExit(f"{name}: the server did not come up")
     return process
+
+
+def machine_yardstick() -> str:
+    """This machine's speed in the dashboard's main unit of work, for comparing latencies
+    measured on different machines: one cold eigen-analysis with vectors at the default point
+    (s0 = 0.005, 120 km/h, one BLAS thread; best of 5) [ms], and the load average."""
+    from threadpoolctl import threadpool_limits
+
+    from model import KMH, build_model, eigen_analysis, load_parameters
+    from model.eigen import forget_systems
+    from model.operating_point import OperatingPoint
+
+    parameters = load_parameters()
+    model = build_model(parameters)
+    op = OperatingPoint(0.005, 120 * KMH, parameters["wheel_force"], parameters["motor_slope"])
+    times = []
+    with threadpool_limits(1):
+        for _ in range(5):
+            forget_systems(model)
+            start = time.perf_counter()
+            eigen_analysis(model, op)
+            times.append(time.perf_counter() - start)
+    return (f"machine: one eigen-analysis with vectors {min(times) * 1e3:.1f} ms (best of 5, one "
+            f"BLAS thread), {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}")
