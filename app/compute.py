@@ -310,20 +310,25 @@ def dense_locus_result(params_path: str, rail: str, parameter: str, fixed: float
     return _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=True)
 
 
+def _step_lengths(eigenvalues: np.ndarray, re_unit: float, im_unit: float) -> np.ndarray:
+    """(n_points - 1, n_branches) step lengths of the branches, Re counted in ``re_unit`` and
+    Im in ``im_unit`` [1/s]."""
+    steps = np.diff(eigenvalues, axis=0)
+    return np.hypot(steps.real / re_unit, steps.imag / im_unit)
+
+
 def _plot_shares(eigenvalues: np.ndarray) -> np.ndarray:
-    """(n_points - 1, n_branches) step lengths as shares of the plot: Re and Im divided by the
-    sweep's spans of Re and Im (the axes' extent when the whole sweep is shown)."""
+    """Step lengths as shares of the plot: Re and Im divided by the sweep's spans of Re and Im
+    (the axes' extent when the whole sweep is shown)."""
     finite = eigenvalues[np.isfinite(eigenvalues)]
     spans = [np.ptp(part) if finite.size and np.ptp(part) > 0 else 1.0
              for part in (finite.real, finite.imag)]
-    steps = np.diff(eigenvalues, axis=0)
-    return np.hypot(steps.real / spans[0], steps.imag / spans[1])
+    return _step_lengths(eigenvalues, *spans)
 
 
 def _plot_steps(eigenvalues: np.ndarray) -> np.ndarray:
-    """(n_points - 1, n_branches) step lengths in plot units (Re [1/s], Im [Hz])."""
-    steps = np.diff(eigenvalues, axis=0)
-    return np.hypot(steps.real, steps.imag / (2 * math.pi))
+    """Step lengths in plot units (Re [1/s], Im [Hz])."""
+    return _step_lengths(eigenvalues, 1.0, 2 * math.pi)
 
 
 def refine_grid(values: np.ndarray, eigenvalues: np.ndarray, n_points: int) -> np.ndarray:
