@@ -301,7 +301,7 @@ def build_model(parameters: Parameters) -> BogieModel:
             axis_springs((0, 0, 0), (0, p["secondary_damping_y"], 0))))
         asm.add_connection(SpringDamper(
             "secondary.yaw_damper", "secondary", frame, car_body,
-            np.array([0.0, side * p["yaw_damper_half_base_y"], sh]),
+            np.array([0.0, side * p["yaw_damper_half_base_y"], p["yaw_damper_height"]]),
             axis_springs((0, 0, 0), (p["yaw_damping"], 0, 0))))
 
     # healthy motor (ID2): torque depends on the rotor's speed relative to the stator

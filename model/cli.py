@@ -217,7 +217,7 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
     out = Path(args.out) if args.out else CALIBRATED_FILE
     if not out.parent.is_dir():
         raise UsageError(f"directory '{out.parent}' does not exist")
-    run(start, out, max_evaluations=args.max_evaluations,
+    run(start, out, max_evaluations=args.max_evaluations, scale=args.budget_scale,
         progress=lambda text: print(text, file=sys.stderr if args.json else sys.stdout, flush=True))
 
 
@@ -267,9 +267,13 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("calibrate", help="fit the uncertain parameters to the published results")
     p.add_argument("--start", default=None, metavar="FILE", help="starting set (default: estimate.toml)")
     p.add_argument("--out", default=None, metavar="FILE", help="output (default: calibrated.toml)")
-    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=600,
-                   help="eigen-analyses of the structural stage's pattern search "
-                        "(default %(default)s)")
+    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=2400,
+                   help="trial parameter sets of the pattern search, each up to three "
+                        "eigen-analyses (default %(default)s)")
+    p.add_argument("--budget-scale", type=number("--budget-scale", 0.001, 10, high_open=False,
+                                                 allowed="must be in (0.001, 10]"),
+                   default=1.0, help="multiply the evaluation budgets of stages D-F (the ranking; "
+                                     "default %(default)s; smaller for a quick check)")
     p.add_argument("--json", action="store_true", help="progress to stderr")
     p.set_defaults(func=cmd_calibrate)
 

@@ -53,6 +53,7 @@ SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "secondary_half_base_y": ("m", "lateral half distance of the secondary springs", _POS),
     "secondary_height": ("m", "height of the secondary spring seats above the axle centres", (-2, 2, False)),
     "yaw_damper_half_base_y": ("m", "lateral half distance of the longitudinal (yaw) dampers", _POS),
+    "yaw_damper_height": ("m", "height of the yaw dampers' line of action above the axle centres", (-2, 2, False)),
     "gear_radius": ("m", "pitch radius of the driven gear; pinion radius = gear_radius/gear_ratio", _POS),
     "gear_ratio": ("1", "gear ratio p = rotor speed / wheel speed", _POS),
     "pressure_angle": ("rad", "working pressure angle of the gear mesh", (0.0, 0.8, False)),

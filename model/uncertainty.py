@@ -90,26 +90,28 @@ class UncertainParameter:
 
 
 UNCERTAIN_PARAMETERS: tuple[UncertainParameter, ...] = (
-    UncertainParameter("creep_slope", 400.0, 800.0, "published characteristic needs ~600 "
-                       "(docs/model.md); Hertz+Kalker would give ~130, so ±1/3 around the fit"),
-    # the creep law keeps a maximum below s = 1 at 120–200 km/h over this box (checked on a grid:
-    # with A = 0.8 and B >= 2.3 s/m at slope 400 it has none, and s0* would need the full search)
-    UncertainParameter("polach_A", 0.5, 0.78, "Polach's presets 0.4; calibrated 0.70"),
-    UncertainParameter("polach_B", 0.8, 2.2, "Polach's presets 0.2–0.6 s/m; calibrated 1.72"),
-    UncertainParameter("motor_slope", 1000.0, 10000.0, "torque falls 12.8 kN m over 0.6–6 % of "
-                       "208 rad/s (converter control unknown)"),
+    UncertainParameter("creep_slope", 850.0, 1700.0, "the calibrated creep shape (kA 0.76, kS "
+                       "0.24) needs ~1 270 (docs/validation.md); Hertz+Kalker would give ~130, "
+                       "so ±1/3 around the fit"),
+    # the creep law keeps a maximum below s = 1 over this box (checked on a grid of 5 values each
+    # of slope, A and B at 40–250 km/h: only the corner slope 850, A 0.78, B 2.2 s/m at 250 km/h
+    # has none, and there s0* takes the full search)
+    UncertainParameter("polach_A", 0.5, 0.78, "Polach's presets 0.4; calibrated 0.69"),
+    UncertainParameter("polach_B", 0.8, 2.2, "Polach's presets 0.2–0.6 s/m; calibrated 1.47"),
+    UncertainParameter("motor_slope", 1000.0, 12000.0, "torque falls 12.8 kN m over 0.5–6 % of "
+                       "213 rad/s (converter control unknown); calibrated 11 000"),
     UncertainParameter("rubber_loss_time", 1e-4, 4e-4, "rubber loss factor 0.05–0.2 at ~80 Hz",
                        log=False),
     UncertainParameter("disc_clutch_torsional_stiffness", 4e4, 1e5, "rubber disc clutch; "
-                       "calibrated 6.3e4 from the 2.7 Hz mode"),
-    UncertainParameter("driving_shaft_stiffness", 6e6, 1.2e7, "quill shaft; calibrated 8.9e6 "
+                       "calibrated 7.1e4 from the 2.7 Hz mode"),
+    UncertainParameter("driving_shaft_stiffness", 6e6, 1.2e7, "quill shaft; calibrated 8.6e6 "
                        "from the 298 Hz mode"),
     UncertainParameter("rotor_inertia", 8.0, 18.0, "550 kg rotor, radius of gyration 0.12–0.18 m"),
-    UncertainParameter("silent_block_stiffness_x", 1.5e6, 6e6, "rubber-metal block, calibrated "
-                       "2.9e6 (×/÷ 2)"),
-    UncertainParameter("primary_stiffness_x", 1.7e6, 7e6, "longitudinal guide, calibrated 3.5e6 "
-                       "(×/÷ 2)"),
-    UncertainParameter("yaw_damping", 1.4e5, 5.4e5, "yaw damper, calibrated 2.7e5 (×/÷ 2)"),
+    UncertainParameter("silent_block_stiffness_x", 7.9e6, 2.4e7, "rubber-metal block, "
+                       "calibrated 1.58e7 (÷ 2; up to the calibration's bound 2.4e7)"),
+    UncertainParameter("primary_stiffness_x", 1.7e6, 7e6, "longitudinal guide, calibrated 3.2e6 "
+                       "(about ×/÷ 2)"),
+    UncertainParameter("yaw_damping", 5e5, 2e6, "yaw damper, calibrated 1.0e6 (×/÷ 2)"),
     UncertainParameter("gear_mesh_stiffness", 7.5e8, 3e9, "~7–30 N/(µm mm) × 100 mm face width"),
 )
 
