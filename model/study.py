@@ -182,7 +182,10 @@ def _reduced_limit(line_model, s0_values, growth, xtol: float, evaluations: int 
     Brent's method from the grid bracket took 9–12 evaluations.  Here the secant steps follow
     the real part of the crossing branch: the top eigenvalue at the grid point above the
     crossing, extrapolated linearly (slope from the next grid point, then from the last two
-    evaluations), and at each evaluation the eigenvalue nearest to the extrapolation.  Each step
+    evaluations), and at each evaluation the eigenvalue nearest to the extrapolation among those
+    that moved since the grid point below the crossing (the slow creeping modes sit near 0 and do
+    not move; the extrapolation is ≈ 0 at a secant root, so without that they were taken for the
+    branch and the steps crawled by xtol/4: 21 evaluations at 250 km/h).  Each step
     stays inside the bracket (regula falsi on g where the branch's secant leaves it) and is at
     least xtol/4 long, so that the bracket closes once the iterate has converged: 3–8
     evaluations measured.  Brent's method on the remaining bracket after ``evaluations``."""
@@ -199,10 +202,19 @@ def _reduced_limit(line_model, s0_values, growth, xtol: float, evaluations: int 
     x = known[0] - known[1].real / slope.real if slope.real > 0 else np.nan
     if not lo < x < hi:
         x = lo - g_lo * (hi - lo) / (g_hi - g_lo)  # regula falsi on the grid bracket
+    steady = line_model.grid_values[i - 1] if len(line_model.grid_values) == len(s0_values) \
+        else np.zeros(0, dtype=complex)
     for _ in range(evaluations):
         gx = line_model.point(x)[0][0]
         values = line_model.values
-        branch = values[np.argmin(np.abs(values - (known[1] + slope * (x - known[0]))))]
+        # the branch moves by about |slope| (x - s_below) since the grid point below; a value
+        # within 1 % of that from one there did not move: a slow mode, not the branch
+        moved = values
+        if len(steady):
+            shift = np.min(np.abs(values[:, None] - steady[None, :]), axis=1)
+            moved = values[shift > 0.01 * abs(slope) * (x - s0_values[i - 1])]
+        candidates = moved if len(moved) else values
+        branch = candidates[np.argmin(np.abs(candidates - (known[1] + slope * (x - known[0]))))]
         if x != known[0]:
             slope, known = (branch - known[1]) / (x - known[0]), (x, branch)
         if gx > 0:
@@ -310,6 +322,7 @@ class _LineModel:
         self._start = np.random.default_rng(0).standard_normal(r)  # inverse iteration start
         self.values = np.zeros(0, dtype=complex)  # the last point's eigenvalues [1/s]
         self.top_values = np.zeros(0, dtype=complex)  # the top eigenvalue at each grid point
+        self.grid_values: list[np.ndarray] = []  # all eigenvalues at each grid point [1/s]
         # [1/s] (set by reduced_s0_line; the s0* search follows the crossing branch from it)
 
     def _ritz_vectors(self, lam: np.ndarray, C: np.ndarray) -> np.ndarray:
@@ -497,6 +510,7 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     rows = []
     dense = np.zeros(n, dtype=bool)
     line_model.top_values = np.zeros(n, dtype=complex)  # the top eigenvalue at each point
+    line_model.grid_values = []
     for i in range(n):
         if i in solved:
             values = solved[i]
@@ -507,6 +521,7 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
             rows.append(summary)
             values = line_model.values
         line_model.top_values[i] = values[np.argmax(values.real)]
+        line_model.grid_values.append(values)
     growth = np.array([r[0] for r in rows])
     limit = _line_limit(model, line_model, s0_values, growth, v, N0, b_M, s0_limit_xtol)
     return LineResult(s0_values, v, N0, b_M, growth, np.array([r[1] for r in rows]),
