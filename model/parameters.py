@@ -196,7 +196,12 @@ def parse_parameters(table: Mapping[str, object], source: str = "<memory>") -> P
         notes[name] = str(entry.get("note", ""))
     missing = [name for name in SCHEMA if name not in values]
     if missing:
-        raise ParameterError(f"{source}: missing parameter(s) {', '.join(missing)}")
+        hint = ""
+        if "yaw_damper_height" in missing:  # a set written before the parameter existed
+            hint = ("; yaw_damper_height (m, added with the calibration by rank) was the "
+                    "secondary spring height in earlier sets: yaw_damper_height = { value = "
+                    "<secondary_height>, unit = \"m\" } reproduces them")
+        raise ParameterError(f"{source}: missing parameter(s) {', '.join(missing)}{hint}")
     if values["polach_kS"] > values["polach_kA"]:
         raise ParameterError(f"{source}: polach_kS must not exceed polach_kA")
     if values["hollow_shaft_inner_radius"] >= values["hollow_shaft_outer_radius"]:

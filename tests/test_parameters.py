@@ -124,6 +124,15 @@ def test_bad_tables_raise_parameter_error_naming_the_problem(table, how, message
         parse_parameters(_break(table, how), source="test.toml")
 
 
+def test_a_set_from_before_the_yaw_damper_height_says_how_to_update_it(table):
+    """Sets written before issue 11 lack yaw_damper_height: the error names it and how to
+    reproduce the earlier model (the dampers then sat at the secondary spring height)."""
+    del table["yaw_damper_height"]
+    with pytest.raises(ParameterError, match=r"missing parameter\(s\) yaw_damper_height;.*"
+                                             r"secondary spring height"):
+        parse_parameters(table, source="old.toml")
+
+
 def test_errors_from_files_name_the_file(table, tmp_path):
     path = tmp_path / "broken.toml"
     path.write_text(dumps_parameters(parse_parameters(table)).replace(
