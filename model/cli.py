@@ -268,8 +268,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--start", default=None, metavar="FILE", help="starting set (default: estimate.toml)")
     p.add_argument("--out", default=None, metavar="FILE", help="output (default: calibrated.toml)")
     p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=2400,
-                   help="trial parameter sets of the pattern search, each up to three "
-                        "eigen-analyses (default %(default)s)")
+                   help="trial parameter sets of stages B1 and B2 (the characters, then Table 1 "
+                        "by rank), each up to three eigen-analyses (default %(default)s)")
     p.add_argument("--budget-scale", type=number("--budget-scale", 0.001, 10, high_open=False,
                                                  allowed="must be in (0.001, 10]"),
                    default=1.0, help="multiply the evaluation budgets of stages D-F (the ranking; "

@@ -166,6 +166,23 @@ def test_bad_export_target(capsys, tmp_path, monkeypatch, arguments):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize(("arguments", "mention"), [
+    pytest.param(["--budget-scale", "0"], "--budget-scale", id="budget scale 0"),
+    pytest.param(["--budget-scale", "11"], "--budget-scale", id="budget scale above 10"),
+    pytest.param(["--max-evaluations", "0"], "--max-evaluations", id="no evaluations"),
+    pytest.param(["--out", "/no/such/directory/set.toml"], "does not exist", id="missing dir"),
+    pytest.param(["--start", "/no/such/start.toml"], "does not exist", id="missing start"),
+])
+def test_bad_calibrate_arguments_change_nothing(capsys, tmp_path, monkeypatch, arguments,
+                                                mention):
+    """Rejected before any search: one line, exit 2, no file written."""
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(["calibrate", *arguments], capsys)
+    assert_one_line_error(code, out, err)
+    assert mention in err
+    assert list(tmp_path.iterdir()) == []
+
+
 # a process start costs ~1–2 s (numpy, scipy): one case in the fast set, the others slow
 @pytest.mark.parametrize("arguments", [
     pytest.param(["eigen", "--s0", "1.5"], id="creepage"),
