@@ -5,9 +5,11 @@ catch a lost or wrong root.  Real components, no mocks.
 
 Tolerances.  Both sides carry rounding errors of the order of eps·‖A‖·cond(λ): ‖A‖ ≈ 3·10⁵ 1/s
 (|λ| up to 3·10⁵ 1/s), so the two computations of one eigenvalue differ by more than eps·|λ|.
-Measured on 100-point lines at 40, 120 and 250 km/h: at most 6.5·10⁻⁹ relative to
-max(|λ|, 1 1/s) (the ill-conditioned near-twin eigenvalues), largest real part within 4.2·10⁻⁹
-1/s.  EIG_RTOL = 2·10⁻⁸ and GROWTH_ATOL = 10⁻⁷ 1/s leave a factor 3 and 20 to these.  s0*: both
+Measured on 100-point lines at 40, 120 and 250 km/h (the set calibrated by rank, issue 11): at
+most 2.6·10⁻⁸ / 1.9·10⁻⁸ / 1.5·10⁻⁸ relative to max(|λ|, 1 1/s), at the ill-conditioned
+near-twin eigenvalues (the ID1/ID2 twins near 3·10⁵ 1/s, closer on this set than on the previous
+one, which gave at most 6.5·10⁻⁹), largest real part within 3.4·10⁻⁹ 1/s.  EIG_RTOL = 8·10⁻⁸
+and GROWTH_ATOL = 10⁻⁷ 1/s leave a factor 3 and 30 to these.  s0*: both
 searches stop within xtol = 10⁻⁶, so they differ by at most 2·10⁻⁶.
 """
 
@@ -29,7 +31,7 @@ from model.eigen import state_matrix
 from model.operating_point import OperatingPoint
 from model.study import dense_line, s0_line, spectrum_summary
 
-EIG_RTOL = 2e-8
+EIG_RTOL = 8e-8
 GROWTH_ATOL = 1e-7
 LIMIT_ATOL = 2e-6
 
