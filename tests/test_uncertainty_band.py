@@ -5,8 +5,8 @@ result assembled from plain arrays: the band's logic needs the provenance and th
 not a model run; a real CLI run is in tests/test_posterior.py).  Checked: a result of the set
 and conditions on screen draws its 5–95 % band and median at its speeds, with the method and
 sample count in the legend; a different wheel force, motor slope, rail condition or parameter
-set clears the band and the notice says which; a result without provenance (the older format
-of assets/data/uncertainty_n16.json) is not drawn; a bad file keeps the previous band; with a
+set clears the band and the notice says which; a result without provenance (the older format:
+the stored study with its hash removed) is not drawn; a bad file keeps the previous band; with a
 map on screen the map's set and conditions count.
 """
 
@@ -28,6 +28,7 @@ from model.parameters import parameter_hash
 from model.uncertainty import UNCERTAIN_PARAMETERS, UncertaintyResult, output_names, output_units
 
 SPEEDS = (40.0, 120.0, 200.0)
+B_M = compute.parameters("", "calibrated")["motor_slope"]  # the set's b_M [N m s/rad]
 
 
 def _result_file(path: Path, parameters, method="posterior", names=None, seed=3) -> Path:
@@ -61,7 +62,7 @@ def dash():
 @pytest.fixture
 def view(dash):
     with param.parameterized.discard_events(dash):
-        dash.N0, dash.b_M, dash.rail = 100.0, 3000.0, "calibrated"
+        dash.N0, dash.b_M, dash.rail = 100.0, B_M, "calibrated"
     view = dash.studies
     view.map, view.uncertainty = None, None
     view.plot.band.update(None)
@@ -71,7 +72,7 @@ def view(dash):
 
 def test_matching_result_draws_its_band(view, dash, tmp_path):
     parameters = compute.parameters("", "calibrated")
-    assert (parameters["wheel_force"], parameters["motor_slope"]) == (100e3, 3000.0)
+    assert parameters["wheel_force"] == 100e3
     path = _result_file(tmp_path / "u.json", parameters)
     band = read_band(path)
     view.uncertainty_path.value = str(path)
@@ -102,7 +103,7 @@ def test_matching_result_draws_its_band(view, dash, tmp_path):
 
 @pytest.mark.parametrize(("change", "reason"), [
     ({"N0": 120.0}, "wheel force N0: result 100 kN, screen 120 kN"),
-    ({"b_M": 2000.0}, "motor slope b_M: result sampled around 3000 N m s/rad, screen 2000"),
+    ({"b_M": 2000.0}, f"motor slope b_M: result sampled around {B_M:g} N m s/rad, screen 2000"),
     ({"rail": "wet"}, "rail condition: result 'calibrated', screen 'wet'"),
 ])
 def test_other_conditions_clear_the_band_and_say_why(view, dash, tmp_path, change, reason):
@@ -117,7 +118,7 @@ def test_other_conditions_clear_the_band_and_say_why(view, dash, tmp_path, chang
     assert reason in view.band_notice.object
     assert "does not match the dashboard's set" in view.band_notice.object
     with param.parameterized.discard_events(dash):
-        dash.N0, dash.b_M, dash.rail = 100.0, 3000.0, "calibrated"
+        dash.N0, dash.b_M, dash.rail = 100.0, B_M, "calibrated"
     view.check_band()
     assert view.plot.band.shown
     assert not view.band_notice.visible
@@ -139,7 +140,13 @@ def test_other_parameter_set_and_old_format_are_not_drawn(view, tmp_path):
     assert not view.plot.band.shown
     assert "parameter set: result" in view.band_notice.object
     assert "re-calibrated" in view.band_notice.object
-    old = Path(__file__).resolve().parent.parent / "assets" / "data" / "uncertainty_n16.json"
+    # a result written before studies recorded their set: the stored study without its hash
+    stored = json.loads((Path(__file__).resolve().parent.parent / "assets" / "data"
+                         / "uncertainty_n16.json").read_text(encoding="utf-8"))
+    stored.pop("parameters_hash")
+    stored.pop("conditions", None)
+    old = tmp_path / "old.json"
+    old.write_text(json.dumps(stored), encoding="utf-8")
     view.open_uncertainty(str(old))
     assert not view.plot.band.shown
     assert "does not say which parameter set" in view.band_notice.object
@@ -165,7 +172,7 @@ def test_the_map_on_screen_decides(view, tmp_path):
     view.open_uncertainty(str(_result_file(tmp_path / "u.json", parameters)))
     assert view.plot.band.shown
 
-    def map_view(hash_, N0=100e3, b_M=3000.0):
+    def map_view(hash_, N0=100e3, b_M=B_M):
         return MapView(np.array([0.005, 0.01]), np.array([40.0, 200.0]), np.zeros((2, 2)),
                        np.full(2, np.nan), 2, 2, {"parameters_hash": hash_}, N0, b_M)
 
@@ -185,6 +192,6 @@ def test_band_mismatch_without_sampled_motor_slope(tmp_path):
     band = read_band(_result_file(tmp_path / "u.json", parameters, method="prior", names=names))
     assert band.method == "prior"
     assert not band.motor_slope_sampled
-    assert band_mismatch(band, parameter_hash(parameters), 100e3, 3000.0, "calibrated") is None
+    assert band_mismatch(band, parameter_hash(parameters), 100e3, B_M, "calibrated") is None
     reason = band_mismatch(band, parameter_hash(parameters), 100e3, 2000.0, "calibrated")
-    assert reason == "motor slope b_M: result 3000 N m s/rad, screen 2000 N m s/rad"
+    assert reason == f"motor slope b_M: result {B_M:g} N m s/rad, screen 2000 N m s/rad"
