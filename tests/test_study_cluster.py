@@ -85,6 +85,17 @@ def study_and_reference():
     return parameters, study, run_serial(study, parameters)
 
 
+@pytest.fixture(scope="module")
+def long_study_reference():
+    """24 speed lines (chunks): on the set calibrated by rank a chunk of 8 points takes ~0.5 s, so
+    6 chunks finished within ~1 s of each other and a Ctrl-C after the first came too late; with
+    24 the study runs ~7 s on two workers after its first chunk."""
+    parameters = load_parameters()
+    study = MapStudy(np.linspace(0.002, 0.016, 8), np.linspace(50, 240, 24) * KMH,
+                     [parameters["wheel_force"]], [parameters["motor_slope"]])
+    return run_serial(study, parameters)
+
+
 def _assert_equal_to_reference(path, reference):
     dataset = open_study(path)
     assert (dataset["chunk_done"].values == 1).all()
@@ -138,11 +149,11 @@ def test_worker_killed_mid_study(cluster, study_and_reference, tmp_path):
     _assert_equal_to_reference(tmp_path / "k.zarr", reference)
 
 
-def test_interrupt_then_resume_recomputes_nothing_finished(cluster, study_and_reference,
+def test_interrupt_then_resume_recomputes_nothing_finished(cluster, long_study_reference,
                                                             tmp_path):
-    _parameters, _study, reference = study_and_reference
+    reference = long_study_reference
     out = tmp_path / "r.zarr"
-    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:8", "--v", "50:240:6",
+    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:8", "--v", "50:240:24",
             "--out", str(out), "--scheduler", cluster, "--connect-timeout", "30", "--json"]
     process = subprocess.Popen(argv, cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
@@ -180,8 +191,8 @@ def test_ctrl_c_with_the_local_cluster_stops_everything_cleanly(tmp_path):
     processes): exit 130, one message and no traceback, no process of the group left; the
     resume on the default local cluster finishes the rest."""
     out = tmp_path / "c.zarr"
-    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:6", "--v", "50:240:6",
-            "--out", str(out), "--json"]
+    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:6", "--v", "50:240:24",
+            "--out", str(out), "--json"]  # 24 chunks: see long_study_reference
     process = subprocess.Popen(argv, cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, start_new_session=True)
     deadline = time.monotonic() + 300
@@ -202,7 +213,7 @@ def test_ctrl_c_with_the_local_cluster_stops_everything_cleanly(tmp_path):
     resumed = subprocess.run([*argv, "--resume"], cwd=ROOT, env=ENV, capture_output=True,
                              text=True, timeout=600)
     assert resumed.returncode == 0, resumed.stderr
-    assert json.loads(resumed.stdout)["computed_chunks"] == 6 - finished
+    assert json.loads(resumed.stdout)["computed_chunks"] == 24 - finished
 
 
 def test_uncertainty_study_on_the_cluster_equals_serial(cluster):
