@@ -97,10 +97,14 @@ def test_against_finite_differences(setup, s0):
         if name == "polach_kA":  # at its upper bound 1: the law is analytic beyond it
             h = min(h, 0.01)
         ev = {c: _eigenvalues(parameters, model, op, name, value + c * h / 4)
-              for c in (-32, -16, -8, -4, -2, -1, 1, 2, 4, 8, 16, 32)}
+              for c in (-32, -16, -8, -4, -2, -1, -0.5, 0.5, 1, 2, 4, 8, 16, 32)}
         pick = lambda e, target: e[np.argmin(np.abs(e - target))]  # noqa: E731
         errors = []
-        for k in (1, 2, 4, 8, 16):  # steps h/4 … 4h: the best step of the reference is not known
+        # steps h/8 … 4h: the best step of the reference is not known.  h/8 since the set
+        # calibrated by rank: its wheelsets' yaw pair (12.04 / 12.07 Hz) lies near the frame's
+        # lateral–roll (12.42 Hz) and bends strongly with the frame's and motors' roll inertias
+        # (best error at h/4 … 4h 6.9e-5 and 4.0e-5, at h/8 4.7e-6 and 5.1e-6)
+        for k in (0.5, 1, 2, 4, 8, 16):
             fd = np.array([(-pick(ev[2 * k], t) + 8 * pick(ev[k], t) - 8 * pick(ev[-k], t)
                             + pick(ev[-2 * k], t)) / (12 * k * h / 4) for t in lam])
             errors.append(np.abs(analytic - fd).max() / np.abs(fd).max())
