@@ -25,7 +25,11 @@ assignment makes the cost jump where modes trade places, which stalls a gradient
 B1 places the ten characters (:func:`character_cost`), stage B2 minimises :func:`rank_cost`.  An
 evaluation of stage B2 costs one eigen-analysis with vectors at s0 = 0.005 (characters only for the lowest
 :data:`CANDIDATES` pairs), one without at 0.014 and one without just below the limit; the later
-ones are skipped as soon as the partial cost exceeds the best so far.
+ones are skipped as soon as the partial cost exceeds the best so far.  Stages C–F
+(:func:`rank_stages`) then move the modes of other characters out of the band below 12.6 Hz and
+put the ten in Table 1's order, ending on B2's cost with the ranking held
+(:func:`ranked_search_cost`).  Everything is deterministic (fixed move order and budgets):
+``bogie calibrate`` reproduces ``assets/parameters/calibrated.toml`` byte for byte.
 
 The published targets live here, as *targets* of the fit; the model never reads them.
 """
