@@ -87,11 +87,12 @@ def study_and_reference():
 
 @pytest.fixture(scope="module")
 def long_study_reference():
-    """24 speed lines (chunks): on the set calibrated by rank a chunk of 8 points takes ~0.5 s, so
-    6 chunks finished within ~1 s of each other and a Ctrl-C after the first came too late; with
-    24 the study runs ~7 s on two workers after its first chunk."""
+    """48 speed lines (chunks) of 40 points: on the set calibrated by rank a chunk of 8 points
+    takes ~0.5 s, and the Ctrl-C tests' interrupt (sent once the first chunk is finished) came
+    after the end of a 6-chunk study; in the full suite it did with 24 chunks (7 s) too, though
+    not run alone.  This study runs ≈ 20 s on two workers after its first chunk."""
     parameters = load_parameters()
-    study = MapStudy(np.linspace(0.002, 0.016, 8), np.linspace(50, 240, 24) * KMH,
+    study = MapStudy(np.linspace(0.002, 0.016, 40), np.linspace(50, 240, 48) * KMH,
                      [parameters["wheel_force"]], [parameters["motor_slope"]])
     return run_serial(study, parameters)
 
@@ -153,18 +154,21 @@ def test_interrupt_then_resume_recomputes_nothing_finished(cluster, long_study_r
                                                             tmp_path):
     reference = long_study_reference
     out = tmp_path / "r.zarr"
-    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:8", "--v", "50:240:24",
+    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:40", "--v", "50:240:48",
             "--out", str(out), "--scheduler", cluster, "--connect-timeout", "30", "--json"]
     process = subprocess.Popen(argv, cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 300
+    started = time.monotonic()
+    deadline, polls = started + 300, 0
     while time.monotonic() < deadline and process.poll() is None:
+        polls += 1
         if (out / "chunk_done" / "zarr.json").exists() and finished_chunks(out):
             break
         time.sleep(0.05)
+    waited = f"interrupt after {time.monotonic() - started:.1f} s and {polls} polls\n"
     process.send_signal(signal.SIGINT)  # Ctrl-C
     _, err = process.communicate(timeout=120)
-    assert process.returncode == 130, err
+    assert process.returncode == 130, waited + err
     assert "continue with --resume" in err
     assert "Traceback" not in err
     finished = finished_chunks(out)
@@ -191,18 +195,21 @@ def test_ctrl_c_with_the_local_cluster_stops_everything_cleanly(tmp_path):
     processes): exit 130, one message and no traceback, no process of the group left; the
     resume on the default local cluster finishes the rest."""
     out = tmp_path / "c.zarr"
-    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:6", "--v", "50:240:24",
-            "--out", str(out), "--json"]  # 24 chunks: see long_study_reference
+    argv = [str(BIN / "bogie"), "study", "map", "--s0", "0.002:0.016:40", "--v", "50:240:48",
+            "--out", str(out), "--json"]  # 48 chunks: see long_study_reference
     process = subprocess.Popen(argv, cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, start_new_session=True)
-    deadline = time.monotonic() + 300
+    started = time.monotonic()
+    deadline, polls = started + 300, 0
     while time.monotonic() < deadline and process.poll() is None:
+        polls += 1
         if (out / "chunk_done" / "zarr.json").exists() and finished_chunks(out):
             break
         time.sleep(0.05)
+    waited = f"interrupt after {time.monotonic() - started:.1f} s and {polls} polls\n"
     os.killpg(process.pid, signal.SIGINT)  # the group started here (a new session)
     _, err = process.communicate(timeout=120)
-    assert process.returncode == 130, err
+    assert process.returncode == 130, waited + err
     assert "Traceback" not in err
     assert "continue with --resume" in err
     time.sleep(2)
@@ -213,7 +220,7 @@ def test_ctrl_c_with_the_local_cluster_stops_everything_cleanly(tmp_path):
     resumed = subprocess.run([*argv, "--resume"], cwd=ROOT, env=ENV, capture_output=True,
                              text=True, timeout=600)
     assert resumed.returncode == 0, resumed.stderr
-    assert json.loads(resumed.stdout)["computed_chunks"] == 24 - finished
+    assert json.loads(resumed.stdout)["computed_chunks"] == 48 - finished
 
 
 def test_uncertainty_study_on_the_cluster_equals_serial(cluster):
