@@ -133,9 +133,16 @@ class _Reduced:
         X /= np.linalg.norm(X, axis=0)
         return lam, X
 
-    def error_estimate(self, c: np.ndarray, lam: np.ndarray, X: np.ndarray) -> np.ndarray:
-        """First-order relative eigenvalue error from the full-model residual."""
-        C_Phi = self.C0_Phi + sum(ck * P for ck, P in zip(c, self.P_Phi, strict=True))
+    def damping_Phi(self, c: np.ndarray) -> np.ndarray:
+        """C(c) Φ: the full damping matrix at creep coefficients c times the basis [N s/m]."""
+        return self.C0_Phi + sum(ck * P for ck, P in zip(c, self.P_Phi, strict=True))
+
+    def error_estimate(self, c: np.ndarray, lam: np.ndarray, X: np.ndarray,
+                       C_Phi: np.ndarray | None = None) -> np.ndarray:
+        """First-order relative eigenvalue error from the full-model residual (``C_Phi``:
+        :meth:`damping_Phi` at c, if already formed)."""
+        if C_Phi is None:
+            C_Phi = self.damping_Phi(c)
         CX = C_Phi @ X
         MX = self.M_Phi @ X
         residual = lam**2 * MX + lam * CX + self.K_Phi @ X

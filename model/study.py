@@ -75,7 +75,7 @@ from .locus import (
     creep_patterns,
     nonlinear_inverse_iteration,
 )
-from .operating_point import OperatingPoint, damping_matrix
+from .operating_point import OperatingPoint, creep_law, damping_matrix, kalker
 from .parameters import Parameters, parameter_hash
 from .stability import NoStabilityLimit, stability_limit
 
@@ -135,6 +135,21 @@ class LineResult:
     def stable(self) -> np.ndarray:
         """(n,) bool: all non-rigid eigenvalues in the closed left half-plane."""
         return self.largest_real_part <= 0.0
+
+
+def _line_coefficients(model: BogieModel, s0_values: np.ndarray, v: float,
+                       N0: float) -> np.ndarray:
+    """Creep coefficients (b11, b22, b23, b33) [N s/m, N s/m, N s, N s m] at every creepage of
+    a line (rows), as :func:`model.operating_point.creep_coefficients` gives them point by point:
+    the contact (Hertz, Kalker) depends on N0 only, so it is solved once, and μ'(s0) for all s0
+    at once."""
+    parameters = model.parameters
+    law = creep_law(parameters, N0)
+    contact = kalker(parameters, N0)
+    rows = np.empty((len(s0_values), 4))
+    rows[:, 0] = N0 * np.asarray(law.dmu_ds(np.asarray(s0_values, dtype=float), v)) / v
+    rows[:, 1:] = (contact.f22 / v, contact.f23 / v, contact.f33 / v)
+    return rows
 
 
 def _dense_point(model: BogieModel, op: OperatingPoint, vectors: bool = False):
@@ -320,6 +335,8 @@ class _LineModel:
         self._base = first_order(red.K_r, red.C0_r)
         self._parts = [first_order(None, P) for P in red.P_r]
         self._start = np.random.default_rng(0).standard_normal(r)  # inverse iteration start
+        self._line_key: tuple | None = None  # (b22, b23, b33) of self._line_parts
+        self._line_parts: tuple = ()
         self.values = np.zeros(0, dtype=complex)  # the last point's eigenvalues [1/s]
         self.top_values = np.zeros(0, dtype=complex)  # the top eigenvalue at each grid point
         self.grid_values: list[np.ndarray] = []  # all eigenvalues at each grid point [1/s]
@@ -343,12 +360,32 @@ class _LineModel:
         X = red.Linv.T @ X
         return X / np.linalg.norm(X, axis=0)
 
+    def _matrices(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(A22, reduced C, full C Φ) at creep coefficients c = (b11, b22, b23, b33).  Along a
+        line only b11 changes: the terms of b22, b23 and b33 are summed once and kept (for the
+        last (b22, b23, b33) seen), and each point adds the b11 term."""
+        key = tuple(float(ck) for ck in c[1:])
+        if key != self._line_key:
+            red = self.reduced
+            A22, C, C_Phi = self._base.copy(), red.C0_r.copy(), red.C0_Phi.copy()
+            for ck, D, P, P_Phi in zip(key, self._parts[1:], red.P_r[1:], red.P_Phi[1:],
+                                       strict=True):
+                A22 += ck * D
+                C += ck * P
+                C_Phi += ck * P_Phi
+            self._line_key, self._line_parts = key, (A22, C, C_Phi)
+        A22, C, C_Phi = self._line_parts
+        b11 = float(c[0])
+        return (A22 + b11 * self._parts[0], C + b11 * self.reduced.P_r[0],
+                C_Phi + b11 * self.reduced.P_Phi[0])
+
     def ritz_values(self, c: np.ndarray) -> np.ndarray:
         """All non-rigid Ritz values [1/s] at creep coefficients ``c`` (eigenvalues only; the
         rigid zeros are deflated)."""
-        A22 = self._base.copy()
-        for ck, D in zip(c, self._parts, strict=True):
-            A22 += ck * D
+        return self._eigvals(self._matrices(c)[0])
+
+    @staticmethod
+    def _eigvals(A22: np.ndarray) -> np.ndarray:
         return sla.eigvals(A22, overwrite_a=True, check_finite=False)
 
     def _result(self, values: np.ndarray, dense: bool) -> tuple[tuple[float, int, int], bool]:
@@ -362,8 +399,8 @@ class _LineModel:
         if c is None:
             c = _coefficients(self.model, op)
         red = self.reduced
-        C = red.C0_r + sum(ck * Pk for ck, Pk in zip(c, red.P_r, strict=True))
-        lam = self.ritz_values(c)
+        A22, C, C_Phi = self._matrices(c)
+        lam = self._eigvals(A22)
         lam = lam[lam.imag >= -IMAG_TOL * np.abs(lam)]  # one of each pair, and the reals
         # Only Ritz values with Re λ ≥ min(top, 0) − BAND can decide the summary; their vectors
         # and first-order errors (from the full residual) are computed.  Beyond the controlled
@@ -381,7 +418,7 @@ class _LineModel:
                 X = self._ritz_vectors(lam[candidates], C)
             except np.linalg.LinAlgError:  # a Ritz value exact to the last bit: no inverse step
                 return self._result(_dense_point(self.model, op).eigenvalues, True)
-            relative = red.error_estimate(c, lam[candidates], X)
+            relative = red.error_estimate(c, lam[candidates], X, C_Phi)
             checked[candidates] = True
             error[candidates] = relative * np.abs(lam[candidates])
             vectors[:, candidates] = X
@@ -489,7 +526,7 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     # solved densely too (eigenvalues only) and checks the basis: every eigenvalue there that the
     # selection would take (basis_modes) must have a Ritz value of the reduced model next to it;
     # if one has none, that point's eigenvectors join the basis (a third anchor, as before)
-    coefficients = [_coefficients(model, op) for op in points]
+    coefficients = _line_coefficients(model, s0_values, v, N0)
     b11 = np.array([c[0] for c in coefficients])
     middle = int(np.argmin(b11))
     anchors = {i: _dense_point(model, points[i], vectors=True) for i in sorted({0, n - 1})}
