@@ -15,22 +15,36 @@ the same continuation.  Against a full eigen-analysis at every point of 100-poin
 (``scripts/bench_study.py --check-lines``, tests/test_continuation.py).
 
 The first method of issue 13, :func:`reduced_s0_line` (method "reduced", the default: it is
-cheaper, see BENCHMARKS.md), reuses one Galerkin-reduced model (:class:`model.locus._Reduced`,
-the root locus's projection on exact eigenvectors at a few *anchor* creepages) and costs two
-dense eigen-analyses with vectors (the anchors: both ends), one without at the grid creepage of
-the most negative b11 (the steepest falling creep slope, the most destabilizing point) when it
-lies inside the line, and one small eigenproblem per point (2r − 2 unknowns: the rigid-body
-zeros of the reduced model are deflated once per line).  The dense eigenvalues at that creepage
-check the basis: every eigenvalue there that the selection below would take must have a Ritz
-value within 10⁻⁴·max(|λ|, 1 1/s); if one has none, its eigenvectors join the basis (a third
-anchor; before the fourth session it always was one).  Its properties:
+cheaper, see BENCHMARKS.md), reuses one Galerkin-reduced model (:class:`model.locus._Reduced`)
+per line and costs one dense eigen-analysis with vectors (the *anchor*: the last creepage), two
+without (the first creepage and the grid creepage of the most negative b11, the steepest falling
+creep slope, the most destabilizing point) and one small eigenproblem per point (2r − 2
+unknowns: the rigid-body zeros of the reduced model are deflated once per line).
+
+**The basis** (tenth session): the anchor's exact eigenvectors of the selection below and the
+*creep responses* ``T_a(σ)⁻¹ G`` (T_a(λ) = λ²M + λC_a + K at the anchor, G the four
+longitudinal creep patterns, :func:`model.operating_point.longitudinal_creep_pattern`).  Along a
+line only b11 changes, by a rank-4 term: an eigenpair (μ, x) at b11 = c solves
+T_a(μ) x = −(c − c_a) μ G Gᵀ x, so **x lies in the range of T_a(μ)⁻¹ G**, whose modal expansion
+is the anchor's modes near μ (in the basis) plus the far ones', which change slowly with μ.  The
+shifts σ are −1 1/s (the low-frequency part), the top eigenvalue of each densely solved point
+(there the top eigenvector is in the span exactly) and iω at each near-twin pair among the
+anchor's selected modes (relative gap ≤ ``TWIN_GAP``: the ID1/ID2 twins, which the creep splits;
+without these shifts one twin of the ≈ 37 Hz pair had no Ritz value between the checked points
+and three test lines came out with 2 flutter pairs too few).  Measured: 59–66 columns instead
+of 69–71 for the exact eigenvectors at both ends (BENCHMARKS.md, "Issue 13, tenth session").
+The dense eigenvalues at the first creepage and at the b11 minimum check the basis: every eigenvalue there
+that the selection would take must have a Ritz value within 10⁻⁴·max(|λ|, 1 1/s); if one has
+none, the basis falls back to the exact eigenvectors at both ends (the ninth session's), and at
+that creepage as a third anchor if its check still fails.  Its properties:
 
 What a point reports is a property of **all** eigenvalues, not only of tracked branches:
 
 * The basis holds, at every anchor, the exact eigenvectors of every eigenvalue inside the disc
   |λ| < 2π·``max_frequency_hz`` and of every eigenvalue less damped than Re λ > −5 1/s
   (``SELECTION_MARGIN``) whatever its frequency (e.g. the ≈ 50 Hz longitudinal rim modes that
-  the falling creep branch destabilizes).  All Ritz values of the reduced model are summarized,
+  the falling creep branch destabilizes), and at the checked creepages a Ritz value within
+  10⁻⁴ of each of those eigenvalues.  All Ritz values of the reduced model are summarized,
   except the rigid-body zeros and, outside the controlled disc (1.5 × the basis disc), Ritz
   values whose error estimate exceeds 10⁻³·|λ| (they approximate no eigenvalue).
 * Every Ritz value that can decide the result (the largest real part; any whose estimated error
@@ -39,7 +53,7 @@ What a point reports is a property of **all** eigenvalues, not only of tracked b
   ``rtol``·max(|λ|, 1 1/s), else it is refined by Newton's method on the full model; if more than
   a few need it, the point is solved densely (exact).
 * The eigenvalues outside the basis are damped by more than 5 1/s at every anchor and at the
-  checked creepage (by the selection and the check); each line records their largest real part
+  checked creepages (by the selection and the check); each line records their largest real part
   there (``outside_max_real_part``).
   That they stay below the top in between is an **assumption**, not a theorem: a real part is
   not monotone in b11 (modes interact).  With a margin of 2 1/s instead of 5 it failed (at
@@ -75,7 +89,13 @@ from .locus import (
     creep_patterns,
     nonlinear_inverse_iteration,
 )
-from .operating_point import OperatingPoint, creep_law, damping_matrix, kalker
+from .operating_point import (
+    OperatingPoint,
+    creep_law,
+    damping_matrix,
+    kalker,
+    longitudinal_creep_pattern,
+)
 from .parameters import Parameters, parameter_hash
 from .stability import NoStabilityLimit, stability_limit
 
@@ -89,6 +109,8 @@ SPURIOUS = 1e-3  # relative error estimate above which a Ritz value outside the 
 MAX_NEWTON = 4  # more Ritz values failing the tolerance at a point: solve the point densely
 MATCH = 1e-4  # a Ritz value this close (relative) to an eigenvalue represents it in the basis check
 IMAG_TOL = 1e-9  # |Im λ| ≤ IMAG_TOL·|λ|: a real eigenvalue
+TWIN_GAP = 1e-3  # anchor eigenvalues closer than this (relative) are a near-twin pair (a shift)
+CREEP_RESPONSE_SHIFT = -1.0  # σ [1/s] of the basis's low-frequency creep-response vectors
 
 
 # --- spectral summary -----------------------------------------------------------------------------
@@ -150,6 +172,15 @@ def _line_coefficients(model: BogieModel, s0_values: np.ndarray, v: float,
     rows[:, 0] = N0 * np.asarray(law.dmu_ds(np.asarray(s0_values, dtype=float), v)) / v
     rows[:, 1:] = (contact.f22 / v, contact.f23 / v, contact.f33 / v)
     return rows
+
+
+def _top(eigenvalues: np.ndarray) -> complex | float:
+    """The eigenvalue with the largest real part [1/s] (of a pair, the one with Im > 0; a real
+    one as a float)."""
+    top = eigenvalues[np.argmax(eigenvalues.real)]
+    if abs(top.imag) <= IMAG_TOL * abs(top):
+        return float(top.real)
+    return complex(top.real, abs(top.imag))
 
 
 def _dense_point(model: BogieModel, op: OperatingPoint, vectors: bool = False):
@@ -295,7 +326,7 @@ class _LineModel:
     """The reduced model of one line and its error-controlled point evaluation."""
 
     def __init__(self, model: BogieModel, v: float, N0: float, b_M: float, anchors,
-                 max_frequency_hz: float, rtol: float):
+                 max_frequency_hz: float, rtol: float, creep_shifts=()):
         self.model, self.v, self.N0, self.b_M, self.rtol = model, v, N0, b_M, rtol
         self.radius = 2 * np.pi * max_frequency_hz
         n = model.n
@@ -308,6 +339,21 @@ class _LineModel:
 
         patterns = creep_patterns(model)
         vectors = [model.rigid_body_modes] + [part for r in anchors for part in modes(r)]
+        if len(creep_shifts):
+            # T_a(σ)⁻¹ G (module docstring): the far modes' share of every eigenvector on the line
+            C_anchor = damping_matrix(model, anchors[0].operating_point)
+            G = longitudinal_creep_pattern(model)
+            for shift in creep_shifts:
+                try:
+                    Y = np.linalg.solve(shift * shift * model.M + shift * C_anchor + model.K, G)
+                except np.linalg.LinAlgError:  # a shift on an anchor eigenvalue: its mode is in
+                    continue  # the basis already
+                vectors += [Y.real, Y.imag] if np.iscomplexobj(Y) else [Y]
+            # columns of very different scales (displacement parts of unit state vectors fall as
+            # 1/|λ|, the responses are ≈ 10⁻⁷ m per N): each scaled to unit length before the SVD
+            stacked = np.hstack(vectors)
+            norms = np.linalg.norm(stacked, axis=0)
+            vectors = [stacked[:, norms > 0] / norms[norms > 0]]
         U, sigma, _ = np.linalg.svd(np.hstack(vectors), full_matrices=False)
         basis = U[:, sigma > BASIS_CUTOFF * sigma[0]]
         self.reduced = _Reduced(model, anchors[0].operating_point, patterns, [basis])
@@ -472,7 +518,8 @@ def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
     default: :func:`reduced_s0_line`, ``max_frequency_hz`` and ``rtol`` apply) or "dense"
     (:func:`dense_line`).  The default stays "reduced" because it is cheaper: measured on the
     shared machine, a map point cost 0.35 of an eigenvalues-only analysis with "reduced" and
-    1.26 with "continuation" (BENCHMARKS.md, issue 13)."""
+    1.26 with "continuation" (BENCHMARKS.md, issue 13); in the tenth session 0.18–0.19 with
+    "reduced" and 20–26 ms a point (≈ 0.8) with "continuation"."""
     if method == "reduced":
         return reduced_s0_line(model, s0_values, v, N0, b_M, max_frequency_hz, rtol,
                                s0_limit_xtol)
@@ -515,32 +562,43 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     closing bracket, :func:`_reduced_limit`; Brent's method if they do not close it).
 
     ``max_frequency_hz``: the reduction basis holds the exact eigenvectors with |λ| < 2π·f (and
-    those with Re λ > −5 1/s) at the anchors (see the module docstring for what is assumed of
-    the eigenvalues outside it).
+    those with Re λ > −5 1/s) at the anchor and the creep responses there (see the module
+    docstring for the basis, its checks and what is assumed of the eigenvalues outside it).
     """
     s0_values = _check_s0(s0_values)
     n = len(s0_values)
     points = [OperatingPoint(float(s), v, N0, b_M) for s in s0_values]
-    # anchors (solved densely, their eigenvectors span the basis): both ends.  The grid creepage
-    # of the most negative b11 (the steepest falling creep slope, the most destabilizing point) is
-    # solved densely too (eigenvalues only) and checks the basis: every eigenvalue there that the
-    # selection would take (basis_modes) must have a Ritz value of the reduced model next to it;
-    # if one has none, that point's eigenvectors join the basis (a third anchor, as before)
     coefficients = _line_coefficients(model, s0_values, v, N0)
-    b11 = np.array([c[0] for c in coefficients])
-    middle = int(np.argmin(b11))
-    anchors = {i: _dense_point(model, points[i], vectors=True) for i in sorted({0, n - 1})}
+    middle = int(np.argmin(coefficients[:, 0]))
     radius = 2 * np.pi * max_frequency_hz
-    solved = {i: r.eigenvalues for i, r in anchors.items()}  # grid points solved densely
     if n < 3:
         line = dense_line(model, s0_values, v, N0, b_M, s0_limit_xtol)
+        spectra = [_dense_point(model, points[i]).eigenvalues for i in sorted({0, n - 1})]
         return LineResult(**{**line.__dict__, "method": "reduced",
-                             "outside_max_real_part": _outside_max_real_part(solved.values(),
-                                                                             radius)})
-    line_model = _LineModel(model, v, N0, b_M, list(anchors.values()), max_frequency_hz, rtol)
-    if middle not in anchors:
-        solved[middle] = _dense_point(model, points[middle]).eigenvalues
-        if _missing_modes(solved[middle], line_model.ritz_values(coefficients[middle]), radius):
+                             "outside_max_real_part": _outside_max_real_part(spectra, radius)})
+    # The basis: the exact eigenvectors at the last creepage and the creep-response vectors there
+    # (module docstring).  The first creepage and the grid creepage of the most negative b11 are
+    # solved densely (eigenvalues only) and check it: every eigenvalue there that the selection
+    # would take (basis_modes) must have a Ritz value next to it.  If one has none, the basis is
+    # the exact eigenvectors at both ends, and at that grid creepage if its check still fails.
+    anchors = {n - 1: _dense_point(model, points[n - 1], vectors=True)}
+    solved = {n - 1: anchors[n - 1].eigenvalues}  # grid points solved densely
+    for i in sorted({0, middle} - {n - 1}):
+        solved[i] = _dense_point(model, points[i]).eigenvalues
+    shifts = [CREEP_RESPONSE_SHIFT] + [_top(solved[i]) for i in sorted(solved) if i != n - 1]
+    lam = anchors[n - 1].eigenvalues
+    lam = np.sort_complex(lam[basis_modes(lam, radius) & (lam.imag > 0)])
+    twins = np.flatnonzero(np.abs(np.diff(lam)) <= TWIN_GAP * np.abs(lam[1:]))
+    shifts += [1j * lam[k].imag for k in twins]
+    line_model = _LineModel(model, v, N0, b_M, [anchors[n - 1]], max_frequency_hz, rtol,
+                            creep_shifts=shifts)
+    if any(_missing_modes(solved[i], line_model.ritz_values(coefficients[i]), radius)
+           for i in sorted(solved) if i != n - 1):
+        anchors[0] = _dense_point(model, points[0], vectors=True)
+        line_model = _LineModel(model, v, N0, b_M, [anchors[0], anchors[n - 1]],
+                                max_frequency_hz, rtol)
+        if middle not in anchors and _missing_modes(
+                solved[middle], line_model.ritz_values(coefficients[middle]), radius):
             anchors[middle] = _dense_point(model, points[middle], vectors=True)
             line_model = _LineModel(model, v, N0, b_M, [anchors[i] for i in sorted(anchors)],
                                     max_frequency_hz, rtol)
