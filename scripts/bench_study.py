@@ -66,6 +66,23 @@ def best_of(repeat: int, function, before=None) -> float:
     return min(times)
 
 
+def report_accuracy(args, serial, worst, worst_eig, counts_equal, fallbacks, t_line,
+                    t_dense) -> None:
+    """Print the checked lines' accuracy against the dense reference and their timing."""
+    print(f"accuracy on {args.check_lines} lines x {args.s0_points} points against a full "
+          f"eigen-analysis: max |d largest real part| {worst:.2e} 1/s, flutter/divergent counts "
+          f"identical: {counts_equal}")
+    if args.method == "continuation":
+        print(f"  every eigenvalue within {worst_eig:.2e} relative (to max(|lambda|, 1 1/s)); "
+              f"fallbacks (points solved densely after failed checks, s0* included): "
+              f"{fallbacks} on {args.check_lines * args.s0_points} points")
+    else:
+        print(f"  outside-basis eigenvalues at the densely solved creepages <= "
+              f"{float(serial['outside_max_real_part'].max()):.3f} 1/s")
+    print(f"  the same lines timed in this run: s0_line {t_line:.2f} s, dense_line {t_dense:.2f} s "
+          f"-> a line costs {t_line / t_dense:.3f} of the dense line (both with s0*)")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--s0-points", type=int, default=100)
@@ -192,18 +209,10 @@ def main() -> None:
                     rows, cols = linear_sum_assignment(cost)
                     worst_eig = max(worst_eig, float((cost[rows, cols] / np.maximum(
                         np.abs(dense[cols]), 1.0)).max()))
-    print(f"accuracy on {args.check_lines} lines x {args.s0_points} points against a full "
-          f"eigen-analysis: max |d largest real part| {worst:.2e} 1/s, flutter/divergent counts "
-          f"identical: {counts_equal}")
-    if args.method == "continuation":
-        print(f"  every eigenvalue within {worst_eig:.2e} relative (to max(|lambda|, 1 1/s)); "
-              f"fallbacks (points solved densely after failed checks, s0* included): "
-              f"{fallbacks} on {args.check_lines * args.s0_points} points")
+    if args.check_lines > 0:
+        report_accuracy(args, serial, worst, worst_eig, counts_equal, fallbacks, t_line, t_dense)
     else:
-        print(f"  outside-basis eigenvalues at the anchors <= "
-              f"{float(serial['outside_max_real_part'].max()):.3f} 1/s")
-    print(f"  the same lines timed in this run: s0_line {t_line:.2f} s, dense_line {t_dense:.2f} s "
-          f"-> a line costs {t_line / t_dense:.3f} of the dense line (both with s0*)")
+        print("accuracy: not checked (--check-lines 0)")
 
     sobol = args.sobol_samples * (args.sobol_parameters + 2)
     print(f"\nprojection T(W) = tasks x (t_task + overhead) / W (t_task measured here, one core "
