@@ -233,11 +233,11 @@ class TargetRow:
 CANDIDATES = 14  # lowest complex pairs whose character is computed (Table 1 has ten)
 
 
-def match_table1_modes(model, result, max_modes: int = CANDIDATES):
-    """Indices (into ``result.eigenvalues``) of the modes matching Table 2's characters, by an
-    optimal one-to-one assignment on the signature scores over the ``max_modes`` lowest complex
-    pairs; plus the characters computed."""
-    candidates = result.complex_index[:max_modes]
+def _signature_assignment(model, result, candidates):
+    """Table 2's characters assigned one-to-one to the ``candidates`` (indices of complex pairs
+    in ``result``) by an optimal assignment on their signature scores: (rows: Table 2's
+    characters, columns: positions in ``candidates``, the score matrix (characters x
+    candidates), the characters computed)."""
     shapes = [result.mode_shape(i) for i in candidates]
     characters = [characterize(model, result.eigenvalues[i], q)
                   for i, q in zip(candidates, shapes, strict=True)]
@@ -245,6 +245,15 @@ def match_table1_modes(model, result, max_modes: int = CANDIDATES):
     score = np.array([[signature(c, yaw) for c, yaw in zip(characters, yaws, strict=True)]
                       for _, signature in MODE_SIGNATURES])
     rows, columns = linear_sum_assignment(-score)
+    return rows, columns, score, characters
+
+
+def match_table1_modes(model, result, max_modes: int = CANDIDATES):
+    """Indices (into ``result.eigenvalues``) of the modes matching Table 2's characters, by an
+    optimal one-to-one assignment on the signature scores over the ``max_modes`` lowest complex
+    pairs; plus the characters computed."""
+    candidates = result.complex_index[:max_modes]
+    rows, columns, _, characters = _signature_assignment(model, result, candidates)
     matched = np.empty(len(MODE_SIGNATURES), dtype=int)
     matched[rows] = candidates[columns]
     return matched, characters
@@ -525,13 +534,7 @@ def _extra_mode_analysis(parameters: Parameters) -> dict:
     index = result.complex_index
     frequency = result.eigenvalues[index].imag / (2 * np.pi)
     candidates = index[:max(12, int(np.count_nonzero(frequency < EXTRA_MODE_CANDIDATES)))]
-    shapes = [result.mode_shape(i) for i in candidates]
-    characters = [characterize(model, result.eigenvalues[i], q)
-                  for i, q in zip(candidates, shapes, strict=True)]
-    yaws = [wheelset_yaw_fraction(model, q) for q in shapes]
-    score = np.array([[signature(c, y) for c, y in zip(characters, yaws, strict=True)]
-                      for _, signature in MODE_SIGNATURES])
-    rows, columns = linear_sum_assignment(-score)
+    rows, columns, score, _ = _signature_assignment(model, result, candidates)
     position = np.empty(len(MODE_SIGNATURES), dtype=int)  # rank position of Table 2's k-th
     position[rows] = columns
     return {"frequency": frequency[:len(candidates)], "position": position,
