@@ -64,6 +64,29 @@ def test_line_equals_dense_reference(setup, v_kmh, n0_factor, b_M, method):
         assert line.fallbacks >= np.count_nonzero(line.dense_points) - 1
 
 
+def test_reduced_basis_falls_back_to_both_ends_when_a_check_fails(setup, monkeypatch):
+    """The reduced line's basis is the last creepage's eigenvectors and creep responses; when the
+    dense eigenvalues at the first or the steepest creepage have no Ritz value next to them, it
+    falls back to the exact eigenvectors at both ends.  With the check made impossible (MATCH = 0)
+    the fallback runs: a larger basis, and every point still as the dense reference gives it."""
+    import model.study as study
+
+    parameters, model = setup
+    N0, b_M = parameters["wheel_force"], parameters["motor_slope"]
+    s0 = np.linspace(0.001, 0.02, 17)
+    v = 160 * KMH
+    reference = dense_line(model, s0, v, N0, b_M)
+    normal = s0_line(model, s0, v, N0, b_M)
+    monkeypatch.setattr(study, "MATCH", 0.0)
+    fallback = s0_line(model, s0, v, N0, b_M)
+    assert fallback.basis_size > normal.basis_size
+    for line in (normal, fallback):
+        np.testing.assert_allclose(line.largest_real_part, reference.largest_real_part, rtol=0,
+                                   atol=GROWTH_ATOL)
+        np.testing.assert_array_equal(line.flutter_pairs, reference.flutter_pairs)
+        np.testing.assert_array_equal(line.divergent_real, reference.divergent_real)
+
+
 def test_line_limit_equals_stability_limit(setup):
     """s0* of a line (Brent on the reduced evaluation) against model.stability.stability_limit
     (bracket doubling and Brent on dense eigen-analyses)."""
