@@ -33,10 +33,11 @@ anchor's selected modes (relative gap ≤ ``TWIN_GAP``: the ID1/ID2 twins, which
 without these shifts one twin of the ≈ 37 Hz pair had no Ritz value between the checked points
 and three test lines came out with 2 flutter pairs too few).  Measured: 59–66 columns instead
 of 69–71 for the exact eigenvectors at both ends (BENCHMARKS.md, "Issue 13, tenth session").
-The dense eigenvalues at the first creepage and at the b11 minimum check the basis: every eigenvalue there
-that the selection would take must have a Ritz value within 10⁻⁴·max(|λ|, 1 1/s); if one has
-none, the basis falls back to the exact eigenvectors at both ends (the ninth session's), and at
-that creepage as a third anchor if its check still fails.  Its properties:
+The dense eigenvalues at the first creepage and at the b11 minimum check the basis: every
+eigenvalue there that the selection would take must have a Ritz value within
+10⁻⁴·max(|λ|, 1 1/s); if one has none, the basis falls back to the exact eigenvectors at both
+ends (the ninth session's), and at that creepage as a third anchor if its check still fails.
+Its properties:
 
 What a point reports is a property of **all** eigenvalues, not only of tracked branches:
 
@@ -587,9 +588,10 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
         solved[i] = _dense_point(model, points[i]).eigenvalues
     shifts = [CREEP_RESPONSE_SHIFT] + [_top(solved[i]) for i in sorted(solved) if i != n - 1]
     lam = anchors[n - 1].eigenvalues
-    lam = np.sort_complex(lam[basis_modes(lam, radius) & (lam.imag > 0)])
-    twins = np.flatnonzero(np.abs(np.diff(lam)) <= TWIN_GAP * np.abs(lam[1:]))
-    shifts += [1j * lam[k].imag for k in twins]
+    lam = lam[basis_modes(lam, radius) & (lam.imag > 0)]
+    twins, _ = np.nonzero(np.triu(np.abs(lam[:, None] - lam[None, :])
+                                  <= TWIN_GAP * np.abs(lam)[:, None], k=1))
+    shifts += [1j * lam[k].imag for k in np.unique(twins)]
     line_model = _LineModel(model, v, N0, b_M, [anchors[n - 1]], max_frequency_hz, rtol,
                             creep_shifts=shifts)
     if any(_missing_modes(solved[i], line_model.ritz_values(coefficients[i]), radius)
