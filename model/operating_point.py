@@ -100,6 +100,21 @@ def creep_coefficients(parameters: Parameters, op: OperatingPoint) -> CreepCoeff
                              coefficients.f23 / op.v, coefficients.f33 / op.v)
 
 
+def line_creep_coefficients(parameters: Parameters, s0_values, v: float,
+                            N0: float) -> np.ndarray:
+    """:func:`creep_coefficients`' (b11, b22, b23, b33) [N s/m, N s/m, N s, N s m] at every
+    creepage of ``s0_values`` [-] at speed v [m/s] and wheel force N0 [N], one row each, with
+    the same values: the contact (Hertz, Kalker) depends on N0 only, so it is solved once, and
+    μ'(s0) for all creepages at once."""
+    law = creep_law(parameters, N0)
+    coefficients = kalker(parameters, N0)
+    s0_values = np.asarray(s0_values, dtype=float)
+    rows = np.empty((len(s0_values), 4))
+    rows[:, 0] = N0 * np.asarray(law.dmu_ds(s0_values, v)) / v
+    rows[:, 1:] = (coefficients.f22 / v, coefficients.f23 / v, coefficients.f33 / v)
+    return rows
+
+
 def motor_torque(parameters: Parameters, op: OperatingPoint) -> float:
     """Steady motor torque before the fault, M(s0, v) = 2 μ N0 r0 / p [N m] (eq. 7)."""
     mu = float(creep_law(parameters, op.N0).mu(op.s0, op.v))

@@ -92,9 +92,8 @@ from .locus import (
 )
 from .operating_point import (
     OperatingPoint,
-    creep_law,
     damping_matrix,
-    kalker,
+    line_creep_coefficients,
     longitudinal_creep_pattern,
 )
 from .parameters import Parameters, parameter_hash
@@ -158,21 +157,6 @@ class LineResult:
     def stable(self) -> np.ndarray:
         """(n,) bool: all non-rigid eigenvalues in the closed left half-plane."""
         return self.largest_real_part <= 0.0
-
-
-def _line_coefficients(model: BogieModel, s0_values: np.ndarray, v: float,
-                       N0: float) -> np.ndarray:
-    """Creep coefficients (b11, b22, b23, b33) [N s/m, N s/m, N s, N s m] at every creepage of
-    a line (rows), as :func:`model.operating_point.creep_coefficients` gives them point by point:
-    the contact (Hertz, Kalker) depends on N0 only, so it is solved once, and μ'(s0) for all s0
-    at once."""
-    parameters = model.parameters
-    law = creep_law(parameters, N0)
-    contact = kalker(parameters, N0)
-    rows = np.empty((len(s0_values), 4))
-    rows[:, 0] = N0 * np.asarray(law.dmu_ds(np.asarray(s0_values, dtype=float), v)) / v
-    rows[:, 1:] = (contact.f22 / v, contact.f23 / v, contact.f33 / v)
-    return rows
 
 
 def _top(eigenvalues: np.ndarray) -> complex | float:
@@ -569,7 +553,7 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     s0_values = _check_s0(s0_values)
     n = len(s0_values)
     points = [OperatingPoint(float(s), v, N0, b_M) for s in s0_values]
-    coefficients = _line_coefficients(model, s0_values, v, N0)
+    coefficients = line_creep_coefficients(model.parameters, s0_values, v, N0)
     middle = int(np.argmin(coefficients[:, 0]))
     radius = 2 * np.pi * max_frequency_hz
     if n < 3:
@@ -583,10 +567,11 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     # would take (basis_modes) must have a Ritz value next to it.  If one has none, the basis is
     # the exact eigenvectors at both ends, and at that grid creepage if its check still fails.
     anchors = {n - 1: _dense_point(model, points[n - 1], vectors=True)}
+    checked = sorted({0, middle} - {n - 1})  # grid points that check the basis
     solved = {n - 1: anchors[n - 1].eigenvalues}  # grid points solved densely
-    for i in sorted({0, middle} - {n - 1}):
+    for i in checked:
         solved[i] = _dense_point(model, points[i]).eigenvalues
-    shifts = [CREEP_RESPONSE_SHIFT] + [_top(solved[i]) for i in sorted(solved) if i != n - 1]
+    shifts = [CREEP_RESPONSE_SHIFT] + [_top(solved[i]) for i in checked]
     lam = anchors[n - 1].eigenvalues
     lam = lam[basis_modes(lam, radius) & (lam.imag > 0)]
     twins, _ = np.nonzero(np.triu(np.abs(lam[:, None] - lam[None, :])
@@ -595,7 +580,7 @@ def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: floa
     line_model = _LineModel(model, v, N0, b_M, [anchors[n - 1]], max_frequency_hz, rtol,
                             creep_shifts=shifts)
     if any(_missing_modes(solved[i], line_model.ritz_values(coefficients[i]), radius)
-           for i in sorted(solved) if i != n - 1):
+           for i in checked):
         anchors[0] = _dense_point(model, points[0], vectors=True)
         line_model = _LineModel(model, v, N0, b_M, [anchors[0], anchors[n - 1]],
                                 max_frequency_hz, rtol)
