@@ -6,6 +6,12 @@ runs ``function(item)`` for many items on a cluster and hands back the results a
 * Default: a ``LocalCluster`` of worker *processes*, one thread each, as many as cores, each with
   one BLAS thread (environment ``OPENBLAS_NUM_THREADS=1`` etc. and ``threadpoolctl`` once per
   process: two workers on two cores must not fight over four BLAS threads).
+* ``supervised=False`` (the dashboard server's cluster): the scheduler in this process and each
+  worker a plain subprocess (``python -m dask spec``), no nanny: exactly one process per worker
+  (a nanny's ``multiprocessing`` adds Python's resource-tracker process).  A worker that dies is
+  not restarted: :meth:`StudyEngine.healthy` tells, and the caller starts a new engine.
+* ``niceness``: the worker threads run at this niceness (a local cluster beside an interactive
+  server leaves it the CPU it needs first).
 * ``scheduler="tcp://HOST:PORT"`` (or the environment variable ``DASK_SCHEDULER_ADDRESS``)
   attaches to a running cluster; the workers need the project installed (docs/cluster.md).  An
   unreachable scheduler raises :class:`EngineUnavailable` after ``connect_timeout`` seconds.
@@ -64,8 +70,16 @@ def _one_blas_thread() -> None:
         _BLAS_LIMITED = True
 
 
-def _call(function: Callable, item):
+_THREAD = threading.local()  # niceness already set for this (worker task) thread
+
+
+def _call(function: Callable, item, niceness: int = 0):
     _one_blas_thread()
+    if niceness and getattr(_THREAD, "niceness", 0) != niceness:
+        from .locus import set_thread_niceness
+
+        set_thread_niceness(niceness)
+        _THREAD.niceness = niceness
     return function(item)
 
 
@@ -79,8 +93,14 @@ class StudyEngine:
     """A Dask client (to a given scheduler or to a new local cluster) as a context manager."""
 
     def __init__(self, scheduler: str | None = None, workers: int | None = None,
-                 connect_timeout: float = 10.0):
-        self.scheduler = scheduler_address(scheduler)
+                 connect_timeout: float = 10.0, use_environment: bool = True,
+                 supervised: bool = True, niceness: int = 0):
+        """``use_environment=False``: ``scheduler=None`` means a local cluster even when
+        ``$DASK_SCHEDULER_ADDRESS`` is set (a server whose operator chose the engine);
+        ``supervised``, ``niceness``: the local cluster's workers (module docstring)."""
+        self.scheduler = scheduler_address(scheduler) if use_environment else (scheduler or None)
+        self.supervised = supervised
+        self.niceness = niceness
         self.workers = workers or os.cpu_count() or 1
         self.connect_timeout = connect_timeout
         self.client = None
@@ -119,15 +139,29 @@ class StudyEngine:
         main = threading.current_thread() is threading.main_thread()
         previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
         try:
-            with dask.config.set(WORKER_CONFIG):
-                self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
-                                            processes=True, dashboard_address=None,
-                                            silence_logs=logging.CRITICAL,  # shutdown races log heartbeat errors
-                                            env=dict(BLAS_ENVIRONMENT))
+            if not self.supervised:
+                self.cluster = _plain_worker_cluster(self.workers)
+            else:
+                with dask.config.set(WORKER_CONFIG):
+                    self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
+                                                processes=True, dashboard_address=None,
+                                                silence_logs=logging.CRITICAL,  # shutdown races log heartbeat errors
+                                                env=dict(BLAS_ENVIRONMENT))
         finally:
             if previous is not None:
                 signal.signal(signal.SIGINT, previous)
         self.client = Client(self.cluster, set_as_default=False)
+
+    def healthy(self) -> bool:
+        """Whether the engine still has its workers (a local cluster: all it started; a cluster at
+        an address: at least one)."""
+        if self.client is None:
+            return False
+        try:
+            count = len(self.client.scheduler_info()["workers"])
+        except (OSError, TimeoutError, KeyError):
+            return False
+        return count >= (1 if self.scheduler else self.workers)
 
     def close(self) -> None:
         if self.client is not None:
@@ -145,7 +179,8 @@ class StudyEngine:
         items = list(items)
         if not items:
             return
-        futures = self.client.map(partial(_call, function), items, pure=False)
+        futures = self.client.map(partial(_call, function, niceness=self.niceness), items,
+                                  pure=False)
         index = {future.key: i for i, future in enumerate(futures)}
         try:
             for future in as_completed(futures, loop=self.client.loop):
@@ -160,6 +195,28 @@ class StudyEngine:
         for i, result in self.map_unordered(function, items):
             results[i] = result
         return results
+
+
+# environment of the plain worker subprocesses (inherited): one BLAS thread, quiet logs
+PLAIN_WORKER_ENVIRONMENT = {**BLAS_ENVIRONMENT, "DASK_LOGGING__DISTRIBUTED": "error"}
+
+
+def _plain_worker_cluster(workers: int):
+    """A cluster on 127.0.0.1: the scheduler in this process, ``workers`` plain worker
+    subprocesses of one thread each (they exit 60 s after losing the scheduler)."""
+    from distributed import Scheduler
+    from distributed.deploy.spec import SpecCluster
+    from distributed.deploy.subprocess import SubprocessWorker
+
+    os.environ.update(PLAIN_WORKER_ENVIRONMENT)  # inherited by the worker subprocesses
+    worker = {"cls": SubprocessWorker,
+              "options": {"worker_class": "distributed.Worker",
+                          "worker_kwargs": {"nthreads": 1, "death_timeout": 60,
+                                            "host": "127.0.0.1"}}}
+    scheduler = {"cls": Scheduler, "options": {"host": "127.0.0.1", "port": 0,
+                                               "dashboard": False, "dashboard_address": None}}
+    return SpecCluster(workers={i: worker for i in range(workers)}, scheduler=scheduler,
+                       worker=worker, silence_logs=logging.CRITICAL, name="bogie-local")
 
 
 def serial_map_unordered(function: Callable, items: Iterable) -> Iterator[tuple[int, object]]:
