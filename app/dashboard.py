@@ -44,7 +44,7 @@ from .sensitivity_view import SensitivityView  # issue 12: sensitivity tornado
 from .serve import limit_blas_threads
 from .url_state import make_query, parse_query
 from .variant_view import VariantView
-from .workers import FIRST_ANSWER_POOL, FOLLOW_UP_POOL, SIDE_VIEW_POOL
+from .workers import FIRST_ANSWER_POOL, FOLLOW_UP_POOL, SIDE_VIEW_POOL, LatestRequest
 
 log = logging.getLogger(__name__)
 skip_detached_markup_models()  # the views' tabs are dynamic (app/panel_fixes.py)
@@ -163,6 +163,10 @@ class BogieDashboard(pn.viewable.Viewer):
         self._pending_views: dict[tuple[str, str], tuple] = {}  # (tab, what) -> (function, args)
         self._dirty = False
         self._busy = False
+        self.closed = False  # the served session has ended: nothing more is computed for it
+        # one waiting follow-up per kind (app.workers.LatestRequest): dense locus, s0*(v)
+        self._dense_requests = LatestRequest(FOLLOW_UP_POOL, self.alive)
+        self._limit_requests = LatestRequest(SIDE_VIEW_POOL, self.alive)
         self._build()
         self.param.watch(self._on_change, ["s0", "v", "N0", "b_M", "M0", "f", "D", "dt_auto",
                                            "dt", "t_end", "rail", "locus", "variant"])
@@ -175,11 +179,20 @@ class BogieDashboard(pn.viewable.Viewer):
         self.param.watch(lambda e: self.locus_plot.zoom(e.new == "low"), ["zoom"])
         doc = pn.state.curdoc
         if doc is not None and doc.session_context is not None:
+            doc.on_session_destroyed(self._session_closed)
             # served: show the fast results at once, the root locus and s0* when they are ready
             self.refresh(slow=False)
             self._request(doc, loading=False)
         else:
             self.refresh()
+
+    def alive(self) -> bool:
+        """Whether results are still wanted (False once the served session has ended)."""
+        return not self.closed
+
+    def _session_closed(self, session_context) -> None:
+        """The browser has left: work not yet started for this session is dropped."""
+        self.closed = True
 
     # --- controls ------------------------------------------------------------------------------
 
@@ -290,7 +303,7 @@ class BogieDashboard(pn.viewable.Viewer):
             self.param.zoom, options={"all modes ≤ 20 Hz": "all", "low modes": "low"},
             css_classes=["ctl-zoom"])
         bokeh_pane = partial(pn.pane.Bokeh, sizing_mode="stretch_width")
-        self.sensitivity = SensitivityView()  # issue 12: sensitivity tornado
+        self.sensitivity = SensitivityView(self.alive)  # sensitivity tornado
         schematic = ASSETS / "schematic.svg"
         self.variant_view = VariantView(self)
         self.click = ModeClickThrough(self)  # tapped locus points and table rows -> mode views
@@ -497,7 +510,7 @@ class BogieDashboard(pn.viewable.Viewer):
     async def _worker(self, doc) -> None:
         loop = asyncio.get_running_loop()
         try:
-            while self._dirty:
+            while self._dirty and not self.closed:
                 self._dirty = False
                 state = self.state()
                 # the coarse root locus (≈ 0.3 s on two threads when not cached) starts at once,
@@ -532,7 +545,7 @@ class BogieDashboard(pn.viewable.Viewer):
                     if self._dirty:
                         continue
                     self._post(doc, self._apply_locus, state, locus)
-                    dense = loop.run_in_executor(FOLLOW_UP_POOL, self._dense_if_current, state)
+                    dense = self._dense_requests.submit(self._dense_if_current, state)
                     dense.add_done_callback(partial(self._dense_done, doc, state))
                     # s0*(v) after the dense locus (which has a target: ≤ 2 s after a speed
                     # change): at a lower priority beside it, its full eigen-analyses still
@@ -550,8 +563,7 @@ class BogieDashboard(pn.viewable.Viewer):
     def _start_limit(self, doc, state: State) -> None:
         """s0*(v) (≈ 0.7 s when not cached) is not waited for: a change arriving meanwhile
         starts at once; the limit is shown when ready if it still belongs to the parameters."""
-        limit = asyncio.get_running_loop().run_in_executor(SIDE_VIEW_POOL, self._limit_if_current,
-                                                           state)
+        limit = self._limit_requests.submit(self._limit_if_current, state)
         limit.add_done_callback(partial(self._limit_done, doc, state))
 
     def _limit_current(self, state: State) -> bool:

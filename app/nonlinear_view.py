@@ -32,7 +32,7 @@ from model.response import ShortCircuit
 
 from . import compute
 from .plots import SeriesSource
-from .workers import NONLINEAR_POOL, SEARCH_POOL
+from .workers import NONLINEAR_POOL, SEARCH_POOL, LatestRequest
 
 log = logging.getLogger(__name__)
 CREEP_MODELS = ("linear", "nonlinear")
@@ -156,6 +156,9 @@ class NonlinearView:
 
     def __init__(self, dashboard):
         self.dash = dashboard
+        # one waiting history and one waiting reaction search per session (app.workers)
+        self._histories = LatestRequest(NONLINEAR_POOL, dashboard.alive)
+        self._searches = LatestRequest(SEARCH_POOL, dashboard.alive)
         self.creep = pn.widgets.RadioButtonGroup(
             options=list(CREEP_MODELS), value="linear",
             css_classes=["ctl-creep"], sizing_mode="stretch_width")
@@ -257,7 +260,7 @@ class NonlinearView:
             return
         key = self._key(state)
         if key != self._shown_key:
-            future = NONLINEAR_POOL.submit(nonlinear_histories, *key)
+            future = self._histories.submit(nonlinear_histories, *key)
             future.add_done_callback(lambda f: f.cancelled() or f.exception())  # on_fast reports
 
     def on_fast(self, state) -> None:
@@ -327,12 +330,12 @@ class NonlinearView:
             # operating point has stayed for REACTION_QUIET_MS: not while a slider is stepped
             def start_if_quiet() -> None:
                 if self._current(key, apply):
-                    future = SEARCH_POOL.submit(if_current)
+                    future = self._searches.submit(if_current)
                     future.add_done_callback(partial(self._done, doc, key, apply))
 
             doc.add_timeout_callback(start_if_quiet, REACTION_QUIET_MS)
             return
-        future = NONLINEAR_POOL.submit(if_current)
+        future = self._histories.submit(if_current)
         future.add_done_callback(partial(self._done, doc, key, apply))
 
     def _current(self, key, apply) -> bool:
@@ -342,6 +345,8 @@ class NonlinearView:
         return self.creep.value == "nonlinear" and self._state is not None and key == self._key()
 
     def _done(self, doc, key, apply, future) -> None:
+        if future.cancelled():
+            return  # replaced by a newer request, or the session has ended
         error = future.exception()
         if isinstance(error, ReactionSuperseded):
             return  # no longer wanted (module comment at _VIEWS)

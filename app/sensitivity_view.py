@@ -100,10 +100,15 @@ def ranked(data: SensitivityData, target: str, mode: int) -> tuple[list[str], np
 class SensitivityView:
     """The tornado chart, its target selector and a note; ``panel`` is the layout to insert."""
 
-    def __init__(self):
+    def __init__(self, alive=lambda: True):
+        """``alive()``: whether the session still wants results (its requests are dropped once
+        it has ended)."""
+        from .workers import SIDE_VIEW_POOL, LatestRequest
+
         self.data: SensitivityData | None = None
         self.mode = 1
         self._wanted: tuple | None = None  # key of the newest requested point
+        self._requests = LatestRequest(SIDE_VIEW_POOL, alive)
         self.target = pn.widgets.RadioButtonGroup(options=TARGETS, value="growth",
                                                   css_classes=["ctl-sensitivity-target"])
         self.source = ColumnDataSource({"name": [], "value": [], "color": []})
@@ -134,12 +139,11 @@ class SensitivityView:
             except Exception as error:
                 self._failed(key, error)
             return
-        from .workers import SIDE_VIEW_POOL
-
-        future = SIDE_VIEW_POOL.submit(sensitivity_data, *key)
+        future = self._requests.submit(self._if_wanted, key)
 
         def done(f) -> None:
-            if f.cancelled() or key != self._wanted:
+            if f.cancelled() or key != self._wanted or (
+                    f.exception() is None and f.result() is None):
                 return
             if f.exception() is not None:
                 doc.add_next_tick_callback(partial(dashboard._locked, doc, self._failed, key,
@@ -148,6 +152,10 @@ class SensitivityView:
             doc.add_next_tick_callback(partial(dashboard._locked, doc, self._apply, f.result()))
 
         future.add_done_callback(done)
+
+    def _if_wanted(self, key: tuple) -> SensitivityData | None:
+        """The sensitivities of ``key``, unless another point was asked for meanwhile."""
+        return sensitivity_data(*key) if key == self._wanted else None
 
     def _failed(self, key: tuple, error: Exception) -> None:
         if key == self._wanted:

@@ -112,7 +112,10 @@ class VariantView(pn.viewable.Viewer):
 
     def __init__(self, dashboard, **params):
         super().__init__(**params)
+        from .workers import SIDE_VIEW_POOL, LatestRequest
+
         self.dashboard = dashboard
+        self._requests = LatestRequest(SIDE_VIEW_POOL, dashboard.alive)
         self.base_name = dashboard._params_path
         self.base = compute.parameters(self.base_name, "calibrated")
         self.inputs: dict[str, pn.widgets.FloatInput] = {}
@@ -282,10 +285,9 @@ class VariantView(pn.viewable.Viewer):
             self._show(state, self._compute(state, base_key))
             return
         from .dashboard import _ignore_outcome
-        from .workers import SIDE_VIEW_POOL
 
         self.table.object = "<i>⏳ comparing with the baseline…</i>"
-        future = SIDE_VIEW_POOL.submit(self._compute, state, base_key)
+        future = self._requests.submit(self._compute_if_current, state, base_key)
         _ignore_outcome(future)
         future.add_done_callback(partial(self._done, doc, state))
 
@@ -293,12 +295,18 @@ class VariantView(pn.viewable.Viewer):
     def _compute(state, base_key: str) -> tuple[Side, Side]:
         return side(state, base_key), side(state, state.params_path)
 
+    def _compute_if_current(self, state, base_key: str) -> tuple[Side, Side] | None:
+        """Both sides, unless the dashboard has moved on before the comparison started."""
+        return self._compute(state, base_key) if self.dashboard.state() == state else None
+
     def _done(self, doc, state, future) -> None:
         if future.cancelled():
             return
         error = future.exception()
 
         def show():
+            if error is None and future.result() is None:
+                return  # superseded before it started
             if error is not None:
                 self.table.object = ""
                 self.dashboard.warn(f"Comparison failed: {error}")

@@ -13,7 +13,9 @@ the process's priority.
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
+import threading
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
 
 from model.locus import set_thread_niceness
 
@@ -39,3 +41,50 @@ SIDE_VIEW_POOL = prioritized_pool(2, SIDE_VIEW, "bogie-side-view")
 NONLINEAR_POOL = prioritized_pool(1, FOLLOW_UP, "bogie-nonlinear")
 SEARCH_POOL = prioritized_pool(1, SEARCH, "bogie-reaction")
 
+
+
+class LatestRequest:
+    """One view's requests of one session on a shared pool: at most one waits in the pool's queue.
+
+    :meth:`submit` returns a future.  A request that has not started when a newer one arrives is
+    cancelled (its future reports ``cancelled()``) and the newer one takes its place in the queue;
+    a request whose session has closed (``alive()`` false when its turn comes) is cancelled
+    instead of run.  So the pools' queues hold at most one entry per session and view, however
+    fast a client sends changes, and a closed session's waiting work costs no CPU.
+    """
+
+    def __init__(self, pool: ThreadPoolExecutor, alive=lambda: True):
+        self._pool = pool
+        self._alive = alive
+        self._lock = threading.Lock()
+        self._next: tuple[Future, Callable, tuple] | None = None
+        self._queued = False
+
+    def submit(self, function: Callable, *args) -> Future:
+        future: Future = Future()
+        with self._lock:
+            replaced, self._next = self._next, (future, function, args)
+            start, self._queued = not self._queued, True
+        if replaced is not None:
+            replaced[0].cancel()
+        if start:
+            self._pool.submit(self._run)
+        return future
+
+    def _run(self) -> None:
+        with self._lock:
+            item, self._next, self._queued = self._next, None, False
+        if item is None:
+            return
+        future, function, args = item
+        if not self._alive():
+            future.cancel()
+            return
+        if not future.set_running_or_notify_cancel():
+            return
+        try:
+            result = function(*args)
+        except BaseException as error:  # handed to the future's callbacks, as the pool does
+            future.set_exception(error)
+        else:
+            future.set_result(result)
