@@ -1,7 +1,9 @@
 """``bogie serve``: run the dashboard with ``panel serve`` semantics (liveness endpoint on).
 
-Each browser session gets a fresh :class:`app.dashboard.BogieDashboard` (no state is shared
-between sessions except the read-only result caches of :mod:`app.compute`).
+Each browser session gets a fresh :class:`app.dashboard.BogieDashboard`.  Sessions share the
+read-only result caches of :mod:`app.compute`, the worker threads of :mod:`app.workers` and the
+study queue of :mod:`app.study_queue`, whose engine, folder and limits are the operator's
+settings (:mod:`app.server_settings`, docs/security.md).
 """
 
 from __future__ import annotations
@@ -59,16 +61,33 @@ def create_app(params: str | None = None):
 
 
 def serve(port: int = 5006, address: str = "127.0.0.1",
-          allow_websocket_origin: list[str] | None = None, params: str | None = None) -> None:
+          allow_websocket_origin: list[str] | None = None, params: str | None = None,
+          settings=None) -> None:
     """Serve the dashboard at /app (and Panel's /liveness?endpoint=/app) until SIGINT/SIGTERM.
 
     Websocket origins: ``allow_websocket_origin``, else the comma-separated host[:port] list in
     the environment variable BOGIE_ALLOWED_ORIGINS, else localhost:port and 127.0.0.1:port only.
+    ``settings``: the operator's :class:`app.server_settings.ServerSettings` (default: from the
+    environment); the studies folder is created here (raises SettingsError if it cannot be).
     """
     import faulthandler
     import signal
 
     import panel as pn
+
+    from .server_settings import ServerSettings, SettingsError, configure
+    from .study_queue import StudyQueue, replace_study_queue
+
+    settings = settings or ServerSettings.from_options()
+    try:
+        settings.studies_dir.mkdir(parents=True, exist_ok=True)
+        if not os.access(settings.studies_dir, os.W_OK | os.X_OK):
+            raise PermissionError("not writable")
+    except OSError as error:
+        raise SettingsError(f"--studies-dir {settings.studies_dir}: cannot be used "
+                            f"({error.strerror or error})") from None
+    configure(settings)
+    replace_study_queue(StudyQueue(settings))
 
     # a fatal error in native code (SIGSEGV, SIGABRT...) leaves the Python stack of every thread
     # in the server's log instead of one line from the C library
@@ -86,7 +105,10 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
         # stops the IO loop, and pn.serve returns
         signal.signal(signal.SIGTERM, _stop_now)
     print(f"bogie serve: dashboard on http://{address}:{port}/app "
-          f"(liveness: /liveness?endpoint=/app)", flush=True)
+          f"(liveness: /liveness?endpoint=/app); studies in {settings.studies_dir} on "
+          f"{settings.scheduler or 'a local cluster (started on the first study)'}, at most "
+          f"{settings.max_study_points} points, {settings.max_running_studies} running, "
+          f"{settings.max_waiting_studies} waiting", flush=True)
     try:
         pn.serve({"app": lambda: create_app(params)}, port=port, address=address,
                  websocket_origin=[o.strip() for o in origins if o.strip()], show=False,
@@ -100,9 +122,12 @@ def _stop_now(*_signal) -> None:
     """Stop the server process at once.  Nothing to save: the computations queued or running for
     sessions that are gone are dropped (``os._exit``: Python would otherwise join every worker
     thread at exit, and a reaction-time search at the lowest priority can run for a minute).
-    Called from the signal handler: the message may wait for another thread's write to stderr
-    (that thread goes on and releases it); one interrupted in this thread is skipped."""
+    The study engine's worker processes are stopped first (a study's store keeps its finished
+    chunks).  Called from the signal handler: the message may wait for another thread's write to
+    stderr (that thread goes on and releases it); one interrupted in this thread is skipped."""
     import sys
+
+    _close_studies()
 
     try:
         print("bogie serve: stopped", file=sys.stderr, flush=True)
@@ -110,3 +135,16 @@ def _stop_now(*_signal) -> None:
     except (OSError, RuntimeError, ValueError):  # a closed or busy stream: stop anyway
         pass
     os._exit(0)
+
+
+def _close_studies(timeout: float = 10.0) -> None:
+    """Stop the studies and the local cluster's worker processes, waiting at most ``timeout`` s
+    (they must not outlive the server: nothing else would stop them)."""
+    from .study_queue import replace_study_queue
+
+    queue = replace_study_queue(None)
+    if queue is None:
+        return
+    closer = threading.Thread(target=queue.close, name="bogie-close-studies", daemon=True)
+    closer.start()
+    closer.join(timeout)

@@ -1,27 +1,27 @@
 """The "Studies" view: a stability map over s0 × v at the dashboard's N0, b_M and rail condition.
 
-It starts a :class:`model.study.MapStudy` on the study engine (a local Dask cluster, a cluster
-at an address, or this process), writes it into a Zarr store (:mod:`model.study_store`), shows
-its progress without blocking the session (the study runs on a background thread; a periodic
-callback of the served session polls it), and draws the heat map of the largest real part with
-the stability limit s0*(v) over it.  A finished store (from here or from ``bogie study map``)
-can be opened, and so can an uncertainty result (``bogie uncertainty --speeds … --out FILE``):
-its 5–95 % band of s0*(v) is drawn over the map when it belongs to the parameter set and the
-conditions on screen (:mod:`app.uncertainty_band`), else a notice says why not.  Bad input (an
-empty range, fewer than two points, a path that is not a map store) shows a notice and keeps the
-previous map.
+It asks the server's study queue (:mod:`app.study_queue`) for a :class:`model.study.MapStudy`;
+the server runs it on the engine its operator chose (:mod:`app.server_settings`), into a Zarr
+store of the server's studies folder (:mod:`model.study_store`), when its turn comes.  The view
+shows the queue position, then the progress without blocking the session (a periodic callback
+of the served session polls the ticket), and draws the heat map of the largest real part with
+the stability limit s0*(v) over it.  A finished store (from here or from ``bogie study map``
+written into the folder) is opened by picking its name from the server's list, and so is an
+uncertainty result (``bogie uncertainty --speeds … --out FILE``): its 5–95 % band of s0*(v) is
+drawn over the map when it belongs to the parameter set and the conditions on screen
+(:mod:`app.uncertainty_band`), else a notice says why not.  Bad input (an empty range, too many
+points, a name not in the list, a store that is not a map) shows a notice and keeps the
+previous map.  No notice names a server path or address.
 
-Hooked into :class:`app.dashboard.BogieDashboard` with one section (marked "issue 13"); it reads
-the dashboard's ``N0`` [kN], ``b_M``, ``rail`` and parameter file when a study starts.
+The dashboard holds it as its ``studies`` view; it reads the dashboard's ``N0`` [kN], ``b_M``,
+``rail`` and bundled parameter set when a study starts.
 """
 
 from __future__ import annotations
 
 import html
-import os
-import tempfile
-import threading
-import time
+import logging
+import secrets
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,10 +34,10 @@ from model.operating_point import KMH
 
 from . import compute
 from .plots import _figure
+from .study_queue import FAILED, WAITING, StudyQueue, StudyTicket, study_queue, wait_until_ended
 from .uncertainty_band import BandLayer, UncertaintyBand, band_mismatch, read_band
 
-WHERE = {"local Dask cluster": "local", "Dask cluster at the address": "address",
-         "this process (no Dask)": "serial"}
+log = logging.getLogger(__name__)
 POLL_MS = 500  # progress refresh of a served session [ms]
 
 
@@ -56,17 +56,19 @@ class MapView:
     b_M: float = float("nan")  # motor slope of the slice [N m s/rad]
 
 
-def read_map(path: str | Path, n0_index: int = 0, bm_index: int = 0) -> MapView:
+def read_map(path: str | Path, n0_index: int = 0, bm_index: int = 0,
+             name: str | None = None) -> MapView:
     """The (s0, v) slice of a map store at the given N0 and b_M indices (raises ValueError if the
-    path is not a map store)."""
+    path is not a map store; the message calls it ``name``, default its path)."""
     import xarray as xr
 
     path = Path(path)
+    name = str(path) if name is None else name
     if not (path / "zarr.json").is_file():
-        raise ValueError(f"'{path}' is not a Zarr store")
+        raise ValueError(f"'{name}' is not a Zarr store")
     with xr.open_zarr(str(path), consolidated=False) as dataset:
         if dataset.attrs.get("study") != "map":
-            raise ValueError(f"'{path}' is not a stability-map store")
+            raise ValueError(f"'{name}' is not a stability-map store")
         sliced = dataset.isel(N0=n0_index, b_M=bm_index).load()
         done = dataset["chunk_done"].values
         growth = np.where(sliced["chunk_done"].values[None, :] == 1,
@@ -116,63 +118,65 @@ class StudyMapPlot:
 
 
 class StudiesView(pn.viewable.Viewer):
-    """Start a stability map at the dashboard's current N0, b_M and rail; follow it; open one."""
+    """Ask the server for a stability map at the dashboard's current N0, b_M and rail; follow it;
+    open a finished one.  Where it runs, where it is stored and how large it may be are the
+    server's settings (:mod:`app.server_settings`); this view only asks (:mod:`app.study_queue`)
+    and picks stores and results by name from the server's list (:mod:`app.studies_folder`)."""
 
-    def __init__(self, dashboard, folder: str | Path | None = None, **params):
+    def __init__(self, dashboard, queue: StudyQueue | None = None, **params):
         super().__init__(**params)
         self.dashboard = dashboard
-        self.folder = Path(folder) if folder else Path(tempfile.gettempdir()) / "bogie-studies"
+        self.queue = queue or study_queue()
+        self.owner = secrets.token_hex(8)  # this session's claim on its study
         self.map: MapView | None = None  # last map shown
-        self.path: Path | None = None  # store of the running / last study
+        self.ticket: StudyTicket | None = None  # the session's running / last study
         self.error = ""
-        self._thread: threading.Thread | None = None
-        self._progress = (0, 0, 0.0)  # finished, total, elapsed [s] (written by the thread)
-        self._outcome: str | None = None  # set by the thread when it ends
-        self._stop = threading.Event()
         self._poller = None
+        settings = self.queue.settings
         self.s0_range = pn.widgets.RangeSlider(label="creepage s0 [-]", start=0.0005, end=0.03,
                                                value=(0.001, 0.02), step=0.0005, format="0.0000",
                                                css_classes=["study-s0"])
-        self.s0_points = pn.widgets.IntInput(label="s0 points", value=40, start=1, end=2000,
+        self.s0_points = pn.widgets.IntInput(label="s0 points", value=40, start=1,
+                                             end=settings.max_study_points,
                                              css_classes=["study-s0-points"], width=110)
         self.v_range = pn.widgets.RangeSlider(label="speed v [km/h]", start=10.0, end=250.0,
                                               value=(40.0, 250.0), step=5.0, format="0",
                                               css_classes=["study-v"])
-        self.v_points = pn.widgets.IntInput(label="v points", value=20, start=1, end=2000,
+        self.v_points = pn.widgets.IntInput(label="v points", value=20, start=1,
+                                            end=settings.max_study_points,
                                             css_classes=["study-v-points"], width=110)
-        self.where = pn.widgets.Select(label="run on", options=list(WHERE),
-                                       value=("Dask cluster at the address"
-                                              if os.environ.get("DASK_SCHEDULER_ADDRESS")
-                                              else "local Dask cluster"),
-                                       css_classes=["study-where"], width=230)
-        self.address = pn.widgets.TextInput(label="scheduler address",
-                                            value=os.environ.get("DASK_SCHEDULER_ADDRESS", ""),
-                                            placeholder="tcp://host:8786",
-                                            css_classes=["study-address"], width=230)
+        self.where = pn.pane.HTML(
+            f"runs on {html.escape(settings.engine_description, quote=False)}; at most "
+            f"{settings.max_study_points} points (s0 × v), "
+            f"{settings.max_running_studies} stud{'y' if settings.max_running_studies == 1 else 'ies'} "
+            "at a time (the server's settings)", css_classes=["study-where"],
+            sizing_mode="stretch_width")
         self.start_button = pn.widgets.Button(label="Start map", color="primary",
                                               css_classes=["study-start"], width=120)
         self.stop_button = pn.widgets.Button(label="Stop", css_classes=["study-stop"], width=80,
                                              disabled=True)
-        self.store_path = pn.widgets.TextInput(label="store (.zarr)", placeholder="/path/map.zarr",
-                                               css_classes=["study-store"], width=360)
-        self.open_button = pn.widgets.Button(label="Open store", css_classes=["study-open"],
+        self.store_select = pn.widgets.Select(label="finished map (server's studies folder)",
+                                              options=[], css_classes=["study-store"], width=360)
+        self.open_button = pn.widgets.Button(label="Open map", css_classes=["study-open"],
                                              width=120)
+        self.refresh_button = pn.widgets.Button(label="↻", css_classes=["study-refresh"],
+                                                width=45, description="update both lists")
         self.progress = pn.indicators.Progress(value=0, max=1, css_classes=["study-progress"],
                                                width=360, visible=False)
         self.status = pn.pane.HTML("", css_classes=["study-status"], sizing_mode="stretch_width")
         self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
                                     css_classes=["study-notice"], sizing_mode="stretch_width")
         self.plot = StudyMapPlot()
-        # issue 12: an uncertainty result's s0*(v) band over the map (app/uncertainty_band.py)
+        # an uncertainty result's s0*(v) band over the map (app/uncertainty_band.py)
         self.uncertainty: UncertaintyBand | None = None
-        self.uncertainty_path = pn.widgets.TextInput(
-            label="uncertainty result (.json, bogie uncertainty --speeds … --out)",
-            placeholder="/path/uncertainty.json", css_classes=["study-uncertainty"], width=360)
+        self.uncertainty_select = pn.widgets.Select(
+            label="uncertainty result (bogie uncertainty --speeds … --out, in the folder)",
+            options=[], css_classes=["study-uncertainty"], width=360)
         self.uncertainty_button = pn.widgets.Button(label="Open result",
                                                     css_classes=["study-open-uncertainty"],
                                                     width=120)
         self.uncertainty_button.on_click(
-            lambda _event: self.open_uncertainty(self.uncertainty_path.value))
+            lambda _event: self.open_uncertainty(self.uncertainty_select.value))
         self.band_status = pn.pane.HTML("", css_classes=["study-band-status"],
                                         sizing_mode="stretch_width")
         self.band_notice = pn.pane.Alert("", alert_type="warning", visible=False,
@@ -185,17 +189,23 @@ class StudiesView(pn.viewable.Viewer):
                              if variant_figure is not None else None)
         self.start_button.on_click(lambda _event: self.start())
         self.stop_button.on_click(lambda _event: self.stop())
-        self.open_button.on_click(lambda _event: self.open(self.store_path.value))
+        self.open_button.on_click(lambda _event: self.open(self.store_select.value))
+        self.refresh_button.on_click(lambda _event: self.refresh_lists())
         self.layout = pn.Column(
             self.notice,
             pn.Row(self.s0_range, self.s0_points, self.v_range, self.v_points,
                    sizing_mode="stretch_width"),
-            pn.Row(self.where, self.address, self.start_button, self.stop_button),
-            pn.Row(self.store_path, self.open_button),
-            pn.Row(self.uncertainty_path, self.uncertainty_button),
+            pn.Row(self.start_button, self.stop_button, self.where, sizing_mode="stretch_width"),
+            pn.Row(self.store_select, self.open_button, self.refresh_button),
+            pn.Row(self.uncertainty_select, self.uncertainty_button),
             self.progress, self.status, self.band_notice, self.band_status,
             pn.pane.Bokeh(self.plot.figure, sizing_mode="stretch_width"),
             sizing_mode="stretch_width", css_classes=["studies-view"])
+        self.refresh_lists()
+        doc = pn.state.curdoc
+        if doc is not None and doc.session_context is not None:
+            # a closed session's waiting study is dropped, its running one stops after its chunk
+            doc.on_session_destroyed(lambda _context: self.queue.drop_owner(self.owner))
 
     def __panel__(self):
         return self.layout
@@ -204,8 +214,18 @@ class StudiesView(pn.viewable.Viewer):
 
     def _reject(self, message: str) -> None:
         self.error = message
-        self.notice.object = f"**Study not started/opened:** {html.escape(message)}"
+        self.notice.object = f"**Study not started/opened:** {html.escape(message, quote=False)}"
         self.notice.visible = True
+
+    def refresh_lists(self) -> None:
+        """The finished maps and uncertainty results of the server's studies folder."""
+        try:
+            maps, results = self.queue.folder.names("map"), self.queue.folder.names("uncertainty")
+        except OSError as error:
+            log.error("the studies folder cannot be listed: %s", error)
+            maps, results = [], []
+        self.store_select.options = maps
+        self.uncertainty_select.options = results
 
     def study(self):
         """The map study of the current controls and dashboard state (raises ValueError)."""
@@ -216,6 +236,11 @@ class StudiesView(pn.viewable.Viewer):
             raise ValueError("s0 points must be at least 1")
         if self.v_points.value is None or self.v_points.value < 1:
             raise ValueError("v points must be at least 1")
+        points = int(self.s0_points.value) * int(self.v_points.value)
+        limit = self.queue.settings.max_study_points
+        if points > limit:  # checked before the grid is made (a doctored client's 10⁹ points)
+            raise ValueError(f"{points} points asked; the server runs studies of at most "
+                             f"{limit} points (s0 points × v points)")
         (s_low, s_high), (v_low, v_high) = self.s0_range.value, self.v_range.value
         if self.s0_points.value > 1 and not s_low < s_high:
             raise ValueError("the s0 range is empty")
@@ -229,113 +254,107 @@ class StudiesView(pn.viewable.Viewer):
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        """Whether this session's study is waiting or running."""
+        return self.ticket is not None and not self.ticket.ended.is_set()
 
     def start(self) -> None:
-        """Start a map in the background (the session stays responsive)."""
+        """Ask the server for a map (it runs in the background; the session stays responsive)."""
         if self.running:
             return
         try:
             study = self.study()
             parameters = compute.parameters(self.dashboard._params_path, self.dashboard.rail)
-        except ValueError as error:
+            ticket = self.queue.submit(self.owner, study, parameters)
+        except ValueError as error:  # StudyRefused is a ValueError
             self._reject(str(error.args[0] if error.args else error))
             return
-        where = WHERE[self.where.value]
-        address = self.address.value.strip() or None
-        if where == "address" and not address:
-            self._reject("give the scheduler address (tcp://host:port) or run locally")
-            return
-        self.folder.mkdir(parents=True, exist_ok=True)
-        self.path = self.folder / f"map-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}-{id(self):x}.zarr"
+        self.ticket = ticket
         self.notice.visible, self.error = False, ""
-        self._progress, self._outcome = (0, len(study.chunks()), 0.0), None
-        self._stop.clear()
         self.start_button.disabled, self.stop_button.disabled = True, False
-        self.progress.visible, self.progress.max, self.progress.value = True, len(study.chunks()), 0
-        self.status.object = (f"starting on {self.where.value} — N0 = {self.dashboard.N0:g} kN, "
-                              f"b_M = {self.dashboard.b_M:g} N m s/rad, rail "
-                              f"{self.dashboard.rail}; store {html.escape(str(self.path))}")
-        self._thread = threading.Thread(target=self._run, args=(study, parameters, where, address),
-                                        name="bogie-study", daemon=True)
-        self._thread.start()
+        self.progress.visible, self.progress.max, self.progress.value = True, ticket.total, 0
+        self._conditions = (f"N0 = {self.dashboard.N0:g} kN, b_M = {self.dashboard.b_M:g} "
+                            f"N m s/rad, rail {self.dashboard.rail}; store "
+                            f"{html.escape(ticket.name)}")
+        self.poll()
         doc = pn.state.curdoc
         if doc is not None and doc.session_context is not None:
             self._poller = pn.state.add_periodic_callback(self.poll, period=POLL_MS)
 
-    def _run(self, study, parameters, where: str, address: str | None) -> None:
-        from model.study_engine import StudyEngine, serial_map_unordered
-        from model.study_store import run_into_store
-
-        def progress(finished, total, elapsed):
-            self._progress = (finished, total, elapsed)
-            if self._stop.is_set():
-                raise KeyboardInterrupt  # leaves the finished chunks in the store
-
-        engine = None
-        try:
-            if where == "serial":
-                mapper = serial_map_unordered
-            else:
-                engine = StudyEngine(address if where == "address" else None)
-                engine.start()
-                mapper = engine.map_unordered
-            run_into_store(study, parameters, self.path, mapper, progress=progress)
-            self._outcome = "done"
-        except KeyboardInterrupt:
-            self._outcome = "stopped"
-        except Exception as error:  # shown in the view; the session stays alive
-            self._outcome = f"failed: {str(error).splitlines()[0] if str(error) else type(error).__name__}"
-        finally:
-            if engine is not None:
-                engine.close()
-
     def stop(self) -> None:
-        """Stop after the chunk in progress (the store keeps the finished ones)."""
-        self._stop.set()
+        """Stop this session's study: a waiting one leaves the queue, a running one stops after
+        the chunk in progress (the store keeps the finished ones)."""
+        if self.ticket is not None:
+            self.queue.stop(self.ticket, self.owner)
+            self.poll()
 
     def wait(self, timeout: float | None = None) -> None:
-        """Wait for the running study (tests, scripts)."""
-        if self._thread is not None:
-            self._thread.join(timeout)
+        """Wait for this session's study to end (tests, scripts)."""
+        if self.ticket is not None:
+            wait_until_ended(self.ticket, timeout)
+
+    @property
+    def outcome(self) -> str | None:
+        """"done", "stopped", "failed", "dropped" once the study ended, else None."""
+        ticket = self.ticket
+        return ticket.state if ticket is not None and ticket.ended.is_set() else None
 
     def poll(self) -> None:
-        """Show the progress and the lines finished so far (periodic callback when served)."""
-        finished, total, elapsed = self._progress
+        """Show the queue position or progress, and the lines finished so far (periodic callback
+        when served)."""
+        ticket = self.ticket
+        if ticket is None:
+            return
+        finished, total, elapsed = ticket.finished, ticket.total, ticket.elapsed
         self.progress.value = min(finished, self.progress.max)
+        if ticket.state == WAITING:
+            ahead = self.queue.position(ticket)
+            running, _waiting = self.queue.counts()
+            self.status.object = (f"waiting: {ahead if ahead is not None else 0} stud"
+                                  f"{'y' if ahead == 1 else 'ies'} ahead in the queue, {running} "
+                                  f"running — {self._conditions}")
+            return
         left = ""
         if 0 < finished < total:
             left = f", ~{elapsed / finished * (total - finished):.0f} s left"
-        self.status.object = f"{finished}/{total} s0-lines, {elapsed:.0f} s{left}"
-        if self.path is not None and (self.path / "zarr.json").is_file():
-            try:
-                self._show(read_map(self.path))
-            except (ValueError, OSError, KeyError):
-                pass  # the store is being created: next poll
-        if self._outcome is not None and not self.running:
-            if self._outcome.startswith("failed"):
-                self._reject(f"the study {self._outcome}")
-            self.status.object = (f"{self._outcome}: {finished}/{total} s0-lines in "
-                                  f"{elapsed:.1f} s — store {html.escape(str(self.path))}")
+        self.status.object = (f"running: {finished}/{total} s0-lines, {elapsed:.0f} s{left} — "
+                              f"{self._conditions}")
+        self._show_running_store(ticket)
+        if ticket.ended.is_set():
+            if ticket.state == FAILED:
+                self._reject(f"the study failed: {ticket.message}")
+            self.status.object = (f"{ticket.state}: {finished}/{total} s0-lines in "
+                                  f"{elapsed:.1f} s — {self._conditions}")
             self.start_button.disabled, self.stop_button.disabled = False, True
+            self.refresh_lists()
             if self._poller is not None:
                 self._poller.stop()
                 self._poller = None
 
+    def _show_running_store(self, ticket: StudyTicket) -> None:
+        path = self.queue.folder.root / ticket.name
+        if (path / "zarr.json").is_file():
+            try:
+                self._show(read_map(path, name=ticket.name))
+            except (ValueError, OSError, KeyError):
+                pass  # the store is being created: next poll
+
     # --- opening -------------------------------------------------------------------------------
 
-    def open(self, path: str) -> None:
-        """Show a finished (or partial) map store; a bad path shows a notice, the map stays."""
+    def open(self, name) -> None:
+        """Show a finished (or partial) map store of the folder's list; a name not in the list,
+        or a store that is not a map, shows a notice and the map stays."""
         try:
-            view = read_map(Path(path.strip()))
+            path = self.queue.folder.path(name, "map")
+            view = read_map(path, name=name)
         except (ValueError, OSError, KeyError) as error:
-            self._reject(str(error))
+            self._reject(str(error) if isinstance(error, ValueError) else
+                         f"the store could not be read ({type(error).__name__})")
             return
         self.notice.visible, self.error = False, ""
         self._show(view)
-        self.status.object = (f"opened {html.escape(path)}: {view.finished}/{view.total} s0-lines; "
-                              f"parameters {view.attrs.get('parameters_hash', '')[:12]}…, code "
-                              f"{html.escape(str(view.attrs.get('code_version', '')))}")
+        self.status.object = (f"opened {html.escape(name)}: {view.finished}/{view.total} "
+                              f"s0-lines; parameters {view.attrs.get('parameters_hash', '')[:12]}…, "
+                              f"code {html.escape(str(view.attrs.get('code_version', '')))}")
 
     def _show(self, view: MapView) -> None:
         self.map = view
@@ -344,13 +363,16 @@ class StudiesView(pn.viewable.Viewer):
 
     # --- the uncertainty band (issue 12) ---------------------------------------------------------
 
-    def open_uncertainty(self, path: str) -> None:
-        """Open an uncertainty result; a bad file shows a notice and the previous band stays."""
+    def open_uncertainty(self, name) -> None:
+        """Open an uncertainty result of the folder's list; a name not in the list or a bad file
+        shows a notice and the previous band stays."""
         try:
-            band = read_band(path)
+            band = read_band(self.queue.folder.path(name, "uncertainty"), name=name)
         except (ValueError, OSError) as error:
+            reason = (str(error) if isinstance(error, ValueError) else
+                      f"the result could not be read ({type(error).__name__})")
             self.band_notice.object = (f"**Uncertainty result not opened (previous one kept):** "
-                                       f"{html.escape(str(error))}")
+                                       f"{html.escape(reason, quote=False)}")
             self.band_notice.visible = True
             return
         self.uncertainty = band
@@ -390,7 +412,7 @@ class StudiesView(pn.viewable.Viewer):
         reason = band_mismatch(band, hash_, N0, b_M, rail)
         if reason is not None:
             self.plot.band.update(None)
-            self.band_notice.object = (f"**Uncertainty band not drawn** ({html.escape(band.path)} "
+            self.band_notice.object = (f"**Uncertainty band not drawn** ({html.escape(band.name)} "
                                        f"does not match {what}): "
                                        f"{html.escape(reason, quote=False)}")
             self.band_notice.visible = True

@@ -8,8 +8,9 @@ motor slope b_M [N m s/rad] — sampled when ``motor_slope`` is an uncertain par
 nominal value —, rail condition), the speeds of s0* [km/h], the sample count and the method
 (prior ranges or linearized posterior).  The band is drawn only when all of that matches the
 set and conditions on screen (:func:`band_mismatch`); otherwise the view says which item does
-not match and why.  The server opens the file by its path (a browser never writes the server's
-disk); nothing here computes physics.
+not match and why.  The server opens the file by its path in its studies folder; a browser only
+picks its name from the server's list (:mod:`app.studies_folder`) and never writes the server's
+disk; messages call the file by that name.  Nothing here computes physics.
 """
 
 from __future__ import annotations
@@ -24,15 +25,16 @@ from bokeh.models import ColumnDataSource
 
 from model.uncertainty import RESULT_FORMAT
 
+from .studies_folder import MAX_RESULT_BYTES as MAX_BYTES  # larger result files: not read
+
 BAND_COLOR = "#7b3294"  # purple: not in the map's red-blue palette
-MAX_BYTES = 50_000_000  # a result file larger than this is refused (not read)
 
 
 @dataclass(frozen=True)
 class UncertaintyBand:
     """The s0*(v) distribution of an uncertainty result (plain data)."""
 
-    path: str
+    name: str  # the file's name (in the server's studies folder)
     method: str  # "prior" or "posterior" ("" in a result without provenance)
     base_samples: int  # n
     runs: int  # model runs
@@ -56,24 +58,26 @@ def _number(value) -> float:
     return math.nan if value is None else float(value)
 
 
-def read_band(path: str | Path) -> UncertaintyBand:
+def read_band(path: str | Path, name: str | None = None) -> UncertaintyBand:
     """The s0*(v) band of an uncertainty result file (raises ValueError: not a file, not JSON,
-    not an uncertainty result, no s0* outputs)."""
+    not an uncertainty result, no s0* outputs; the messages call it ``name``, default its
+    path)."""
     path = Path(str(path).strip())
+    name = str(path) if name is None else name
     if not path.is_file():
-        raise ValueError(f"'{path}' is not a file")
+        raise ValueError(f"'{name}' is not a file")
     if path.stat().st_size > MAX_BYTES:
-        raise ValueError(f"'{path}' is larger than {MAX_BYTES // 1_000_000} MB")
+        raise ValueError(f"'{name}' is larger than {MAX_BYTES // 1_000_000} MB")
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise ValueError(f"'{path}' is not JSON ({error.__class__.__name__})") from None
+        raise ValueError(f"'{name}' is not JSON ({error.__class__.__name__})") from None
     if not isinstance(data, dict) or not isinstance(data.get("outputs"), list):
-        raise ValueError(f"'{path}' is not an uncertainty result (no 'outputs')")
+        raise ValueError(f"'{name}' is not an uncertainty result (no 'outputs')")
     limits = [o for o in data["outputs"] if isinstance(o, dict)
               and str(o.get("name", "")).startswith("s0_limit_")]
     if not limits:
-        raise ValueError(f"'{path}' has no stability-limit outputs (s0_limit_<v>)")
+        raise ValueError(f"'{name}' has no stability-limit outputs (s0_limit_<v>)")
     try:
         speeds = np.array([float(o["name"][len("s0_limit_"):]) for o in limits])
         p5, p50, p95, nominal = (np.array([_number(o.get(key)) for o in limits])
@@ -81,7 +85,7 @@ def read_band(path: str | Path) -> UncertaintyBand:
         conditions = data.get("conditions") or {}
         order = np.argsort(speeds)
         return UncertaintyBand(
-            str(path), str(data.get("method", "")) if data.get("format") == RESULT_FORMAT else "",
+            name, str(data.get("method", "")) if data.get("format") == RESULT_FORMAT else "",
             int(data.get("base_samples", 0)), int(data.get("runs", 0)), speeds[order], p5[order],
             p50[order], p95[order], nominal[order], str(data.get("parameters_hash", "")),
             _number(conditions.get("wheel_force_N")),
@@ -89,7 +93,7 @@ def read_band(path: str | Path) -> UncertaintyBand:
             bool(conditions.get("motor_slope_sampled", False)),
             str(conditions.get("rail", "")))
     except (KeyError, TypeError, ValueError) as error:
-        raise ValueError(f"'{path}': malformed uncertainty result ({error})") from None
+        raise ValueError(f"'{name}': malformed uncertainty result ({error})") from None
 
 
 def band_mismatch(band: UncertaintyBand, parameters_hash: str, N0: float, b_M: float,

@@ -47,6 +47,19 @@ def number(label: str, low: float = -math.inf, high: float = math.inf, low_open:
     return parse
 
 
+def non_negative_int(label: str) -> Callable[[str], int]:
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{label} must be a whole number, got '{text}'") from None
+        if value < 0:
+            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: must be >= 0")
+        return value
+
+    return parse
+
+
 def positive_int(label: str) -> Callable[[str], int]:
     def parse(text: str) -> int:
         try:
@@ -231,9 +244,14 @@ def cmd_export(args: argparse.Namespace) -> None:
 
 def cmd_serve(args: argparse.Namespace) -> None:
     from app.serve import serve
+    from app.server_settings import ServerSettings
 
+    settings = ServerSettings.from_options(
+        scheduler=args.scheduler, studies_dir=args.studies_dir,
+        max_study_points=args.max_study_points, max_running_studies=args.max_running_studies,
+        max_waiting_studies=args.max_waiting_studies)
     serve(port=args.port, address=args.address, allow_websocket_origin=args.allow_websocket_origin,
-          params=args.params)
+          params=args.params, settings=settings)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -282,13 +300,39 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="output file (.npz)")
     p.set_defaults(func=cmd_export)
 
-    p = sub.add_parser("serve", help="serve the dashboard (panel serve semantics)")
+    p = sub.add_parser(
+        "serve", help="serve the dashboard (panel serve semantics)",
+        description="Serve the dashboard at /app (liveness: /liveness?endpoint=/app).  The options "
+                    "below are the operator's: no browser can change them (docs/security.md).  "
+                    "Each study option has an environment variable of the same meaning (named in "
+                    "its help); the option wins over the variable.")
     p.add_argument("--port", type=number("--port", 0, 65536, low_open=False,
                                          allowed="must be 0…65535"), default=5006)
-    p.add_argument("--address", default="127.0.0.1")
+    p.add_argument("--address", default="127.0.0.1", help="interface to listen on (default "
+                   "%(default)s; 0.0.0.0: every interface)")
     p.add_argument("--allow-websocket-origin", action="append", default=None,
-                   help="host[:port] allowed to open the websocket (repeatable)")
+                   help="host[:port] allowed to open the websocket (repeatable; environment: "
+                        "BOGIE_ALLOWED_ORIGINS, comma-separated)")
     p.add_argument("--params", default=None, metavar="FILE", help="parameter file (TOML)")
+    p.add_argument("--scheduler", default=None, metavar="ADDR",
+                   help="Dask scheduler the dashboard's studies run on (tcp://host:port; "
+                        "environment: BOGIE_SCHEDULER); default: one local cluster of this server, "
+                        "started on the first study, one worker process per core, shared by all "
+                        "sessions")
+    p.add_argument("--studies-dir", default=None, metavar="DIR",
+                   help="folder studies are written to and opened from (created if missing; "
+                        "environment: BOGIE_STUDIES_DIR; default ~/.local/share/bogie/studies)")
+    p.add_argument("--max-study-points", type=positive_int("--max-study-points"), default=None,
+                   metavar="N", help="largest study a session may ask for, s0 points × v points "
+                                     "(environment: BOGIE_MAX_STUDY_POINTS; default 10000)")
+    p.add_argument("--max-running-studies", type=positive_int("--max-running-studies"),
+                   default=None, metavar="K",
+                   help="studies running at once; more wait in a queue (environment: "
+                        "BOGIE_MAX_RUNNING_STUDIES; default 1)")
+    p.add_argument("--max-waiting-studies", type=non_negative_int("--max-waiting-studies"),
+                   default=None, metavar="W",
+                   help="studies waiting at most; more requests are refused with a notice "
+                        "(environment: BOGIE_MAX_WAITING_STUDIES; default 16)")
     p.set_defaults(func=cmd_serve)
 
     for register in EXTRA_COMMANDS:

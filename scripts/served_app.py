@@ -37,14 +37,18 @@ def alive(url: str, timeout: float = 60.0) -> bool:
     return False
 
 
-def start_server(port: int, name: str) -> subprocess.Popen:
-    """``bogie serve --port PORT`` with its log in ``<tmp>/<name>_server_<port>.log``; exits
-    the calling script if the server is not up within 180 s."""
+def start_server(port: int, name: str, *options: str) -> subprocess.Popen:
+    """``bogie serve --port PORT [options]`` with its log in ``<tmp>/<name>_server_<port>.log``
+    and its studies in a new temporary folder (unless the options name one); exits the calling
+    script if the server is not up within 180 s."""
     server_log = Path(tempfile.gettempdir()) / f"{name}_server_{port}.log"
+    if "--studies-dir" not in options:
+        options = (*options, "--studies-dir", tempfile.mkdtemp(prefix=f"{name}_studies_"))
     print(f"{name}: {time.strftime('%H:%M:%S')} server log: {server_log}", file=sys.stderr,
           flush=True)
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
-    process = subprocess.Popen([str(ROOT / ".venv/bin/bogie"), "serve", "--port", str(port)],
+    process = subprocess.Popen([str(ROOT / ".venv/bin/bogie"), "serve", "--port", str(port),
+                                *options],
                                cwd=ROOT, stdout=subprocess.DEVNULL,
                                stderr=server_log.open("w"), env=env)
     if not alive(f"http://127.0.0.1:{port}", timeout=180):
