@@ -80,9 +80,11 @@ def app_server():
     thread.stop()
 
 
-def start_bogie_serve(log_dir: Path):
-    """(base URL, process) of a ``bogie serve`` process on a free port of 127.0.0.1, its stderr
-    in ``log_dir/serve.log``, answering its liveness endpoint."""
+def start_bogie_serve(log_dir: Path, *options: str, environment: dict | None = None):
+    """(base URL, process) of a ``bogie serve`` process on a free port of 127.0.0.1 (more
+    ``options`` of ``bogie serve`` and ``environment`` variables may be given), its stderr in
+    ``log_dir/serve.log``, answering its liveness endpoint.  Its studies folder is
+    ``log_dir/studies`` unless the options name one."""
     import socket
     import subprocess
     import sys
@@ -91,10 +93,14 @@ def start_bogie_serve(log_dir: Path):
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     with open(log_dir / "serve.log", "w") as stderr:
-        process = subprocess.Popen([sys.executable, "-m", "model", "serve", "--port", str(port)],
+        if "--studies-dir" not in options:
+            options = (*options, "--studies-dir", str(log_dir / "studies"))
+        process = subprocess.Popen([sys.executable, "-m", "model", "serve", "--port", str(port),
+                                    *options],
                                    cwd=Path(__file__).resolve().parent.parent,
                                    stdout=subprocess.DEVNULL, stderr=stderr,
-                                   env={**os.environ, "OPENBLAS_NUM_THREADS": "1"})
+                                   env={**os.environ, "OPENBLAS_NUM_THREADS": "1",
+                                        **(environment or {})})
     url = f"http://127.0.0.1:{port}"
     try:
         wait_for_liveness(url, timeout=180)
@@ -120,12 +126,14 @@ def stop_process(process, timeout: float = 30) -> None:
 
 @pytest.fixture(scope="module")
 def own_server(tmp_path_factory):
-    """(base URL, process id) of a ``bogie serve`` process started for one test module: a fresh
+    """(base URL, process id, studies folder) of a ``bogie serve`` process started for one test
+    module: a fresh
     server as a reviewer gets it, sharing no state (sessions, caches, background work, Bokeh's
     and Panel's process-wide settings) with the tests that ran before in this process."""
-    url, process = start_bogie_serve(tmp_path_factory.mktemp("server"))
+    log_dir = tmp_path_factory.mktemp("server")
+    url, process = start_bogie_serve(log_dir)
     try:
-        yield url, process.pid
+        yield url, process.pid, log_dir / "studies"
     finally:
         stop_process(process)
 
@@ -159,6 +167,42 @@ def open_app(browser, url: str, timeout_ms: float = 120_000, viewport=(1600, 100
     page.wait_for_selector("canvas", timeout=timeout_ms)
     page.wait_for_selector(".stability-status", timeout=timeout_ms)
     return page
+
+
+# --- the server's study queue without a server ---------------------------------------------------
+
+class InProcessEngine:
+    """A study engine that runs the chunks in this process, in order (the reference of the
+    tests; the served app always uses the operator's Dask engine)."""
+
+    def start(self) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+    @staticmethod
+    def map_unordered(function, items):
+        from model.study_engine import serial_map_unordered
+
+        return serial_map_unordered(function, items)
+
+
+def install_study_queue(folder: Path, engine_factory=InProcessEngine, **settings):
+    """Install a study queue on ``folder`` as the process's (dashboards built afterwards use it);
+    returns (queue, restore) where ``restore()`` puts the previous queue back."""
+    from app.server_settings import ServerSettings
+    from app.study_queue import StudyQueue, replace_study_queue
+
+    queue = StudyQueue(ServerSettings(studies_dir=folder, **settings),
+                       engine_factory=engine_factory)
+    previous = replace_study_queue(queue)
+
+    def restore() -> None:
+        replace_study_queue(previous)
+        queue.close()
+
+    return queue, restore
 
 
 # --- golden files (tests/golden/*.json) ------------------------------------------------------------

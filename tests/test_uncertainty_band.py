@@ -19,9 +19,11 @@ import numpy as np
 import param
 import pytest
 from bokeh.document import Document
+from conftest import install_study_queue
 
 from app import compute
 from app.dashboard import BogieDashboard
+from app.studies_folder import refusal
 from app.studies_view import MapView
 from app.uncertainty_band import band_mismatch, read_band
 from model.parameters import parameter_hash
@@ -52,11 +54,19 @@ def _result_file(path: Path, parameters, method="posterior", names=None, seed=3)
 
 
 @pytest.fixture(scope="module")
-def dash():
+def dash(tmp_path_factory):
+    _queue, restore = install_study_queue(tmp_path_factory.mktemp("studies"))
     dashboard = BogieDashboard()
     doc = Document()
     doc.add_root(dashboard.layout.get_root(doc))
-    return dashboard
+    yield dashboard
+    restore()
+
+
+def _in_folder(view, name: str, parameters, **kwargs) -> str:
+    """Write a result into the server's studies folder; its name (what a reviewer picks)."""
+    _result_file(view.queue.folder.root / name, parameters, **kwargs)
+    return name
 
 
 @pytest.fixture
@@ -70,12 +80,14 @@ def view(dash):
     return view
 
 
-def test_matching_result_draws_its_band(view, dash, tmp_path):
+def test_matching_result_draws_its_band(view, dash):
     parameters = compute.parameters("", "calibrated")
     assert parameters["wheel_force"] == 100e3
-    path = _result_file(tmp_path / "u.json", parameters)
+    path = view.queue.folder.root / _in_folder(view, "u.json", parameters)
     band = read_band(path)
-    view.uncertainty_path.value = str(path)
+    view.refresh_lists()
+    assert "u.json" in view.uncertainty_select.options
+    view.uncertainty_select.value = "u.json"
     view.uncertainty_button.clicks += 1  # the button's own callback
     assert view.uncertainty is not None
     assert not view.band_notice.visible, view.band_notice.object
@@ -106,8 +118,8 @@ def test_matching_result_draws_its_band(view, dash, tmp_path):
     ({"b_M": 2000.0}, f"motor slope b_M: result sampled around {B_M:g} N m s/rad, screen 2000"),
     ({"rail": "wet"}, "rail condition: result 'calibrated', screen 'wet'"),
 ])
-def test_other_conditions_clear_the_band_and_say_why(view, dash, tmp_path, change, reason):
-    view.open_uncertainty(str(_result_file(tmp_path / "u.json", compute.parameters("", "calibrated"))))
+def test_other_conditions_clear_the_band_and_say_why(view, dash, change, reason):
+    view.open_uncertainty(_in_folder(view, "u.json", compute.parameters("", "calibrated")))
     assert view.plot.band.shown
     with param.parameterized.discard_events(dash):
         dash.param.update(**change)
@@ -124,8 +136,8 @@ def test_other_conditions_clear_the_band_and_say_why(view, dash, tmp_path, chang
     assert not view.band_notice.visible
 
 
-def test_slider_change_rechecks_the_band(view, dash, tmp_path):
-    view.open_uncertainty(str(_result_file(tmp_path / "u.json", compute.parameters("", "calibrated"))))
+def test_slider_change_rechecks_the_band(view, dash):
+    view.open_uncertainty(_in_folder(view, "u.json", compute.parameters("", "calibrated")))
     assert view.plot.band.shown
     dash.N0 = 110.0  # the watcher re-checks (the dashboard recomputes its point too)
     assert not view.plot.band.shown
@@ -134,9 +146,9 @@ def test_slider_change_rechecks_the_band(view, dash, tmp_path):
     assert view.plot.band.shown
 
 
-def test_other_parameter_set_and_old_format_are_not_drawn(view, tmp_path):
+def test_other_parameter_set_and_old_format_are_not_drawn(view):
     other = compute.parameters("", "calibrated").replace(yaw_damping=3e5)
-    view.open_uncertainty(str(_result_file(tmp_path / "u.json", other)))
+    view.open_uncertainty(_in_folder(view, "u.json", other))
     assert not view.plot.band.shown
     assert "parameter set: result" in view.band_notice.object
     assert "re-calibrated" in view.band_notice.object
@@ -145,21 +157,21 @@ def test_other_parameter_set_and_old_format_are_not_drawn(view, tmp_path):
                          / "uncertainty_n16.json").read_text(encoding="utf-8"))
     stored.pop("parameters_hash")
     stored.pop("conditions", None)
-    old = tmp_path / "old.json"
-    old.write_text(json.dumps(stored), encoding="utf-8")
-    view.open_uncertainty(str(old))
+    (view.queue.folder.root / "old.json").write_text(json.dumps(stored), encoding="utf-8")
+    view.open_uncertainty("old.json")
     assert not view.plot.band.shown
     assert "does not say which parameter set" in view.band_notice.object
 
 
 def test_bad_file_keeps_the_previous_band(view, tmp_path):
-    path = _result_file(tmp_path / "u.json", compute.parameters("", "calibrated"))
-    view.open_uncertainty(str(path))
+    view.open_uncertainty(_in_folder(view, "u.json", compute.parameters("", "calibrated")))
     shown = view.uncertainty
-    (tmp_path / "bad.json").write_text("{not json", encoding="utf-8")
-    for bad, message in ((tmp_path / "bad.json", "is not JSON"),
-                         (tmp_path / "missing.json", "is not a file")):
-        view.open_uncertainty(str(bad))
+    (view.queue.folder.root / "bad.json").write_text("{not json", encoding="utf-8")
+    (tmp_path / "outside.json").write_text("{}", encoding="utf-8")
+    for bad, message in (("bad.json", "'bad.json' is not JSON"),
+                         ("missing.json", refusal("uncertainty")),
+                         (str(tmp_path / "outside.json"), refusal("uncertainty"))):
+        view.open_uncertainty(bad)
         assert view.band_notice.visible
         assert message in view.band_notice.object
         assert "previous one kept" in view.band_notice.object
@@ -167,9 +179,9 @@ def test_bad_file_keeps_the_previous_band(view, tmp_path):
         assert view.plot.band.shown
 
 
-def test_the_map_on_screen_decides(view, tmp_path):
+def test_the_map_on_screen_decides(view):
     parameters = compute.parameters("", "calibrated")
-    view.open_uncertainty(str(_result_file(tmp_path / "u.json", parameters)))
+    view.open_uncertainty(_in_folder(view, "u.json", parameters))
     assert view.plot.band.shown
 
     def map_view(hash_, N0=100e3, b_M=B_M):
