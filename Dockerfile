@@ -14,6 +14,7 @@ ENV PYTHONDONTWRITEBYTECODE=1 \
     PIP_DISABLE_PIP_VERSION_CHECK=1 \
     PIP_NO_CACHE_DIR=1 \
     BOGIE_PORT=5006 \
+    BOGIE_STUDIES_DIR=/data/studies \
     PATH=/app/.venv/bin:$PATH
 
 WORKDIR /app
@@ -30,10 +31,12 @@ RUN mkdir model app \
 COPY . .
 RUN .venv/bin/python -m pip install --no-cache-dir --no-deps -e . \
     && bogie --help >/dev/null \
-    && useradd --create-home --uid 10001 --user-group --shell /usr/sbin/nologin bogie
+    && useradd --create-home --uid 10001 --user-group --shell /usr/sbin/nologin bogie \
+    && mkdir -p /data/studies && chown -R 10001:10001 /data
 
 # Run as the unprivileged user bogie (uid 10001); the code and the virtual environment stay owned
-# by root, read-only for the server.
+# by root, read-only for the server.  Studies are written to /data/studies (BOGIE_STUDIES_DIR),
+# owned by bogie: mount a volume there to keep them (docs/docker.md).
 USER 10001
 EXPOSE 5006
 # Python handles SIGINT (KeyboardInterrupt) even as PID 1; the default SIGTERM would be ignored.
@@ -43,5 +46,7 @@ STOPSIGNAL SIGINT
 HEALTHCHECK --interval=30s --timeout=10s --start-period=30s --retries=3 \
     CMD ["python3", "-c", "import os, urllib.request as u; u.urlopen('http://127.0.0.1:%s/liveness?endpoint=/app' % os.environ.get('BOGIE_PORT', '5006'), timeout=8)"]
 
-# Websocket origins: BOGIE_ALLOWED_ORIGINS (comma-separated host[:port]; default: localhost only).
+# Operator settings (docs/security.md), as environment variables: BOGIE_ALLOWED_ORIGINS
+# (comma-separated host[:port]; default: localhost only), BOGIE_SCHEDULER, BOGIE_STUDIES_DIR,
+# BOGIE_MAX_STUDY_POINTS, BOGIE_MAX_RUNNING_STUDIES, BOGIE_MAX_WAITING_STUDIES.
 CMD ["sh", "-c", "exec bogie serve --address 0.0.0.0 --port \"${BOGIE_PORT}\""]
