@@ -10,10 +10,11 @@ says ``_hz``)::
     r = eigen_analysis(m, op)                  # r.stable, r.complex_pairs, r.real …
 """
 
-from .assembly import BogieModel, build_model
-from .eigen import EigenResult, eigen_analysis, state_matrix
-from .modes import ModeCharacter, characterize, mode_character
-from .operating_point import (
+from model.analysis.eigen import EigenResult, eigen_analysis, state_matrix
+from model.analysis.modes import ModeCharacter, characterize, mode_character
+from model.analysis.stability import NoStabilityLimit, StabilityLimit, stability_limit
+from model.mechanics.assembly import BogieModel, build_model
+from model.mechanics.operating_point import (
     KMH,
     OperatingPoint,
     OperatingPointError,
@@ -24,9 +25,8 @@ from .operating_point import (
     default_operating_point,
     motor_torque,
 )
-from .outputs import OutputMatrices, output_matrices
-from .parameters import ParameterError, Parameters, load_parameters
-from .stability import NoStabilityLimit, StabilityLimit, stability_limit
+from model.mechanics.outputs import OutputMatrices, output_matrices
+from model.mechanics.parameters import ParameterError, Parameters, load_parameters
 
 __all__ = [
     "KMH", "BogieModel", "EigenResult", "ModeCharacter", "NoStabilityLimit", "OperatingPoint",

@@ -282,7 +282,7 @@ async def session(page, seed: int, presses: int) -> list[float]:
 async def variant_screenshot(page, path: Path) -> None:
     """The Variant tab with a variant (driving shaft 30 % softer) uploaded and compared with the
     baseline; then back to the baseline and the Response tab."""
-    from model.parameters import dumps_parameters, load_parameters
+    from model.mechanics.parameters import dumps_parameters, load_parameters
 
     await page.locator(".bk-tab", has_text="Variant").first.click()
     base = load_parameters()

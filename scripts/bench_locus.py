@@ -21,8 +21,8 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from model import build_model, default_operating_point, eigen_analysis, load_parameters
-from model.eigen import forget_systems
-from model.locus import dense_generalized_eigenvalues, root_locus
+from model.analysis.eigen import forget_systems
+from model.analysis.locus import dense_generalized_eigenvalues, root_locus
 
 
 def best_of(repeat: int, function, before=None):

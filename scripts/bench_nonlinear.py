@@ -9,7 +9,7 @@ One run, one system (calibrated set; default s0 = 0.014, 120 km/h, the unstable 
 excitation, anti-slip off (a plain ODE for Radau), all 20 outputs.
 
 * nonlinear, cold: a fresh operating point (eigendecomposition, the stepping set-up) + the run +
-  all post-processing of :func:`model.nonlinear.nonlinear_response`;
+  all post-processing of :func:`model.analysis.nonlinear.nonlinear_response`;
 * nonlinear, warm: the same with the decomposition and the set-up cached (what a second run at
   the same point, e.g. another anti-slip delay, costs);
 * first call in this process: the same as cold, plus the first imports of the step loop;
@@ -42,16 +42,16 @@ import scipy.signal
 from bench_response import best_of, run_radau  # the same Radau loop and timing as there
 
 from model import build_model, default_operating_point, load_parameters
-from model.eigen import bogie_system, forget_systems
-from model.nonlinear import (
+from model.analysis.eigen import bogie_system, forget_systems
+from model.analysis.nonlinear import (
     creep_force_map,
     creep_velocity_map,
     damping_without_longitudinal_creep,
     nonlinear_response,
 )
-from model.operating_point import creep_law
-from model.outputs import output_matrices
-from model.response import ShortCircuit
+from model.analysis.response import ShortCircuit
+from model.mechanics.operating_point import creep_law
+from model.mechanics.outputs import output_matrices
 
 
 def radau_system(model, op, excitation, step):

@@ -11,7 +11,7 @@ C_v) with the state augmented by the generator of M_C, stepped sample by sample 
   post-processing of :func:`short_circuit_response` (peaks, spectra, limit checks);
 * closed form, warm: the same call with the per-operating-point decomposition cached (changing
   the excitation, the horizon or the sampling, as the dashboard does);
-* closed form, solve only: the warm time history alone (:func:`model.response.solve_linear`);
+* closed form, solve only: the warm time history alone (:func:`model.analysis.response.solve_linear`);
 * lsim: ``scipy.signal.lsim`` on the same state space and the sampled M_C (first-order hold);
 * Radau: ``scipy.integrate.Radau`` (rtol 1e-8, the exact Jacobian) stepped as ``solve_ivp`` does,
   its dense output evaluated on the grid; stopped after ``--radau-budget`` seconds of CPU time
@@ -37,9 +37,9 @@ import scipy.signal
 from scipy.integrate import Radau
 
 from model import build_model, default_operating_point, load_parameters
-from model.eigen import bogie_system, forget_systems
-from model.outputs import output_matrices
-from model.response import ShortCircuit, short_circuit_response, solve_linear
+from model.analysis.eigen import bogie_system, forget_systems
+from model.analysis.response import ShortCircuit, short_circuit_response, solve_linear
+from model.mechanics.outputs import output_matrices
 
 
 def exact_reference(A, b, C, u0, M0, w, sigma, shift, steps, dt):

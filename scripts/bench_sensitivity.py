@@ -7,8 +7,8 @@ In one run, on the calibrated set at s0 = 0.005, 120 km/h:
 
 * reference: one eigen-analysis with vectors at a fresh operating point (cold decomposition);
 * sensitivities: every parameter and s0, v, N0, b_M for the ten lowest modes
-  (:func:`model.sensitivity.eigen_sensitivities`, the decomposition cached, ``describe=False``)
-  plus ds0*/dp at a known s0* (:func:`model.sensitivity.limit_sensitivity`, its eigenvalues-only
+  (:func:`model.analysis.sensitivity.eigen_sensitivities`, the decomposition cached, ``describe=False``)
+  plus ds0*/dp at a known s0* (:func:`model.analysis.sensitivity.limit_sensitivity`, its eigenvalues-only
   analysis at s0* included); the ratio (reference + sensitivities)/reference is the issue's
   "≤ 2×" target; the modes' energy shares and descriptions are timed separately;
 * cold: the derivative matrices of the parameter set (complex step, once per set);
@@ -18,7 +18,7 @@ In one run, on the calibrated set at s0 = 0.005, 120 km/h:
   cost of one model run timed here, and the n projected for width 0.05 on every output
   (width ∝ n^(−1/2)) with its serial cost and on N workers (the runs are independent);
 * s0*: where it equals the creep maximum for every sample, its Sobol indices from the creep law
-  alone (:func:`model.uncertainty.creep_maximum_study`) at ``--creep-n`` (4096).
+  alone (:func:`model.studies.uncertainty.creep_maximum_study`) at ``--creep-n`` (4096).
 
 Times are the median of ``--repeats`` repeats, wall clock; the machine may be shared (ratios are
 from the same run).
@@ -36,16 +36,16 @@ from pathlib import Path
 import numpy as np
 
 from model import build_model, load_parameters
-from model.eigen import eigen_analysis, forget_systems
-from model.operating_point import KMH, OperatingPoint
-from model.sensitivity import (
+from model.analysis.eigen import eigen_analysis, forget_systems
+from model.analysis.sensitivity import (
     eigen_sensitivities,
     limit_sensitivity,
     peak_load_sensitivities,
     structural_derivatives,
 )
-from model.stability import stability_limit
-from model.uncertainty import UNCERTAIN_PARAMETERS, creep_maximum_study, evaluate_chunk
+from model.analysis.stability import stability_limit
+from model.mechanics.operating_point import KMH, OperatingPoint
+from model.studies.uncertainty import UNCERTAIN_PARAMETERS, creep_maximum_study, evaluate_chunk
 
 
 def main() -> None:

@@ -43,12 +43,12 @@ from scipy.optimize import linear_sum_assignment
 from threadpoolctl import threadpool_limits
 
 from model import KMH, build_model, eigen_analysis, load_parameters, stability_limit
-from model.continuation import continue_line
-from model.eigen import forget_systems
-from model.operating_point import OperatingPoint
-from model.study import MapStudy, dense_line, s0_line
-from model.study_engine import StudyEngine, serial_map_unordered
-from model.study_store import open_study, run_into_store
+from model.analysis.continuation import continue_line
+from model.analysis.eigen import forget_systems
+from model.mechanics.operating_point import OperatingPoint
+from model.studies.engine import StudyEngine, serial_map_unordered
+from model.studies.maps import MapStudy, dense_line, s0_line
+from model.studies.store import open_study, run_into_store
 
 
 def _noop(x):
@@ -228,7 +228,7 @@ def main() -> None:
 
 
 def _warm(parameters):
-    from model.study import cached_model
+    from model.studies.maps import cached_model
 
     cached_model(parameters)
     return os.getpid()

@@ -31,10 +31,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from model import build_model, default_operating_point, load_parameters
-from model.antislip import required_reaction_time
-from model.nonlinear import AntiSlip, nonlinear_response
-from model.operating_point import OperatingPoint, creep_law
-from model.response import ShortCircuit, dominant_frequencies, short_circuit_response
+from model.analysis.antislip import required_reaction_time
+from model.analysis.nonlinear import AntiSlip, nonlinear_response
+from model.analysis.response import ShortCircuit, dominant_frequencies, short_circuit_response
+from model.mechanics.operating_point import OperatingPoint, creep_law
 
 CASES = [(0.005, 120.0), (0.014, 120.0), (0.005, 200.0), (0.014, 200.0)]
 COLORS = {"ID1": "tab:red", "ID2": "tab:blue"}

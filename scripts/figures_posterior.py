@@ -7,7 +7,7 @@
     OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/figures_posterior.py [--out assets/figures] [--app]
 
 Prints the prior and posterior standard deviations of ln p per uncertain parameter
-(:mod:`model.posterior`) with the targets that pin each (largest Jacobian entries), the linear
+(:mod:`model.studies.posterior`) with the targets that pin each (largest Jacobian entries), the linear
 prediction of the posterior spread of the creep maximum at 120 km/h, and the 5–95 % widths of
 every output of both studies; draws ``uncertainty_prior_posterior.png`` (s0*(v) of the set,
 both 5–95 % bands with their medians, the published 0.0082 at 120 km/h).  ``--app`` also
@@ -29,10 +29,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from model.calibration import STABILITY_LIMIT
-from model.parameters import load_parameters, parameter_hash
-from model.posterior import linearized_posterior
-from model.uncertainty import UNCERTAIN_PARAMETERS
+from model.mechanics.parameters import load_parameters, parameter_hash
+from model.studies.calibration import STABILITY_LIMIT
+from model.studies.posterior import linearized_posterior
+from model.studies.uncertainty import UNCERTAIN_PARAMETERS
 
 
 def limits(data: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -54,10 +54,10 @@ def main() -> None:
     # cost: the posterior (one eigen-analysis with vectors, the analytic sensitivities with the
     # derivative matrices of a fresh model, 24 operating-data evaluations) against one
     # eigen-analysis with vectors of the same set, same run
-    from model.assembly import build_model
-    from model.calibration import S0_STABLE, V_REF
-    from model.eigen import eigen_analysis
-    from model.operating_point import OperatingPoint
+    from model.analysis.eigen import eigen_analysis
+    from model.mechanics.assembly import build_model
+    from model.mechanics.operating_point import OperatingPoint
+    from model.studies.calibration import S0_STABLE, V_REF
 
     op = OperatingPoint(S0_STABLE, V_REF, parameters["wheel_force"], parameters["motor_slope"])
     model = build_model(parameters)
@@ -127,19 +127,19 @@ def main() -> None:
 
 
 def app_figure(parameters, result: Path, png: Path) -> None:
-    """The Studies tab's figure (app.studies_view.StudyMapPlot) with a fresh map and the band."""
+    """The Studies tab's figure (app.dashboard.studies_view.StudyMapPlot) with a fresh map and the band."""
     import tempfile
 
     from bokeh.embed import file_html
     from bokeh.resources import INLINE
     from playwright.sync_api import sync_playwright
 
-    from app.studies_view import StudyMapPlot, read_map
-    from app.uncertainty_band import band_mismatch, read_band
-    from model.operating_point import KMH
-    from model.study import MapStudy
-    from model.study_engine import serial_map_unordered
-    from model.study_store import run_into_store
+    from app.dashboard.studies_view import StudyMapPlot, read_map
+    from app.dashboard.uncertainty_band import band_mismatch, read_band
+    from model.mechanics.operating_point import KMH
+    from model.studies.engine import serial_map_unordered
+    from model.studies.maps import MapStudy
+    from model.studies.store import run_into_store
 
     with tempfile.TemporaryDirectory() as folder:
         store = Path(folder) / "map.zarr"

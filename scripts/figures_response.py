@@ -26,7 +26,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from model import build_model, default_operating_point, load_parameters
-from model.response import ShortCircuit, short_circuit_response
+from model.analysis.response import ShortCircuit, short_circuit_response
 
 COLORS = {"ID1": "tab:red", "ID2": "tab:blue"}
 

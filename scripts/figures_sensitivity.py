@@ -31,13 +31,13 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from model import build_model, load_parameters
-from model.operating_point import KMH, OperatingPoint, creep_law
-from model.parameters import Parameters
-from model.sensitivity import (
+from model.analysis.sensitivity import (
     eigen_sensitivities,
     limit_sensitivity,
     peak_load_sensitivities,
 )
+from model.mechanics.operating_point import KMH, OperatingPoint, creep_law
+from model.mechanics.parameters import Parameters
 
 LINKED = ("wheel_force", "motor_slope")
 PUBLISHED_LIMIT = 0.0082  # target only: drawn as a marker, never used by the model
@@ -86,7 +86,7 @@ def figure_limit(model, parameters, out: Path) -> None:
 def figure_growth(model, parameters, out: Path) -> None:
     op = at_120(parameters, 0.014)
     sens = eigen_sensitivities(model, op, linked=LINKED)
-    from model.eigen import eigen_analysis
+    from model.analysis.eigen import eigen_analysis
 
     result = eigen_analysis(model, op)
     divergent = int(result.real_index[0])

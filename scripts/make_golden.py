@@ -36,7 +36,7 @@ from model import (  # noqa: E402
     motor_torque,
     stability_limit,
 )
-from model.operating_point import KMH, OperatingPoint  # noqa: E402
+from model.mechanics.operating_point import KMH, OperatingPoint  # noqa: E402
 
 GOLDEN_FILE = ROOT / "tests" / "golden" / "calibrated.json"
 SPEED_KMH = 120.0

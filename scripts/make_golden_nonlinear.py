@@ -27,9 +27,9 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from model import build_model, load_parameters  # noqa: E402
-from model.nonlinear import AntiSlip, nonlinear_response  # noqa: E402
-from model.operating_point import OperatingPoint  # noqa: E402
-from model.response import ShortCircuit  # noqa: E402
+from model.analysis.nonlinear import AntiSlip, nonlinear_response  # noqa: E402
+from model.analysis.response import ShortCircuit  # noqa: E402
+from model.mechanics.operating_point import OperatingPoint  # noqa: E402
 
 GOLDEN_FILE = ROOT / "tests" / "golden" / "nonlinear.json"
 COMMAND = ".venv/bin/python scripts/make_golden_nonlinear.py"

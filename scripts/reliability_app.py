@@ -135,7 +135,7 @@ def _release(slider, value) -> None:
 
 def variant_of(index: int) -> dict[str, float]:
     """Session ``index``'s variant: the silent blocks' vertical stiffness × (1 + 0.1 index)."""
-    from model.parameters import load_parameters
+    from model.mechanics.parameters import load_parameters
 
     base = load_parameters()
     return {"silent_block_stiffness_z": base["silent_block_stiffness_z"] * (1 + 0.1 * index)}
@@ -147,9 +147,9 @@ def isolation(url: str, sessions: int) -> dict:
     import numpy as np
     from bokeh.client import pull_session
 
-    from app.variants import encode, parameters_of_key, set_key
+    from app.results.variants import encode, parameters_of_key, set_key
     from model import build_model, eigen_analysis
-    from model.operating_point import OperatingPoint
+    from model.mechanics.operating_point import OperatingPoint
 
     _register_panel_models()
     shown: dict[int, list[complex]] = {}
@@ -294,7 +294,7 @@ def _upload(doc, data: bytes, filename: str = "set.toml") -> None:
 
 
 def bad_uploads() -> dict[str, bytes]:
-    from model.parameters import dumps_parameters, load_parameters
+    from model.mechanics.parameters import dumps_parameters, load_parameters
 
     text = dumps_parameters(load_parameters())
     line = next(x for x in text.splitlines() if x.startswith("gear_ratio ="))

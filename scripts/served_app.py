@@ -64,8 +64,8 @@ def machine_yardstick() -> str:
     from threadpoolctl import threadpool_limits
 
     from model import KMH, build_model, eigen_analysis, load_parameters
-    from model.eigen import forget_systems
-    from model.operating_point import OperatingPoint
+    from model.analysis.eigen import forget_systems
+    from model.mechanics.operating_point import OperatingPoint
 
     parameters = load_parameters()
     model = build_model(parameters)

@@ -24,7 +24,15 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from model import build_model, eigen_analysis, load_parameters, mode_character  # noqa: E402
-from model.calibration import (  # noqa: E402
+from model.analysis.eigen import state_space  # noqa: E402
+from model.analysis.linear_system import LinearSystem  # noqa: E402
+from model.analysis.stability import stability_limit  # noqa: E402
+from model.mechanics.operating_point import (  # noqa: E402
+    OperatingPoint,
+    creep_coefficients,
+    creep_damping,
+)
+from model.studies.calibration import (  # noqa: E402
     MODE_SIGNATURES,
     TABLE1_IM_HZ,
     TABLE1_RE,
@@ -34,14 +42,6 @@ from model.calibration import (  # noqa: E402
     format_table,
     match_table1_modes,
 )
-from model.eigen import state_space  # noqa: E402
-from model.linear_system import LinearSystem  # noqa: E402
-from model.operating_point import (  # noqa: E402
-    OperatingPoint,
-    creep_coefficients,
-    creep_damping,
-)
-from model.stability import stability_limit  # noqa: E402
 
 
 def _hz(z: complex) -> float:

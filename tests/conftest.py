@@ -64,7 +64,7 @@ def app_server():
     import panel as pn
     from panel.io.state import state
 
-    from app.serve import create_app, limit_blas_threads
+    from app.server.serve import create_app, limit_blas_threads
 
     limit_blas_threads()
     server_id = f"bogie-test-{uuid.uuid4().hex[:8]}"
@@ -95,7 +95,7 @@ def start_bogie_serve(log_dir: Path, *options: str, environment: dict | None = N
     with open(log_dir / "serve.log", "w") as stderr:
         if "--studies-dir" not in options:
             options = (*options, "--studies-dir", str(log_dir / "studies"))
-        process = subprocess.Popen([sys.executable, "-m", "model", "serve", "--port", str(port),
+        process = subprocess.Popen([sys.executable, "-m", "app", "serve", "--port", str(port),
                                     *options],
                                    cwd=Path(__file__).resolve().parent.parent,
                                    stdout=subprocess.DEVNULL, stderr=stderr,
@@ -183,7 +183,7 @@ class InProcessEngine:
 
     @staticmethod
     def map_unordered(function, items):
-        from model.study_engine import serial_map_unordered
+        from model.studies.engine import serial_map_unordered
 
         return serial_map_unordered(function, items)
 
@@ -191,8 +191,8 @@ class InProcessEngine:
 def install_study_queue(folder: Path, engine_factory=InProcessEngine, **settings):
     """Install a study queue on ``folder`` as the process's (dashboards built afterwards use it);
     returns (queue, restore) where ``restore()`` puts the previous queue back."""
-    from app.server_settings import ServerSettings
-    from app.study_queue import StudyQueue, replace_study_queue
+    from app.services.settings import ServerSettings
+    from app.services.study_queue import StudyQueue, replace_study_queue
 
     queue = StudyQueue(ServerSettings(studies_dir=folder, **settings),
                        engine_factory=engine_factory)
@@ -220,7 +220,7 @@ def golden_parameters(golden: dict, path: Path, regenerate: str):
     """The parameter set stored in a golden file (its values, units from the schema); fails if
     they no longer fit the schema."""
     from model import ParameterError
-    from model.parameters import SCHEMA, parse_parameters
+    from model.mechanics.parameters import SCHEMA, parse_parameters
 
     table = {name: {"value": value, "unit": SCHEMA[name][0] if name in SCHEMA else "?"}
              for name, value in golden["parameters"].items()}

@@ -16,9 +16,9 @@ import urllib.request
 import numpy as np
 import pytest
 
-from app import compute
+from app.results import compute
 from model import eigen_analysis
-from model.parameters import parse_parameters
+from model.mechanics.parameters import parse_parameters
 
 CONTROLS = ("s0", "v", "N0", "b_M", "M0", "f", "D", "dt", "t_end")
 
@@ -51,7 +51,7 @@ def test_mode_drawing_moves_carried_points_rigidly():
 
 @pytest.fixture(scope="module")
 def dash():
-    from app.dashboard import BogieDashboard
+    from app.dashboard.dashboard import BogieDashboard
 
     return BogieDashboard()
 
@@ -95,7 +95,7 @@ def test_views_show_the_current_point(dash):
     assert f"{result.max_real_part:+.4f}" in dash.details.object
     assert f"flutter pairs (Re &gt; 0): <b>{result.flutter}</b>" in dash.details.object
     # the stability limit and the margin to it
-    from model.stability import stability_limit
+    from model.analysis.stability import stability_limit
 
     limit = stability_limit(m, op.v, op.N0, op.b_M).s0_limit
     assert f"{limit:.5f}" in dash.details.object
@@ -156,7 +156,7 @@ def test_rail_condition_changes_the_creep_law(dash):
     dash.rail = "wet"
     assert not np.array_equal(dash.creep_plot.curve.data["mu"], calibrated)
     toml = tomllib.loads(dash._toml().read())
-    from model.contact import CREEP_PRESETS
+    from model.contact.creep import CREEP_PRESETS
 
     for name, value in CREEP_PRESETS["wet"].items():
         assert toml[name]["value"] == value
@@ -203,7 +203,7 @@ def test_rejected_combination_keeps_the_last_result(dash, monkeypatch):
 
 @pytest.mark.slow
 def test_sessions_do_not_share_state(dash):
-    from app.dashboard import BogieDashboard
+    from app.dashboard.dashboard import BogieDashboard
 
     other = BogieDashboard()
     other.s0 = 0.014
@@ -221,7 +221,7 @@ def test_render_whole_layout(dash):
     from bokeh.document import Document
     from bokeh.models import Plot
 
-    from app.serve import create_app
+    from app.server.serve import create_app
 
     doc = Document()
     app = create_app()

@@ -9,11 +9,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app import compute
-from app.nonlinear_view import REACTION_DELAYS, anti_slip_key, nonlinear_histories, reaction
-from model.antislip import required_reaction_time
-from model.nonlinear import AntiSlip, NonlinearError, nonlinear_response
-from model.response import ShortCircuit
+from app.dashboard.nonlinear_view import REACTION_DELAYS, anti_slip_key, nonlinear_histories, reaction
+from app.results import compute
+from model.analysis.antislip import required_reaction_time
+from model.analysis.nonlinear import AntiSlip, NonlinearError, nonlinear_response
+from model.analysis.response import ShortCircuit
 
 
 def test_anti_slip_key_validates():
@@ -41,7 +41,7 @@ def test_histories_are_the_model_result():
 
 @pytest.fixture(scope="module")
 def dash():
-    from app.dashboard import BogieDashboard
+    from app.dashboard.dashboard import BogieDashboard
 
     return BogieDashboard()
 
@@ -118,7 +118,7 @@ def test_a_reaction_search_no_session_wants_stops_at_once():
     stops before its first nonlinear run instead of holding the shared worker for ≈ 20 runs."""
     import time
 
-    from app.nonlinear_view import ReactionSuperseded, wanted_reaction
+    from app.dashboard.nonlinear_view import ReactionSuperseded, wanted_reaction
 
     start = time.perf_counter()
     with pytest.raises(ReactionSuperseded):

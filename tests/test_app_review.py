@@ -14,8 +14,8 @@ import math
 import numpy as np
 import pytest
 
-from app import compute
-from app.fig6 import fig6_series
+from app.results import compute
+from app.results.eigenvalue_sweep import fig6_series
 
 # --- root locus: grid, jumps, broken lines -------------------------------------------------------
 
@@ -99,7 +99,7 @@ def test_fig6_series_splits_complex_and_real_branches():
 @pytest.mark.slow
 def test_dense_locus_is_the_models_eigenvalues():
     """The dense sweep has LOCUS_DENSE_POINTS points and contains the coarse grid; at sample
-    points every tracked eigenvalue is an eigenvalue of the full model (model.eigen) — within
+    points every tracked eigenvalue is an eigenvalue of the full model (model.analysis.eigen) — within
     1e-5 relative: root_locus controls its estimated error to 1e-6 inside the tracked disc."""
     from model import eigen_analysis
 
@@ -126,13 +126,13 @@ ISSUE_QUERY = {"s0": "0.014", "v": "200", "n0": "100000", "bm": "3000", "m0": "5
 
 
 def _class_params():
-    from app.dashboard import BogieDashboard
+    from app.dashboard.dashboard import BogieDashboard
 
     return BogieDashboard.param
 
 
 def test_query_with_the_cli_names_and_units():
-    from app.url_state import parse_query
+    from app.dashboard.url_state import parse_query
 
     values, variant, tab, notices = parse_query(
         {**ISSUE_QUERY, "phase": "0.002", "rail": "wet", "locus": "v", "mode": "3",
@@ -156,7 +156,7 @@ def test_query_with_the_cli_names_and_units():
     ("variant", "gear_ratio:1e300"), ("variant", "x" * 5000),
     ("bogus", "1")])
 def test_bad_query_values_give_a_notice_and_the_default(name, text):
-    from app.url_state import parse_query
+    from app.dashboard.url_state import parse_query
 
     values, variant, tab, notices = parse_query({name: text, "f": "100"}, _class_params(),
                                                 ["response"])
@@ -168,7 +168,7 @@ def test_bad_query_values_give_a_notice_and_the_default(name, text):
 
 
 def test_variant_text_round_trips():
-    from app import variants
+    from app.results import variants
 
     base = variants.base_parameters("")
     changes = {"gear_ratio": base["gear_ratio"] * 1.1,
@@ -187,7 +187,7 @@ def test_variant_text_round_trips():
 
 @pytest.mark.slow
 def test_link_restores_the_state_and_the_controls():
-    from app.dashboard import BogieDashboard
+    from app.dashboard.dashboard import BogieDashboard
 
     query = {**ISSUE_QUERY, "rail": "dry", "tab": "fig-6", "variant": "gear_ratio:4.5"}
     dash = BogieDashboard(query=query)
@@ -210,13 +210,13 @@ def test_link_restores_the_state_and_the_controls():
 
 @pytest.fixture(scope="module")
 def dash():
-    from app.dashboard import BogieDashboard
+    from app.dashboard.dashboard import BogieDashboard
 
     return BogieDashboard()
 
 
 def _toml_bytes(**changes) -> bytes:
-    from model.parameters import dumps_parameters, load_parameters
+    from model.mechanics.parameters import dumps_parameters, load_parameters
 
     return dumps_parameters(load_parameters().replace(**changes)).encode()
 
@@ -253,7 +253,7 @@ def test_variant_editor_upload_and_comparison(dash):
     # download: a valid parameter file of the variant
     import tomllib
 
-    from model.parameters import parse_parameters
+    from model.mechanics.parameters import parse_parameters
 
     downloaded = parse_parameters(tomllib.loads(view._download().read()))
     assert downloaded["silent_block_stiffness_z"] == view.base["silent_block_stiffness_z"] * 3
@@ -329,8 +329,8 @@ def _assert_self_contained(text: str) -> None:
 
 @pytest.mark.slow
 def test_report_of_a_variant_is_self_contained_and_complete():
-    from app.report import build_report
-    from app.variants import parameters_of_key, set_hash
+    from app.report.page import build_report
+    from app.results.variants import parameters_of_key, set_hash
 
     base = compute.parameters("", "calibrated")
     key = f"|gear_ratio:{base['gear_ratio'] * 1.1!r}"
@@ -356,7 +356,7 @@ def test_report_of_a_variant_is_self_contained_and_complete():
 @pytest.mark.slow
 def test_clicking_a_table_row_or_a_diamond_shows_that_mode(dash):
     from model import build_model, eigen_analysis
-    from model.modes import mode_character
+    from model.analysis.modes import mode_character
 
     dash.param.update(s0=0.005, v=120.0)
     click = dash.click
@@ -365,7 +365,7 @@ def test_clicking_a_table_row_or_a_diamond_shows_that_mode(dash):
     mode = dash.point.modes[3]
     assert mode.description in click.detail.object
     assert "ν = 4" in click.detail.object
-    # the energy shares are the model's (model.modes) for that mode
+    # the energy shares are the model's (model.analysis.modes) for that mode
     m = build_model(compute.parameters("", "calibrated"))
     result = eigen_analysis(m, compute.operating_point("", "calibrated", 0.005, 120.0, dash.N0,
                                                        dash.b_M))

@@ -83,7 +83,7 @@ def test_bad_link_gives_a_notice_and_the_defaults(own_server, chromium):
 
 
 def test_variant_upload_comparison_click_through_and_report(own_server, chromium, tmp_path):
-    from model.parameters import dumps_parameters, load_parameters
+    from model.mechanics.parameters import dumps_parameters, load_parameters
 
     page = open_app(chromium, own_server[0])
     page.errors.clear()

@@ -20,12 +20,12 @@ from model import (
     motor_torque,
     output_matrices,
 )
-from model.assembly import DRIVES, dof_names
-from model.dofs import AXES6, DofMap
-from model.eigen import state_space
-from model.operating_point import creep_coefficients, creep_damping
-from model.outputs import static_load
-from model.parameters import CALIBRATED_FILE, ESTIMATE_FILE
+from model.analysis.eigen import state_space
+from model.mechanics.assembly import DRIVES, dof_names
+from model.mechanics.dofs import AXES6, DofMap
+from model.mechanics.operating_point import creep_coefficients, creep_damping
+from model.mechanics.outputs import static_load
+from model.mechanics.parameters import CALIBRATED_FILE, ESTIMATE_FILE
 
 EPS = np.finfo(float).eps
 N_DOF = 193

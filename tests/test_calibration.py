@@ -1,4 +1,4 @@
-"""Unit tests of the calibration's pieces (model/calibration.py) — not of the calibrated numbers
+"""Unit tests of the calibration's pieces (model/studies/calibration.py) — not of the calibrated numbers
 (those are tests/test_literature.py), and without running the search (minutes)."""
 
 from __future__ import annotations
@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from model import load_parameters
-from model.calibration import (
+from model.mechanics.parameters import ESTIMATE_FILE
+from model.studies.calibration import (
     FREE_PARAMETERS,
     RESTART_VALUES,
     SEARCH_PARAMETERS,
@@ -27,7 +28,6 @@ from model.calibration import (
     real_part_residual,
     with_constraints,
 )
-from model.parameters import ESTIMATE_FILE
 
 
 def test_stage_a_meets_the_operating_data_for_another_creep_shape():

@@ -1,7 +1,7 @@
-"""The command line ``bogie`` / ``python -m model``: documented JSON contracts, and bad input
+"""The command line ``bogie`` / ``python -m app``: documented JSON contracts, and bad input
 answered by ONE line on stderr with exit status 2 and no traceback.
 
-Most cases run in-process through :func:`model.cli.main` (fast); a few go through a real
+Most cases run in-process through :func:`app.cli.main.main` (fast); a few go through a real
 subprocess (``sys.executable -m model``) so that the process-level contract is checked too.
 """
 
@@ -15,12 +15,12 @@ import sys
 import numpy as np
 import pytest
 
+from app.cli.main import main
 from model import build_model, eigen_analysis, load_parameters, motor_torque
-from model.cli import main
-from model.eigen import EigenResult
-from model.operating_point import OperatingPoint, damping_matrix
-from model.outputs import output_matrices
-from model.parameters import ESTIMATE_FILE, dumps_parameters
+from model.analysis.eigen import EigenResult
+from model.mechanics.operating_point import OperatingPoint, damping_matrix
+from model.mechanics.outputs import output_matrices
+from model.mechanics.parameters import ESTIMATE_FILE, dumps_parameters
 
 EIGEN_KEYS = {"operating_point", "stable", "complex", "real", "rigid_body"}
 EXPORT_ARRAYS = {"M", "B", "K", "dofs", "f_mc", "motor_torque", "C_q", "C_v", "outputs"}
@@ -38,8 +38,8 @@ def run(argv: list[str], capsys) -> tuple[int, str, str]:
 
 
 def run_process(argv: list[str], timeout: float = 300) -> subprocess.CompletedProcess:
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}  # see app.serve.limit_blas_threads
-    return subprocess.run([sys.executable, "-m", "model", *argv], capture_output=True, text=True,
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}  # see app.server.serve.limit_blas_threads
+    return subprocess.run([sys.executable, "-m", "app", *argv], capture_output=True, text=True,
                           timeout=timeout, check=False, env=env)
 
 

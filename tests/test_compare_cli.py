@@ -12,7 +12,7 @@ import json
 import pytest
 from test_cli import run  # the in-process CLI runner (tests/ is on sys.path under pytest)
 
-from model.parameters import CALIBRATED_FILE, load_parameters, save_parameters
+from model.mechanics.parameters import CALIBRATED_FILE, load_parameters, save_parameters
 
 OP = ["--s0", "0.005", "--v", "120", "--t-end", "0.3"]
 
@@ -49,7 +49,7 @@ def test_json_has_both_sides_and_their_difference(variant_file, capsys):
                                                        - base["pairs"][0]["im_hz"])
     # each side is the model's own analysis of that set
     from model import build_model, eigen_analysis
-    from model.operating_point import OperatingPoint
+    from model.mechanics.operating_point import OperatingPoint
 
     p = load_parameters(variant_file)
     result = eigen_analysis(build_model(p), OperatingPoint.from_kmh(

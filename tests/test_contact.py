@@ -10,8 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from model.bodies import point_map
-from model.contact import (
+from model.contact.creep import (
     _KALKER_A_OVER_B_SMALL,
     _KALKER_B_OVER_A_SMALL,
     CREEP_PRESETS,
@@ -21,7 +20,8 @@ from model.contact import (
     kalker_coefficients,
     kalker_creep_coefficients,
 )
-from model.dofs import AXES6, PAPER_RIM_ORDER
+from model.mechanics.bodies import point_map
+from model.mechanics.dofs import AXES6, PAPER_RIM_ORDER
 
 
 def test_hertz_equal_curvatures_is_the_circular_formula():

@@ -1,5 +1,5 @@
-"""The exact continuation of all eigenvalues along s0 (model.continuation) against a full
-eigen-analysis (model.eigen.eigen_analysis) at every point: all eigenvalues, the largest real
+"""The exact continuation of all eigenvalues along s0 (model.analysis.continuation) against a full
+eigen-analysis (model.analysis.eigen.eigen_analysis) at every point: all eigenvalues, the largest real
 part, flutter pairs and divergent reals, s0*; the rank-4 structure it rests on; its checks
 catch a lost or wrong root.  Real components, no mocks.
 
@@ -20,16 +20,16 @@ import pytest
 from scipy.optimize import linear_sum_assignment
 
 from model import KMH, build_model, eigen_analysis, load_parameters
-from model.continuation import (
+from model.analysis.continuation import (
     Continuation,
     continue_line,
     creep_coefficient,
     make_anchor,
     update_vectors,
 )
-from model.eigen import state_matrix
-from model.operating_point import OperatingPoint
-from model.study import dense_line, s0_line, spectrum_summary
+from model.analysis.eigen import state_matrix
+from model.mechanics.operating_point import OperatingPoint
+from model.studies.maps import dense_line, s0_line, spectrum_summary
 
 EIG_RTOL = 8e-8
 GROWTH_ATOL = 1e-7

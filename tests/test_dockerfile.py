@@ -124,18 +124,18 @@ def test_dockerignore_keeps_the_venv_git_and_caches_out():
 
 
 def test_serve_origins_from_the_environment(monkeypatch):
-    """app.serve.serve(): BOGIE_ALLOWED_ORIGINS (default localhost only), liveness on."""
+    """app.server.serve.serve(): BOGIE_ALLOWED_ORIGINS (default localhost only), liveness on."""
     pn = pytest.importorskip("panel")
-    import app.serve
-    from app.serve import serve
+    import app.server.serve
+    from app.server.serve import serve
 
-    monkeypatch.setattr(app.serve, "limit_blas_threads", lambda: None, raising=False)
+    monkeypatch.setattr(app.server.serve, "limit_blas_threads", lambda: None, raising=False)
 
     calls, handlers, stops = [], {}, []
     monkeypatch.setattr(pn, "serve", lambda *args, **kwargs: calls.append(kwargs))
     monkeypatch.setattr(signal, "signal", handlers.__setitem__)  # leave pytest's handlers alone
     # the process ends (os._exit) when pn.serve returns or on SIGTERM: not this one
-    monkeypatch.setattr(app.serve, "_stop_now", lambda *args: stops.append(args))
+    monkeypatch.setattr(app.server.serve, "_stop_now", lambda *args: stops.append(args))
 
     monkeypatch.delenv("BOGIE_ALLOWED_ORIGINS", raising=False)
     serve(port=5123.0, address="0.0.0.0")  # the command line gives a float
@@ -144,7 +144,7 @@ def test_serve_origins_from_the_environment(monkeypatch):
     assert calls[-1]["address"] == "0.0.0.0"
     assert calls[-1]["port"] == 5123
     assert isinstance(calls[-1]["port"], int)
-    assert handlers == {signal.SIGTERM: app.serve._stop_now}  # docker stop ends it at once
+    assert handlers == {signal.SIGTERM: app.server.serve._stop_now}  # docker stop ends it at once
     assert len(stops) == 1  # and so does the end of pn.serve (Ctrl-C: Panel stops its loop)
 
     monkeypatch.setenv("BOGIE_ALLOWED_ORIGINS", " bogie.example.org , localhost:8080,")

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from model.beam import TubeSection, beam_global_matrices, beam_local_matrices, local_frame
-from model.bodies import carried_body, free_body, point_map, rigid_mass_matrix, skew
-from model.connections import Spring, SpringDamper, axis_springs
-from model.dofs import AXES6, DofMap
+from model.mechanics.beam import TubeSection, beam_global_matrices, beam_local_matrices, local_frame
+from model.mechanics.bodies import carried_body, free_body, point_map, rigid_mass_matrix, skew
+from model.mechanics.connections import Spring, SpringDamper, axis_springs
+from model.mechanics.dofs import AXES6, DofMap
 
 # A steel tube of the size of the hollow shaft (independent of the parameter files).
 STEEL = {"young": 2.1e11, "poisson": 0.3, "density": 7850.0}

@@ -1,4 +1,4 @@
-"""Unit tests of the shared first-order form (model.linear_system): the Householder deflation
+"""Unit tests of the shared first-order form (model.analysis.linear_system): the Householder deflation
 and the eigendecomposition shared by the eigen-analysis and the response."""
 
 import threading
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from model import build_model, default_operating_point, eigen_analysis, load_parameters
-from model.eigen import bogie_system
-from model.linear_system import Deflation, LinearSystem, SystemCache, balancing_scale
+from model.analysis.eigen import bogie_system
+from model.analysis.linear_system import Deflation, LinearSystem, SystemCache, balancing_scale
 
 
 @pytest.mark.parametrize("rank", [0, 1, 2, 3])

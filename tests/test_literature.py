@@ -32,7 +32,9 @@ import numpy as np
 import pytest
 
 from model import OperatingPoint, build_model, eigen_analysis, load_parameters, mode_character
-from model.calibration import (
+from model.analysis.stability import stability_limit
+from model.mechanics.operating_point import adhesion_moment, motor_torque
+from model.studies.calibration import (
     ADHESION_MOMENT,
     DIVERGENCE_RATES,
     DRIVING_SHAFT_HZ,
@@ -47,8 +49,6 @@ from model.calibration import (
     match_table1_modes,
     wheelset_yaw_fraction,
 )
-from model.operating_point import adhesion_moment, motor_torque
-from model.stability import stability_limit
 
 IM_TOLERANCE = 0.05  # [-] relative, by rank
 RE_TOLERANCE, RE_ABSOLUTE = 0.30, 0.05  # [-] relative; [1/s] where |Re_published| < 0.2 1/s

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from model import OperatingPointError, build_model, default_operating_point, load_parameters
-from model.locus import clear_sweep_starts, dense_generalized_eigenvalues, root_locus
+from model.analysis.locus import clear_sweep_starts, dense_generalized_eigenvalues, root_locus
 
 CONTROLLED = 1.5 * 2 * np.pi * 20.0  # |λ| inside which the tolerance is enforced [1/s]
 
@@ -39,7 +39,7 @@ def test_denser_sweep_reuses_the_start_and_gives_the_same_values(setup, monkeypa
     """A denser sweep over the same range (the dashboard's dense locus after its coarse one)
     reuses the kept end points, basis and short sweep's solutions: it solves only its new points
     and gives bitwise the same eigenvalues as the same sweep computed from scratch."""
-    import model.locus as locus_module
+    import model.analysis.locus as locus_module
 
     model, op, _, _ = setup
     solves = []

@@ -21,8 +21,7 @@ import numpy as np
 import pytest
 
 from model import build_model, default_operating_point, load_parameters
-from model.contact import PolachLaw
-from model.nonlinear import (
+from model.analysis.nonlinear import (
     AntiSlip,
     NonlinearError,
     creep_force_map,
@@ -31,8 +30,9 @@ from model.nonlinear import (
     motor2_force,
     nonlinear_response,
 )
-from model.operating_point import OperatingPoint, creep_coefficients, creep_law, damping_matrix
-from model.response import ShortCircuit, short_circuit_response
+from model.analysis.response import ShortCircuit, short_circuit_response
+from model.contact.creep import PolachLaw
+from model.mechanics.operating_point import OperatingPoint, creep_coefficients, creep_law, damping_matrix
 
 
 @pytest.fixture(scope="module")

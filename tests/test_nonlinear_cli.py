@@ -10,8 +10,8 @@ import pytest
 from test_cli import assert_one_line_error, run
 
 from model import build_model, default_operating_point, load_parameters
-from model.antislip import required_reaction_time
-from model.nonlinear import AntiSlip
+from model.analysis.antislip import required_reaction_time
+from model.analysis.nonlinear import AntiSlip
 
 BASE = ["response", "--s0", "0.014", "--t-end", "0.3", "--fs", "5000"]
 

@@ -1,4 +1,4 @@
-"""The nonlinear step loop's block solve (model/_nonlinear_kernel.py) against its one-step form.
+"""The nonlinear step loop's block solve (model/analysis/block_stepper.py) against its one-step form.
 
 With ``SUB_STEPS = 1`` every block is a single step: the plain implicit one-step scheme (Newton on
 the five channel values of one step). The default solves 32 steps together; both solve the same
@@ -13,10 +13,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import model._nonlinear_kernel as kernel
+import model.analysis.block_stepper as kernel
 from model import build_model, default_operating_point, load_parameters
-from model.eigen import forget_systems
-from model.nonlinear import AntiSlip, nonlinear_response
+from model.analysis.eigen import forget_systems
+from model.analysis.nonlinear import AntiSlip, nonlinear_response
 
 
 @pytest.fixture(scope="module")
@@ -28,7 +28,7 @@ def bogie():
 def test_polach_matches_the_law(bogie):
     """The vectorised law of the loop is the model's PolachLaw (both branches, both signs)."""
     parameters, _ = bogie
-    from model.operating_point import creep_law
+    from model.mechanics.operating_point import creep_law
 
     law = creep_law(parameters)
     s = np.concatenate([-np.logspace(-6, 0, 50), [0.0], np.logspace(-6, 0, 50)])

@@ -8,7 +8,7 @@ import tomllib
 
 import pytest
 
-from model.parameters import (
+from model.mechanics.parameters import (
     CALIBRATED_FILE,
     ESTIMATE_FILE,
     SCHEMA,

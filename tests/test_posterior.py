@@ -1,4 +1,4 @@
-"""The linearized posterior (model/posterior.py) and the uncertainty pipeline's provenance.
+"""The linearized posterior (model/studies/posterior.py) and the uncertainty pipeline's provenance.
 
 * the posterior covariance is symmetric positive definite and no parameter's posterior standard
   deviation exceeds its prior one (data can only add information to a Gaussian prior);
@@ -20,10 +20,10 @@ import math
 import numpy as np
 import pytest
 
-from model.cli import main
-from model.parameters import load_parameters, parameter_hash
-from model.posterior import PosteriorError, calibration_residuals, linearized_posterior
-from model.uncertainty import (
+from app.cli.main import main
+from model.mechanics.parameters import load_parameters, parameter_hash
+from model.studies.posterior import PosteriorError, calibration_residuals, linearized_posterior
+from model.studies.uncertainty import (
     UNCERTAIN_PARAMETERS,
     UncertainParameter,
     UncertaintyError,
@@ -81,10 +81,10 @@ def test_frequency_rows_against_central_differences(posterior, name):
     ill-conditioned modes, divided by h) showed as a 3 % error on the 2.3e-5 entry of mode 7's
     motor slope on the set calibrated by rank (h = 3e-3 / 1e-2 / 3e-2 agree with the analytic
     value to 0.1–0.4 %)."""
-    from model.assembly import build_model
-    from model.calibration import S0_STABLE, V_REF, match_table1_modes
-    from model.eigen import eigen_analysis
-    from model.operating_point import OperatingPoint
+    from model.analysis.eigen import eigen_analysis
+    from model.mechanics.assembly import build_model
+    from model.mechanics.operating_point import OperatingPoint
+    from model.studies.calibration import S0_STABLE, V_REF, match_table1_modes
 
     parameters = load_parameters()
 
@@ -116,7 +116,7 @@ def test_residuals_are_the_calibrations():
     assert sigmas[0] == 0.03
     assert np.all(np.isfinite(r))
     # the posterior's residuals at the set are the calibration's (same matched modes)
-    from model.posterior import frequency_jacobian
+    from model.studies.posterior import frequency_jacobian
 
     labels, r_freq, _, _ = frequency_jacobian(load_parameters(), ("creep_slope",))
     assert labels == names[:11]

@@ -29,7 +29,7 @@ from model import (
     motor_torque,
     stability_limit,
 )
-from model.operating_point import KMH, OperatingPoint
+from model.mechanics.operating_point import KMH, OperatingPoint
 
 GOLDEN_FILE = Path(__file__).resolve().parent / "golden" / "calibrated.json"
 REGENERATE = "regenerate with: .venv/bin/python scripts/make_golden.py"

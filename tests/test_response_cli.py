@@ -85,7 +85,7 @@ def test_bad_input_is_one_line_exit_2(argv, word, capsys):
 
 
 def test_process_level_error_has_no_traceback(tmp_path):
-    result = subprocess.run([sys.executable, "-m", "model", "response", "--fs", "10",
+    result = subprocess.run([sys.executable, "-m", "app", "response", "--fs", "10",
                              "--out", str(tmp_path / "a.npz")], capture_output=True, text=True,
                             timeout=300)
     assert result.returncode == 2

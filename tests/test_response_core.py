@@ -1,4 +1,4 @@
-"""The exact LTI core of model.response against hand-derived closed forms.
+"""The exact LTI core of model.analysis.response against hand-derived closed forms.
 
 Single DOF (under- and critically damped, resonance of the excitation with the mode), a free–free
 two-mass system (rigid-body ramp/parabola, defective zero eigenvalue), and the excitation of
@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from model.response import LinearSystem, ResponseError, ShortCircuit, solve_linear
+from model.analysis.response import LinearSystem, ResponseError, ShortCircuit, solve_linear
 
 DT, N = 1e-3, 3001
 T = np.arange(N) * DT

@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from model import build_model, default_operating_point, eigen_analysis, load_parameters
-from model.modes import mode_character
-from model.response import ShortCircuit, short_circuit_response
+from model.analysis.modes import mode_character
+from model.analysis.response import ShortCircuit, short_circuit_response
 
 T_END, FS = 2.0, 5000.0  # the published plots span 0…2 s
 PUBLISHED_HZ = {"ID1.disc_clutch": 2.694, "ID1.driving_shaft": 298.4}

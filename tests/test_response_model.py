@@ -18,10 +18,10 @@ import scipy.linalg as sla
 from scipy.integrate import solve_ivp
 
 from model import build_model, default_operating_point, load_parameters
-from model.export import export_system
-from model.operating_point import OperatingPoint
-from model.response import ResponseError, ShortCircuit, short_circuit_response
-from model.stability import stability_limit
+from model.analysis.export import export_system
+from model.analysis.response import ResponseError, ShortCircuit, short_circuit_response
+from model.analysis.stability import stability_limit
+from model.mechanics.operating_point import OperatingPoint
 
 TOLERANCE = 1e-5  # of each output's peak |Δy| (issue 3)
 
@@ -208,11 +208,11 @@ def test_closed_form_matches_radau(bogie, s0):
     parameters, model = bogie
     op = default_operating_point(parameters, s0)
     result = short_circuit_response(model, op, ShortCircuit(), 0.1, 10_000.0, method="modal")
-    from model.eigen import bogie_system
+    from model.analysis.eigen import bogie_system
 
     system = bogie_system(model, op)
     u0, a, mu = ShortCircuit().terms(result.motor_torque)
-    from model.outputs import output_matrices
+    from model.mechanics.outputs import output_matrices
 
     outputs = output_matrices(model, op)
     C = np.hstack([outputs.C_q, outputs.C_v])

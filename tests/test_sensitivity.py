@@ -1,4 +1,4 @@
-"""Sensitivities (model/sensitivity.py) and the uncertainty pipeline (model/uncertainty.py).
+"""Sensitivities (model/analysis/sensitivity.py) and the uncertainty pipeline (model/studies/uncertainty.py).
 
 * analytic dλ/dp against fourth-order central differences of eigenvalues (test-only) for every
   parameter and s0, v, N0, b_M at three operating points (slow).  Tolerance 1e-5 relative to the
@@ -26,12 +26,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from model.assembly import build_model
-from model.cli import main
-from model.eigen import eigen_analysis
-from model.operating_point import KMH, OperatingPoint, creep_law, damping_matrix
-from model.parameters import SCHEMA, Parameters, load_parameters
-from model.sensitivity import (
+from app.cli.main import main
+from model.analysis.eigen import eigen_analysis
+from model.analysis.sensitivity import (
     NOT_IN_ASSEMBLY,
     OPERATING_PARAMETERS,
     MatrixDerivative,
@@ -41,8 +38,11 @@ from model.sensitivity import (
     null_vectors,
     structural_derivatives,
 )
-from model.stability import stability_limit
-from model.uncertainty import UncertaintyError, run_uncertainty, sobol_study
+from model.analysis.stability import stability_limit
+from model.mechanics.assembly import build_model
+from model.mechanics.operating_point import KMH, OperatingPoint, creep_law, damping_matrix
+from model.mechanics.parameters import SCHEMA, Parameters, load_parameters
+from model.studies.uncertainty import UncertaintyError, run_uncertainty, sobol_study
 
 
 @pytest.fixture(scope="module")
@@ -198,7 +198,7 @@ def test_euler_eigenvalues(setup, s0):
 
 def test_limit_is_creep_maximum_and_structure_cannot_move_it(setup):
     parameters, model = setup
-    from model.sensitivity import limit_sensitivity
+    from model.analysis.sensitivity import limit_sensitivity
 
     v, N0, b_M = 120 * KMH, parameters["wheel_force"], parameters["motor_slope"]
     limit = limit_sensitivity(model, v, N0, b_M)
@@ -225,7 +225,7 @@ def test_limit_sensitivity_finds_the_critical_eigenvalue_without_the_full_analys
     the same derivatives and mechanism as with the full eigen-analysis, and λc the eigenvalue of
     that analysis nearest to 0 (both are at rounding level: |λc| ≤ 1e-3 1/s, while the next real
     eigenvalue is ≈ -0.02 1/s)."""
-    import model.sensitivity as sensitivity
+    import model.analysis.sensitivity as sensitivity
     from model import eigen_analysis
 
     parameters, model = setup
@@ -301,7 +301,7 @@ def test_uncertainty_bad_input(setup):
 def test_cli_bad_input(argv, message, capsys):
     try:
         status = main(argv)
-    except SystemExit as stop:  # argparse's own errors (one line, see model.cli._Parser)
+    except SystemExit as stop:  # argparse's own errors (one line, see app.cli.main._Parser)
         status = stop.code
     assert status == 2
     err = capsys.readouterr().err
@@ -332,7 +332,7 @@ def test_cli_json_keys(capsys):
 def test_uncertainty_pipeline_on_the_model(setup):
     """Two parameters, n = 2: 8 model runs through a map-like executor, in chunks; the result's
     distributions are the model's own outputs at the sampled values."""
-    from model.uncertainty import OUTPUT_NAMES, UNCERTAIN_PARAMETERS, sample_outputs
+    from model.studies.uncertainty import OUTPUT_NAMES, UNCERTAIN_PARAMETERS, sample_outputs
 
     parameters, _ = setup
     chosen = [u for u in UNCERTAIN_PARAMETERS if u.name in ("polach_B", "rotor_inertia")]
@@ -360,7 +360,7 @@ def test_uncertainty_pipeline_on_the_model(setup):
 
 
 def test_modes_are_the_ten_lowest_pairs_with_the_tools_descriptions(setup):
-    from model.modes import describe_modes
+    from model.analysis.modes import describe_modes
 
     parameters, model = setup
     op = _op(parameters, 0.005)

@@ -1,6 +1,6 @@
-"""The dashboard's sensitivity tornado (app/sensitivity_view.py) without a server.
+"""The dashboard's sensitivity tornado (app/dashboard/sensitivity_view.py) without a server.
 
-Expectations come from model.sensitivity at the dashboard's point, never typed in.  Building a
+Expectations come from model.analysis.sensitivity at the dashboard's point, never typed in.  Building a
 dashboard computes the stability limit, a root locus and the derivative matrices (seconds), so
 these tests are slow.
 """
@@ -10,14 +10,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app import compute
-from app.sensitivity_view import BARS, ranked, sensitivity_data
-from model.sensitivity import eigen_sensitivities
+from app.dashboard.sensitivity_view import BARS, ranked, sensitivity_data
+from app.results import compute
+from model.analysis.sensitivity import eigen_sensitivities
 
 
 @pytest.fixture(scope="module")
 def dash():
-    from app.dashboard import BogieDashboard
+    from app.dashboard.dashboard import BogieDashboard
 
     return BogieDashboard()
 

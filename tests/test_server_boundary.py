@@ -41,7 +41,7 @@ import numpy as np
 import pytest
 from conftest import start_bogie_serve, stop_process, wait_for_liveness
 
-from app.studies_folder import refusal
+from app.services.studies_folder import refusal
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
@@ -135,11 +135,11 @@ def _result_json(parameters) -> str:
 def setup(tmp_path_factory):
     """(URL, server pid, studies folder, FIFO watch, listed names) of a server whose studies
     folder holds a valid map and result, and traps pointing out of it."""
-    from app import compute
+    from app.results import compute
     from model import KMH
-    from model.study import MapStudy
-    from model.study_engine import serial_map_unordered
-    from model.study_store import run_into_store
+    from model.studies.engine import serial_map_unordered
+    from model.studies.maps import MapStudy
+    from model.studies.store import run_into_store
 
     root = tmp_path_factory.mktemp("boundary")
     studies, outside = root / "studies", root / "outside"
@@ -361,7 +361,7 @@ def test_names_given_straight_to_the_view_are_refused_alike(tmp_path):
     from bokeh.document import Document
     from conftest import install_study_queue
 
-    from app.dashboard import BogieDashboard
+    from app.dashboard.dashboard import BogieDashboard
 
     studies, outside = tmp_path / "studies", tmp_path / "outside"
     studies.mkdir()
@@ -520,10 +520,10 @@ def test_server_options_and_environment_are_the_operators(tmp_path):
     import subprocess
     import sys
 
-    from app.server_settings import ServerSettings, SettingsError
+    from app.services.settings import ServerSettings, SettingsError
 
     def serve(*args, env=None):
-        return subprocess.run([sys.executable, "-m", "model", "serve", "--port", "0", *args],
+        return subprocess.run([sys.executable, "-m", "app", "serve", "--port", "0", *args],
                               capture_output=True, text=True, timeout=120,
                               env={**os.environ, **(env or {})})
 
@@ -550,7 +550,7 @@ def test_server_options_and_environment_are_the_operators(tmp_path):
     assert "tcp://" not in settings.engine_description  # what a reviewer reads
     with pytest.raises(SettingsError, match="BOGIE_MAX_WAITING_STUDIES"):
         ServerSettings.from_options(environ={"BOGIE_MAX_WAITING_STUDIES": "many"})
-    help_text = subprocess.run([sys.executable, "-m", "model", "serve", "--help"],
+    help_text = subprocess.run([sys.executable, "-m", "app", "serve", "--help"],
                                capture_output=True, text=True, timeout=60).stdout
     for variable in ("BOGIE_SCHEDULER", "BOGIE_STUDIES_DIR", "BOGIE_MAX_STUDY_POINTS",
                      "BOGIE_MAX_RUNNING_STUDIES", "BOGIE_MAX_WAITING_STUDIES"):
@@ -590,7 +590,7 @@ def _running(pid: int) -> bool:
 
 def test_the_folder_is_listed_without_following_links(tmp_path):
     """Unit level: what the list holds (no server)."""
-    from app.studies_folder import StudiesFolder, StudyNameRefused
+    from app.services.studies_folder import StudiesFolder, StudyNameRefused
 
     folder = StudiesFolder(tmp_path / "studies")
     root = folder.ensure()

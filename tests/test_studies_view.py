@@ -15,13 +15,13 @@ import pytest
 from bokeh.document import Document
 from conftest import InProcessEngine, install_study_queue
 
-from app import compute
-from app.dashboard import BogieDashboard
-from app.server_settings import ServerSettings
-from app.studies_folder import refusal
-from app.studies_view import StudiesView
-from app.study_queue import StudyQueue
-from model.study import run_serial
+from app.dashboard.dashboard import BogieDashboard
+from app.dashboard.studies_view import StudiesView
+from app.results import compute
+from app.services.settings import ServerSettings
+from app.services.studies_folder import refusal
+from app.services.study_queue import StudyQueue
+from model.studies.maps import run_serial
 
 
 @pytest.fixture(scope="module")

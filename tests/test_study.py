@@ -10,12 +10,12 @@ import time
 import numpy as np
 import pytest
 
+from app.cli.main import main
 from model import KMH, build_model, load_parameters, stability_limit
-from model.cli import main
-from model.parameters import parameter_hash
-from model.study import LimitStudy, MapStudy, dense_line, run_serial, s0_line
-from model.study_engine import serial_map_unordered
-from model.study_store import StoreMismatch, finished_chunks, open_study, run_into_store
+from model.mechanics.parameters import parameter_hash
+from model.studies.engine import serial_map_unordered
+from model.studies.maps import LimitStudy, MapStudy, dense_line, run_serial, s0_line
+from model.studies.store import StoreMismatch, finished_chunks, open_study, run_into_store
 
 # largest real part: the error-controlled Ritz values are within rtol·max(|λ|, 1 1/s) = 1e-6 x
 # |λ| ≤ 2π·60 Hz of the dense solution (measured: 3e-9 1/s); 1e-5 1/s leaves room for it
@@ -69,7 +69,7 @@ def test_reduced_basis_falls_back_to_both_ends_when_a_check_fails(setup, monkeyp
     dense eigenvalues at the first or the steepest creepage have no Ritz value next to them, it
     falls back to the exact eigenvectors at both ends.  With the check made impossible (MATCH = 0)
     the fallback runs: a larger basis, and every point still as the dense reference gives it."""
-    import model.study as study
+    import model.studies.maps as study
 
     parameters, model = setup
     N0, b_M = parameters["wheel_force"], parameters["motor_slope"]
@@ -88,7 +88,7 @@ def test_reduced_basis_falls_back_to_both_ends_when_a_check_fails(setup, monkeyp
 
 
 def test_line_limit_equals_stability_limit(setup):
-    """s0* of a line (Brent on the reduced evaluation) against model.stability.stability_limit
+    """s0* of a line (Brent on the reduced evaluation) against model.analysis.stability.stability_limit
     (bracket doubling and Brent on dense eigen-analyses)."""
     parameters, model = setup
     v = 120 * KMH
@@ -278,7 +278,7 @@ def test_uncertainty_study_unreachable_scheduler(capsys, tmp_path):
 def test_in_order_yields_in_item_order_as_soon_as_possible():
     """The ordered view of an unordered map: results in item order, none held back longer than
     the earlier items it waits for."""
-    from model.study_engine import in_order
+    from model.studies.engine import in_order
 
     seen = []
 
@@ -299,9 +299,9 @@ def test_basis_check_at_the_most_destabilizing_point(setup):
     b11 the dense eigenvalues check it: with both ends every eigenvalue the selection takes there
     has a Ritz value next to it, with the first end alone (the ≈ 50 Hz rim modes are damped by
     more than 5 1/s there and not in the basis) some have none and the check fails."""
-    from model.locus import _coefficients
-    from model.operating_point import OperatingPoint
-    from model.study import _dense_point, _LineModel, _missing_modes
+    from model.analysis.locus import _coefficients
+    from model.mechanics.operating_point import OperatingPoint
+    from model.studies.maps import _dense_point, _LineModel, _missing_modes
 
     parameters, model = setup
     v, N0, b_M = 120 * KMH, parameters["wheel_force"], parameters["motor_slope"]
@@ -324,7 +324,7 @@ def test_line_limit_few_evaluations(setup, monkeypatch):
     """s0* of a reduced line takes at most 8 reduced evaluations (secant steps on the crossing
     branch, bracket closed within xtol; Brent's method from the grid bracket took 9-12) and
     agrees with the dense line's Brent search within both tolerances."""
-    from model import study
+    from model.studies import maps as study
 
     parameters, model = setup
     calls = []
@@ -349,10 +349,10 @@ def test_point_at_the_crossing_needs_no_full_analysis(setup):
     """At s0* the crossing eigenvalue is real and ≈ 0, next to the rigid-body zeros: its Newton
     refinement divides the rigid rows by λ and converges; the point is not sent to a full
     eigen-analysis, and its largest real part is the dense one within rtol = 1e-6 1/s."""
-    from model.eigen import eigen_analysis
-    from model.locus import _coefficients
-    from model.operating_point import OperatingPoint
-    from model.study import _dense_point, _LineModel
+    from model.analysis.eigen import eigen_analysis
+    from model.analysis.locus import _coefficients
+    from model.mechanics.operating_point import OperatingPoint
+    from model.studies.maps import _dense_point, _LineModel
 
     parameters, model = setup
     v, N0, b_M = 250 * KMH, parameters["wheel_force"], parameters["motor_slope"]

@@ -23,9 +23,9 @@ import numpy as np
 import pytest
 
 from model import KMH, load_parameters
-from model.study import MapStudy, run_serial
-from model.study_engine import StudyEngine
-from model.study_store import finished_chunks, open_study, run_into_store
+from model.studies.engine import StudyEngine
+from model.studies.maps import MapStudy, run_serial
+from model.studies.store import finished_chunks, open_study, run_into_store
 
 pytestmark = pytest.mark.slow
 ROOT = Path(__file__).resolve().parent.parent
@@ -121,7 +121,7 @@ def test_cluster_equals_serial(cluster, study_and_reference, tmp_path):
 
 
 def test_cluster_equals_serial_continuation(cluster, tmp_path):
-    """The same with s0_line's exact continuation (model.continuation): bitwise identical."""
+    """The same with s0_line's exact continuation (model.analysis.continuation): bitwise identical."""
     parameters = load_parameters()
     study = MapStudy(np.linspace(0.002, 0.016, 30), np.linspace(60, 220, 3) * KMH,
                      [parameters["wheel_force"]], [parameters["motor_slope"]],
@@ -231,11 +231,11 @@ def test_ctrl_c_with_the_local_cluster_stops_everything_cleanly(tmp_path):
 
 
 def test_uncertainty_study_on_the_cluster_equals_serial(cluster):
-    """The Monte-Carlo/Sobol study of model.uncertainty through the engine (the map used by
+    """The Monte-Carlo/Sobol study of model.studies.uncertainty through the engine (the map used by
     ``bogie study uncertainty``) gives exactly the serial samples and outputs (two uncertain
     parameters, n = 2: 8 model runs)."""
-    from model.study_engine import in_order
-    from model.uncertainty import UNCERTAIN_PARAMETERS, run_uncertainty
+    from model.studies.engine import in_order
+    from model.studies.uncertainty import UNCERTAIN_PARAMETERS, run_uncertainty
 
     parameters = load_parameters()
     uncertain = UNCERTAIN_PARAMETERS[:2]

@@ -1,4 +1,4 @@
-"""The s0*(v) uncertainty band in the Studies view (app/uncertainty_band.py), without a server.
+"""The s0*(v) uncertainty band in the Studies view (app/dashboard/uncertainty_band.py), without a server.
 
 The result files are written by the model's own :meth:`UncertaintyResult.as_dict` (a small
 result assembled from plain arrays: the band's logic needs the provenance and the percentiles,
@@ -21,13 +21,13 @@ import pytest
 from bokeh.document import Document
 from conftest import install_study_queue
 
-from app import compute
-from app.dashboard import BogieDashboard
-from app.studies_folder import refusal
-from app.studies_view import MapView
-from app.uncertainty_band import band_mismatch, read_band
-from model.parameters import parameter_hash
-from model.uncertainty import UNCERTAIN_PARAMETERS, UncertaintyResult, output_names, output_units
+from app.dashboard.dashboard import BogieDashboard
+from app.dashboard.studies_view import MapView
+from app.dashboard.uncertainty_band import band_mismatch, read_band
+from app.results import compute
+from app.services.studies_folder import refusal
+from model.mechanics.parameters import parameter_hash
+from model.studies.uncertainty import UNCERTAIN_PARAMETERS, UncertaintyResult, output_names, output_units
 
 SPEEDS = (40.0, 120.0, 200.0)
 B_M = compute.parameters("", "calibrated")["motor_slope"]  # the set's b_M [N m s/rad]

@@ -15,7 +15,7 @@ import pytest
 from conftest import open_app
 from test_uncertainty_band import SPEEDS, _result_file
 
-from app import compute
+from app.results import compute
 
 OUTPUT = Path(__file__).resolve().parent.parent / "test-artifacts"  # git-ignored
 pytestmark = [pytest.mark.browser, pytest.mark.slow]

@@ -1,4 +1,4 @@
-"""app.workers.LatestRequest: at most one waiting request per session and kind on a shared pool;
+"""app.services.thread_pools.LatestRequest: at most one waiting request per session and kind on a shared pool;
 a newer request replaces one that has not started; a closed session's request is not run."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import threading
 from concurrent.futures import ThreadPoolExecutor
 
-from app.workers import LatestRequest
+from app.services.thread_pools import LatestRequest
 
 
 def test_a_newer_request_replaces_the_waiting_one_and_the_queue_stays_short():

@@ -1,0 +1,74 @@
+"""``bogie report``: the dashboard's self-contained HTML report from the command line.
+
+    bogie report --s0 0.005 --v 120 [--n0 N --bm B] [--m0 M0 --f F --decay D --phase DT]
+                 [--t-end T] [--rail calibrated|dry|wet] [--params FILE] [--variant TEXT]
+                 --out report.html
+
+Units as in ``bogie response``: ``--n0`` [N], ``--m0`` [N m], ``--phase`` [s].  ``--variant``:
+a design variant as ``name:value,…`` (SI) applied to the set, as in the dashboard's links.  The
+report itself is built by :mod:`app.report.page` (imported only by this command: ``model`` does not
+depend on the app otherwise).  Bad input: one line on stderr, exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from app.cli.main import UsageError, add_operating_point, number
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("report", help="self-contained HTML report of an operating point")
+    add_operating_point(p)
+    p.add_argument("--m0", type=number("--m0 (amplitude, N m)", 0, 2e5, low_open=False,
+                                       high_open=False, allowed="must be in [0, 2e5] N m"),
+                   default=50_000.0, help="short-circuit amplitude M0 [N m] (default %(default)s)")
+    p.add_argument("--f", type=number("--f (frequency, Hz)", 10, 300, False, False,
+                                      allowed="must be in [10, 300] Hz"),
+                   default=90.0, help="short-circuit frequency f [Hz] (default %(default)s)")
+    p.add_argument("--decay", type=number("--decay (D)", 0, 0.3, False, False,
+                                          allowed="must be in [0, 0.3]"),
+                   default=0.04, help="decay D [-] (default %(default)s)")
+    p.add_argument("--phase", type=number("--phase (Δt, s)", -0.01, 0.01, False, False,
+                                          allowed="must be in [-0.01, 0.01] s"),
+                   default=None, help="time shift Δt [s] (default: continuous motor torque)")
+    p.add_argument("--t-end", type=number("--t-end (horizon, s)", 0.2, 5, False, False,
+                                          allowed="must be in [0.2, 5] s"),
+                   default=2.0, help="simulated time [s] (default %(default)s)")
+    p.add_argument("--rail", choices=("calibrated", "dry", "wet"), default="calibrated",
+                   help="creep law (default: the set's own)")
+    p.add_argument("--variant", default="", metavar="TEXT",
+                   help="design variant: name:value,… (SI units) applied to the set")
+    p.add_argument("--out", required=True, help="output file (.html)")
+    p.set_defaults(func=cmd_report)
+
+
+def cmd_report(args: argparse.Namespace) -> None:
+    import sys
+
+    from app.report.page import build_report
+    from app.results.variants import VariantError, apply_variant, base_parameters, decode, set_key
+
+    out = Path(args.out)
+    if out.suffix.lower() not in (".html", ".htm"):
+        raise UsageError(f"--out must end in .html, got '{out.name}'")
+    if not out.parent.is_dir():
+        raise UsageError(f"directory '{out.parent}' does not exist")
+    if args.s0 is None:
+        raise UsageError("--s0 is required")
+    base = str(Path(args.params).resolve()) if args.params else ""
+    try:
+        changes = decode(args.variant)
+        parameters = apply_variant(base_parameters(base), changes)
+    except VariantError as error:
+        raise UsageError(f"--variant: {error}") from None
+    n0 = parameters["wheel_force"] if args.n0 is None else args.n0
+    bm = parameters["motor_slope"] if args.bm is None else args.bm
+    text = build_report(set_key(base, changes), args.rail, args.s0, args.v, n0 / 1e3, bm,
+                        args.m0 / 1e3, args.f, args.decay,
+                        None if args.phase is None else args.phase * 1e3, args.t_end,
+                        progress=lambda step: print(f"bogie report: {step}…", file=sys.stderr,
+                                                    flush=True))
+    out.write_text(text, encoding="utf-8")
+    print(f"wrote {out} ({len(text.encode()) / 1e6:.1f} MB, self-contained)")

@@ -1,0 +1,199 @@
+"""``bogie response``: short-circuit time response (spec §4) from the command line.
+
+    bogie response --s0 0.005 --v 120 [--n0 N --bm B] [--m0 M0 --f F --decay D --phase DT]
+                   --t-end T --fs FS [--out FILE.npz|.csv|.json] [--outputs a,b,…]
+
+Without ``--out``: a table of peaks (totals), their times and dominant frequencies, and the
+limit crossings.  Files: ``.npz`` (array ``t`` [s], one array per output name (totals), ``M_C``,
+plus ``units``/``steady``), ``.csv`` (a column per output, the unit in the header), ``.json``.
+Bad input: one line on stderr, exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from app.cli.antislip import add_creep_arguments, check_creep_arguments, cmd_nonlinear_response
+from app.cli.main import UsageError, add_operating_point, emit, load_model, number
+
+MIN_SAMPLES_PER_PERIOD = 2.5  # fs must exceed 2.5 × the highest excited frequency
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("response", help="short-circuit time response of the drive loads")
+    add_operating_point(p)
+    p.add_argument("--m0", type=number("--m0 (amplitude, N m)", 0, 1e8, low_open=False,
+                                       allowed="must be in [0, 1e8] N m"),
+                   default=None, help="amplitude M0 of the oscillating part [N m] (default 50000)")
+    p.add_argument("--f", type=number("--f (frequency, Hz)", 0, 1e5,
+                                      allowed="must be in (0, 1e5) Hz"),
+                   default=None, help="frequency f of the oscillating part [Hz] (default 90)")
+    p.add_argument("--decay", type=number("--decay (D)", 0, 10, low_open=False,
+                                          allowed="must be in [0, 10]"),
+                   default=None, help="decay D: envelope e^(-D 2π f t) [-] (default 0.04)")
+    p.add_argument("--phase", type=number("--phase (Δt, s)", -10, 10, low_open=False,
+                                          high_open=False, allowed="must be in [-10, 10] s"),
+                   default=None, help="time shift Δt [s] (default: continuous motor torque)")
+    p.add_argument("--t-end", type=number("--t-end (horizon, s)", 0, 60, high_open=False,
+                                          allowed="must be in (0, 60] s"),
+                   default=2.0, help="horizon [s] (default %(default)s)")
+    p.add_argument("--fs", type=number("--fs (sampling rate, Hz)", 0, 1e7,
+                                       allowed="must be in (0, 1e7) Hz"),
+                   default=10_000.0, help="output sampling rate [Hz] (default %(default)s)")
+    p.add_argument("--outputs", default=None,
+                   help="comma-separated output or DOF names (default: all loads)")
+    p.add_argument("--method", choices=("auto", "modal", "expm"), default="auto",
+                   help="evaluation of the closed form (default %(default)s)")
+    p.add_argument("--out", default=None, help="write .npz, .csv or .json")
+    add_creep_arguments(p)  # issue 10: --creep, --anti-slip …
+    p.set_defaults(func=cmd_response)
+
+
+def _check_out(path: str | None) -> Path | None:
+    if path is None:
+        return None
+    out = Path(path)
+    if out.suffix not in (".npz", ".csv", ".json"):
+        raise UsageError(f"unknown file extension '{out.suffix or out.name}': use .npz, .csv or "
+                         ".json")
+    if not out.parent.exists():
+        raise UsageError(f"directory '{out.parent}' does not exist")
+    return out
+
+
+def cmd_response(args: argparse.Namespace) -> None:
+    from model.analysis.response import ShortCircuit, short_circuit_response
+
+    out = _check_out(args.out)
+    check_creep_arguments(args)
+    defaults = ShortCircuit()
+    excitation = ShortCircuit(
+        M0=defaults.M0 if args.m0 is None else args.m0,
+        f=defaults.f if args.f is None else args.f,
+        D=defaults.D if args.decay is None else args.decay,
+        dt=args.phase)
+    if args.fs < MIN_SAMPLES_PER_PERIOD * excitation.f:
+        raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the excitation at "
+                         f"f = {excitation.f:g} Hz: must be at least "
+                         f"{MIN_SAMPLES_PER_PERIOD * excitation.f:g} Hz")
+    if args.t_end * args.fs > 2_000_000:
+        raise UsageError(f"--t-end × --fs = {args.t_end * args.fs:.0f} samples is too many: at "
+                         "most 2000000")
+    names = None if args.outputs is None else [s.strip() for s in args.outputs.split(",")
+                                                if s.strip()]
+    if args.creep != "linear":
+        cmd_nonlinear_response(args, excitation, names, out)
+        return
+    model, op, _ = load_model(args)
+    result = short_circuit_response(model, op, excitation, args.t_end, args.fs, names,
+                                    method=args.method)
+    if result.highest_excited_hz and args.fs < MIN_SAMPLES_PER_PERIOD * result.highest_excited_hz:
+        raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the highest excited "
+                         f"frequency {result.highest_excited_hz:.4g} Hz: must be at least "
+                         f"{MIN_SAMPLES_PER_PERIOD * result.highest_excited_hz:.4g} Hz")
+    finish(args, result, out, write_result, summary_data, summary_table)
+
+
+def finish(args: argparse.Namespace, result, out: Path | None, write, summarize, table) -> None:
+    """The tail of a response command: ``write(result, out)`` if asked, then the summary
+    (``summarize(result)``, JSON) or the table (``table(result)``, text)."""
+    if out is not None:
+        write(result, out)
+    summary = summarize(result)
+    if out is not None:
+        summary["out"] = str(out)
+    emit(args, summary, table(result) + (f"\nwrote {out}" if out else ""))
+
+
+def summary_data(result) -> dict:
+    op = result.operating_point
+    return {
+        "operating_point": op.as_dict(),
+        "excitation": {"M0": result.excitation.M0, "f": result.excitation.f,
+                       "D": result.excitation.D, "dt": result.phase_shift},
+        "motor_torque": result.motor_torque, "method": result.method,
+        "error_estimate": None if math.isnan(result.error_estimate) else result.error_estimate,
+        "truncated_at": result.truncated_at, "limits": result.limits,
+        "highest_excited_hz": result.highest_excited_hz,
+        "outputs": {name: {"unit": result.units[name], "steady": result.steady[name],
+                           "peak": result.peaks[name], "peak_time": result.peak_times[name],
+                           "perturbation_peak": result.perturbation_peaks[name],
+                           "perturbation_peak_time": result.perturbation_peak_times[name],
+                           "dominant_frequencies_hz": list(result.dominant_frequencies[name])}
+                    for name in result.outputs},
+        "limit_crossings": [{"output": c.output, "limit": c.limit_name, "limit_value": c.limit,
+                             "time": c.time, "value": c.value} for c in result.limit_crossings],
+    }
+
+
+def summary_table(result) -> str:
+    op, e = result.operating_point, result.excitation
+    lines = [f"short circuit of ID1's motor at s0 = {op.s0:g}, v = {op.v_kmh:g} km/h, "
+             f"N0 = {op.N0:g} N: M(s0, v) = {result.motor_torque:.6g} N m, M0 = {e.M0:g} N m, "
+             f"f = {e.f:g} Hz, D = {e.D:g}, Δt = {result.phase_shift:.4g} s",
+             f"{len(result.t)} points to t = {result.t[-1]:g} s, method {result.method}"
+             + ("" if math.isnan(result.error_estimate)
+                else f" (rounding-error indicator {result.error_estimate:.1e}, not a bound)")
+             + (f"; TRUNCATED at {result.truncated_at:g} s (growth)" if result.truncated_at
+                else ""),
+             "values are totals (pre-fault + perturbation)", "",
+             f"{'output':<30} {'unit':<4} {'steady':>11} {'peak':>11} {'at [s]':>8} "
+             f"{'Δpeak':>11}  dominant frequencies [Hz]"]
+    for name in result.outputs:
+        freqs = ", ".join(f"{x:.4g}" for x in result.dominant_frequencies[name])
+        lines.append(f"{name:<30} {result.units[name]:<4} {result.steady[name]:>11.4g} "
+                     f"{result.peaks[name]:>11.4g} {result.peak_times[name]:>8.4f} "
+                     f"{result.perturbation_peaks[name]:>11.4g}  {freqs}")
+    return "\n".join(lines + limit_lines(result))
+
+
+def limit_lines(result) -> list[str]:
+    """The limits and their first crossings of a (linear or nonlinear) response, as text lines."""
+    lines = ["", "limits: " + ", ".join(f"{k} = {v:.5g}" for k, v in result.limits.items())]
+    if not result.limit_crossings:
+        return [*lines, "no limit crossed"]
+    lines.append("limit crossings (|total| > limit), first time:")
+    for c in result.limit_crossings:
+        lines.append(f"  {c.time:8.4f} s  {c.output} = {c.value:.5g} beyond {c.limit_name} = "
+                     f"{c.limit:.5g}")
+    return lines
+
+
+def write_result(result, path: Path) -> None:
+    write_series(path, result.t, result.M_C,
+                 {name: (result.outputs[name], result.units[name]) for name in result.outputs},
+                 result.steady, summary_data(result))
+
+
+def write_series(path: Path, t: np.ndarray, M_C: np.ndarray,
+                 series: dict[str, tuple[np.ndarray, str]], steady: dict[str, float],
+                 summary: dict) -> None:
+    """Time series (name -> (values, unit)) at times ``t`` [s] with the short-circuit torque
+    ``M_C`` [N m] as ``.npz`` (arrays, names, units, steady values; NaN where a series has
+    none), ``.csv`` (one column per series, units in the header) or ``.json`` (``summary``
+    plus the series)."""
+    names = list(series)
+    if path.suffix == ".npz":
+        arrays = {"t": t, "M_C": M_C, **{n: series[n][0] for n in names},
+                  "names": np.array(names, dtype=str),
+                  "units": np.array([series[n][1] for n in names], dtype=str),
+                  "steady": np.array([steady.get(n, np.nan) for n in names])}
+        np.savez(path, **arrays)
+    elif path.suffix == ".csv":
+        with path.open("w", newline="") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(["t [s]", "M_C [N m]"] + [f"{n} [{series[n][1]}]" for n in names])
+            table = np.column_stack([t, M_C] + [series[n][0] for n in names])
+            writer.writerows([[repr(float(x)) for x in row] for row in table])
+    else:
+        data = dict(summary)
+        data["t"] = t.tolist()
+        data["M_C"] = M_C.tolist()
+        data["series"] = {n: series[n][0].tolist() for n in names}
+        path.write_text(json.dumps(data, allow_nan=False))

@@ -1,0 +1,318 @@
+"""``bogie study``: parameter studies on Dask (a local cluster by default, a cluster by address).
+
+    bogie study map   --s0 A:B:N --v A:B:N [--n0 LIST] [--bm LIST] [--params FILE] [--rail R]
+                      --out X.zarr [--scheduler tcp://HOST:PORT] [--workers N] [--resume]
+    bogie study limit --v A:B:N [--n0 LIST] [--bm LIST] … --out X.zarr …
+    bogie study uncertainty --samples N [--seed S] [--params FILE] --out U.json
+                      [--posterior | --no-indices] [--speeds LIST]
+                      [--scheduler tcp://HOST:PORT] [--workers N] [--serial]
+
+``A:B:N`` is N values from A to B (N = 1: A alone); a LIST is comma-separated values or A:B:N.
+Speeds in km/h on the command line (m/s in the store).  Results: an xarray Dataset in a Zarr
+store (:mod:`model.studies.store`).  A progress bar with the time left goes to stderr.  Ctrl-C
+stops cleanly: the finished chunks stay in the store, ``--resume`` computes the rest.  Bad input
+(an empty range, N < 1, a store of another study, an unreachable scheduler): one line on
+stderr, exit status 2.  Interrupted: exit status 130.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import math
+import sys
+import time
+
+import numpy as np
+
+from app.cli.main import UsageError, number, positive_int
+
+EXIT_INTERRUPTED = 130
+
+
+def parse_values(text: str, label: str, low: float, high: float, unit: str,
+                 increasing: bool = False) -> list[float]:
+    """'A:B:N' (N values from A to B) or 'x1,x2,…' -> values within [low, high]."""
+    text = text.strip()
+    if ":" in text:
+        parts = text.split(":")
+        try:
+            if len(parts) != 3:
+                raise ValueError
+            start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
+        except ValueError:
+            raise UsageError(f"{label} must be A:B:N (two numbers and a whole count) or a "
+                             f"comma-separated list, got '{text}'") from None
+        if count < 1:
+            raise UsageError(f"{label} = '{text}': N = {count} is not allowed, must be >= 1")
+        if count > 1 and not start < stop:
+            raise UsageError(f"{label} = '{text}' is an empty range: A must be below B")
+        values = [start] if count == 1 else list(np.linspace(start, stop, count))
+    else:
+        try:
+            values = [float(x) for x in text.split(",") if x.strip()]
+        except ValueError:
+            raise UsageError(f"{label} must be numbers separated by commas or A:B:N, "
+                             f"got '{text}'") from None
+        if not values:
+            raise UsageError(f"{label} is empty")
+    for value in values:
+        if not (math.isfinite(value) and low <= value <= high):
+            raise UsageError(f"{label}: {value:g} is not allowed, must be in [{low:g}, {high:g}] "
+                             f"{unit}")
+    if increasing and any(b <= a for a, b in itertools.pairwise(values)):
+        raise UsageError(f"{label} must increase")
+    if len(values) > 100_000:
+        raise UsageError(f"{label}: {len(values)} values, at most 100000 allowed")
+    return [float(v) for v in values]
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--n0", default=None, metavar="LIST",
+                   help="wheel forces N0 [N]: x1,x2,… or A:B:N (default: the parameter set's)")
+    p.add_argument("--bm", default=None, metavar="LIST",
+                   help="motor slopes b_M [N m s/rad]: x1,x2,… or A:B:N (default: the set's)")
+    p.add_argument("--params", default=None, metavar="FILE",
+                   help="parameter file (TOML; default: the calibrated set)")
+    p.add_argument("--rail", choices=("calibrated", "dry", "wet"), default="calibrated",
+                   help="creep law: the set's own (calibrated) or Polach's dry/wet preset")
+    p.add_argument("--out", required=True, metavar="X.zarr", help="Zarr store to write")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the study in --out (same parameters and arguments only)")
+    _engine_options(p)
+    p.add_argument("--json", action="store_true", help="a JSON summary on stdout")
+
+
+def _engine_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                   help="attach to a running Dask scheduler (default: $DASK_SCHEDULER_ADDRESS, "
+                        "else a local cluster)")
+    p.add_argument("--workers", type=positive_int("--workers"), default=None,
+                   help="worker processes of the local cluster (default: one per core)")
+    p.add_argument("--serial", action="store_true",
+                   help="compute in this process, without Dask (the reference)")
+    p.add_argument("--connect-timeout", type=number("--connect-timeout (s)", 0, 600,
+                                                    allowed="must be in (0, 600) s"),
+                   default=10.0, help="seconds to reach the scheduler (default %(default)s)")
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("study", help="parameter studies on Dask: stability map, s0*(v)")
+    sub = p.add_subparsers(dest="study_command", required=True)
+    m = sub.add_parser("map", help="stability map over s0 × v (× N0 × b_M)")
+    m.add_argument("--s0", required=True, metavar="A:B:N", help="creepages s0 [-], increasing")
+    m.add_argument("--v", required=True, metavar="A:B:N", help="speeds [km/h]")
+    m.add_argument("--max-frequency", type=number("--max-frequency (Hz)", 0.5, 500,
+                                                  allowed="must be in (0.5, 500) Hz"),
+                   default=10.0, help="method reduced: reduction basis disc |λ| < 2π f [Hz] "
+                   "(default %(default)s)")
+    m.add_argument("--method", choices=("reduced", "continuation", "dense"),
+                   default="reduced", help="per s0-line: the Galerkin-reduced model (default, "
+                   "cheapest), the exact continuation of all eigenvalues, or a full "
+                   "eigen-analysis per point")
+    _common(m)
+    m.set_defaults(func=cmd_map)
+    limit = sub.add_parser("limit", help="stability limit s0*(v) for lists of N0 and b_M")
+    limit.add_argument("--v", required=True, metavar="A:B:N", help="speeds [km/h]")
+    _common(limit)
+    limit.set_defaults(func=cmd_limit)
+    u = sub.add_parser("uncertainty", help="the Monte-Carlo/Sobol study of `bogie uncertainty` "
+                       "(docs/sensitivity.md) on the same engine")
+    u.add_argument("--samples", type=positive_int("--samples"), required=True,
+                   help="base sample count n (a power of 2 >= 2); model runs: n (d + 2)")
+    u.add_argument("--seed", type=int, default=12, help="seed of the scrambled Sobol' sequence")
+    u.add_argument("--params", default=None, metavar="FILE",
+                   help="parameter file (TOML; default: the calibrated set)")
+    u.add_argument("--out", required=True, metavar="U.json", help="JSON result to write")
+    u.add_argument("--chunk-size", type=positive_int("--chunk-size"), default=4,
+                   help="model runs per task (default %(default)s)")
+    _engine_options(u)
+    from app.cli.sensitivity import add_uncertainty_options
+
+    add_uncertainty_options(u)
+    u.add_argument("--json", action="store_true", help="the result as JSON on stdout")
+    u.set_defaults(func=cmd_uncertainty)
+
+
+def _parameters(args):
+    from model.contact.creep import CREEP_PRESETS
+    from model.mechanics.parameters import load_parameters
+
+    parameters = load_parameters(args.params)
+    if args.rail != "calibrated":
+        parameters = parameters.replace(**CREEP_PRESETS[args.rail])
+    return parameters
+
+
+def _grids(args, parameters):
+    from model.mechanics.operating_point import KMH
+
+    v = [x * KMH for x in parse_values(args.v, "--v", 1, 500, "km/h", increasing=True)]
+    n0 = (parse_values(args.n0, "--n0", 1e3, 1e6, "N") if args.n0 is not None
+          else [parameters["wheel_force"]])
+    bm = (parse_values(args.bm, "--bm", 0, 1e9, "N m s/rad") if args.bm is not None
+          else [parameters["motor_slope"]])
+    return v, n0, bm
+
+
+def cmd_map(args: argparse.Namespace) -> None:
+    from model.studies.maps import MapStudy
+
+    parameters = _parameters(args)
+    s0 = parse_values(args.s0, "--s0", 1e-9, 1 - 1e-9, "-", increasing=True)
+    v, n0, bm = _grids(args, parameters)
+    _run(args, MapStudy(s0, v, n0, bm, max_frequency_hz=args.max_frequency,
+                        method=args.method), parameters)
+
+
+def cmd_limit(args: argparse.Namespace) -> None:
+    from model.studies.maps import LimitStudy
+
+    parameters = _parameters(args)
+    v, n0, bm = _grids(args, parameters)
+    _run(args, LimitStudy(v, n0, bm), parameters)
+
+
+class ProgressBar:
+    """``[#####-----] 5/10 chunks, 12 s elapsed, ~12 s left`` on stderr (redrawn in place on a
+    terminal; otherwise a line at most every 2 s and at the end)."""
+
+    def __init__(self, label: str, stream=None, width: int = 30, unit: str = "chunks"):
+        self.label, self.stream, self.width, self.unit = label, stream or sys.stderr, width, unit
+        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.first: tuple[int, float] | None = None
+        self.last_print = -math.inf
+
+    def __call__(self, finished: int, total: int, elapsed: float) -> None:
+        if self.first is None:
+            self.first = (finished, elapsed)
+        done_here = finished - self.first[0]
+        if done_here > 0 and finished < total:
+            left = f", ~{(elapsed - self.first[1]) / done_here * (total - finished):.0f} s left"
+        else:
+            left = ""
+        filled = int(self.width * finished / max(total, 1))
+        text = (f"{self.label}: [{'#' * filled}{'-' * (self.width - filled)}] {finished}/{total} "
+                f"{self.unit}, {elapsed:.0f} s elapsed{left}")
+        now = time.monotonic()
+        if self.tty:
+            self.stream.write("\r" + text.ljust(100) + ("\n" if finished == total else ""))
+        elif finished == total or now - self.last_print >= 2.0:
+            self.stream.write(text + "\n")
+        else:
+            return
+        self.last_print = now
+        self.stream.flush()
+
+
+def _start_engine(args: argparse.Namespace):
+    """(engine or None, map_unordered, where) for --serial / --scheduler / a local cluster."""
+    from model.studies.engine import EngineUnavailable, StudyEngine, serial_map_unordered
+
+    if args.serial:
+        return None, serial_map_unordered, "this process (serial)"
+    engine = StudyEngine(args.scheduler, args.workers, args.connect_timeout)
+    try:
+        engine.start()
+    except EngineUnavailable as error:
+        raise UsageError(str(error)) from None
+    return engine, engine.map_unordered, engine.description
+
+
+def cmd_uncertainty(args: argparse.Namespace) -> None:
+    from pathlib import Path
+
+    from model.mechanics.parameters import load_parameters
+    from model.studies.engine import in_order
+    from model.studies.uncertainty import UncertaintyError, run_uncertainty
+
+    n = args.samples
+    if n < 2 or n & (n - 1):
+        raise UsageError(f"--samples = {n} is not allowed: must be a power of 2 >= 2 "
+                         "(balance of the Sobol' sequence)")
+    out = Path(args.out)
+    if not out.parent.is_dir():
+        raise UsageError(f"directory '{out.parent}' does not exist")
+    from app.cli.sensitivity import uncertainty_options
+
+    options = uncertainty_options(args)
+    parameters = load_parameters(args.params)
+    bar, start = ProgressBar("study uncertainty", unit="model runs"), time.monotonic()
+    engine, mapper, where = _start_engine(args)
+    try:
+        print(f"study uncertainty: n = {n} on {where}", file=sys.stderr)
+        result = run_uncertainty(parameters, n, seed=args.seed, map_fn=in_order(mapper), **options,
+                                 chunk_size=args.chunk_size,
+                                 progress=lambda done, total: bar(done, total,
+                                                                  time.monotonic() - start))
+    except UncertaintyError as error:
+        raise UsageError(str(error)) from None
+    except KeyboardInterrupt:
+        print("\nstudy uncertainty: interrupted (nothing written)", file=sys.stderr)
+        raise SystemExit(EXIT_INTERRUPTED) from None
+    finally:
+        if engine is not None:
+            engine.close()
+    data = result.as_dict()
+    out.write_text(json.dumps(data, indent=1, allow_nan=False), encoding="utf-8")
+    if args.json:
+        print(json.dumps(data, indent=1, allow_nan=False))
+    else:
+        print(result.summary())
+        print(f"wrote {out}")
+
+
+def _run(args: argparse.Namespace, study, parameters) -> None:
+    from model.studies.store import open_study, prepare_store, run_into_store
+
+    progress = ProgressBar(f"study {study.kind}")
+    if not args.resume:  # refuse a bad --out before starting a cluster
+        from pathlib import Path
+
+        out = Path(args.out)
+        if out.exists():
+            raise UsageError(f"'{out}' exists: continue it with --resume, or remove it")
+        if not out.parent.is_dir():
+            raise UsageError(f"directory '{out.parent}' does not exist")
+    else:
+        prepare_store(args.out, study, parameters, resume=True)  # refuses another study's store
+    engine = None
+    try:
+        engine, mapper, where = _start_engine(args)
+        print(f"study {study.kind}: {len(study.chunks())} chunks on {where}", file=sys.stderr)
+        run = run_into_store(study, parameters, args.out, mapper, resume=args.resume,
+                             progress=progress)
+    except KeyboardInterrupt:
+        from model.studies.store import finished_chunks
+
+        done = len(finished_chunks(args.out))
+        print(f"\nstudy {study.kind}: interrupted; {done} of {len(study.chunks())} chunks "
+              f"finished in {args.out}; continue with --resume", file=sys.stderr)
+        raise SystemExit(EXIT_INTERRUPTED) from None
+    finally:
+        if engine is not None:
+            engine.close()
+    dataset = open_study(args.out)
+    summary = {"out": args.out, "study": study.kind, "chunks": run.total,
+               "skipped_chunks": run.skipped, "computed_chunks": run.computed,
+               "seconds": round(run.seconds, 3), "parameters_hash": dataset.attrs["parameters_hash"]}
+    lines = [f"wrote {args.out}: {run.computed} chunk(s) computed, {run.skipped} already "
+             f"finished, {run.seconds:.1f} s"]
+    if study.kind == "map":
+        stable = dataset["stable"].values
+        summary["stable_fraction"] = float(stable.mean())
+        lines.append(f"stable at {stable.mean():.1%} of {stable.size} points")
+    limits = dataset["s0_limit"].values
+    summary["s0_limit"] = [None if np.isnan(x) else float(x) for x in limits.ravel()]
+    if args.json:
+        print(json.dumps(summary, indent=1, allow_nan=False))
+        return
+    for (i, j, k), value in np.ndenumerate(limits):
+        lines.append(f"  v = {dataset['v_kmh'].values[i]:7.2f} km/h, N0 = {dataset['N0'].values[j]:g} N, "
+                     f"b_M = {dataset['b_M'].values[k]:g} N m s/rad: s0* = "
+                     + ("none in range" if np.isnan(value) else f"{value:.6f}"))
+        if len(lines) > 25:
+            lines.append("  … (open the store with xarray for all)")
+            break
+    print("\n".join(lines))

@@ -1,0 +1,7 @@
+"""What every interface shows: cached results as plain data, and the figures and tables of them.
+
+:mod:`.compute` (the dashboard's and the report's computations, cached across sessions),
+:mod:`.variants` (design variants of the bundled set), :mod:`.plots` and
+:mod:`.eigenvalue_sweep` (Bokeh figures fed with results), :mod:`.tables` (HTML tables of
+results).  May use ``model`` only.
+"""

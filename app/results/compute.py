@@ -1,0 +1,462 @@
+"""What the dashboard computes, as plain data, cached across sessions.
+
+Every function here takes primitives only (so :func:`panel.cache` keys them by value, not by
+object identity) and returns read-only plain data: results are shared between sessions and
+never mutated.  The physics is in :mod:`model`; this module only calls it and reshapes the
+results for plotting.  Units: SI, except where a name says otherwise (``v_kmh`` [km/h],
+``N0_kN`` [kN], ``M0_kNm`` [kN m], ``dt_ms`` [ms], ``im_hz`` [Hz]).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import panel as pn
+
+from model import (
+    KMH,
+    NoStabilityLimit,
+    adhesion_moment,
+    build_model,
+    creep_law,
+    eigen_analysis,
+    mode_character,
+)
+from model.contact.creep import CREEP_PRESETS
+from model.mechanics.operating_point import OperatingPoint
+
+RAIL_CONDITIONS = ("calibrated", "dry", "wet")  # "calibrated": the creep law of the parameter set
+N_COMPLEX_TABLE = 10  # complex pairs in the eigenvalue / mode tables (Table 1 and 2 layout)
+N_REAL_TABLE = 10  # real eigenvalues in the eigenvalue table
+LOCUS_MAX_HZ = 20.0  # branches tracked up to this frequency [Hz]
+LOCUS_POINTS = 25  # points of the coarse root-locus sweep (shown first, brackets s0*)
+LOCUS_DENSE_POINTS = 200  # points of the dense sweep that replaces it
+LOCUS_UNIFORM_SHARE = 0.3  # share of the dense points spread evenly (the rest follow the motion)
+LOCUS_JUMP_FACTOR = 2.5  # a step this many times as fast as both neighbouring steps is a jump
+LOCUS_JUMP_MIN = 0.5  # ... and longer than this in plot units (Re [1/s], Im [Hz]): line broken
+LOCUS_JUMP_LONG = 0.04  # a step longer than this share of the plot (Re and Im spans of the
+LOCUS_JUMP_SIDE = 1.5  # sweep) is a jump already when it is this many times as fast as one
+# neighbouring step: a branch accelerating into a collision of eigenvalues (steps 10, 16, 50,
+# then 5 [1/s]) is not resolved by any grid
+LOCUS_S0 = (0.001, 0.02)  # s0 range of the creepage sweep [-]
+LIMIT_XTOL = 1e-6  # s0*(v) to 1e-6 (shown with 5 decimals)
+LOCUS_V_KMH = (40.0, 200.0)  # speed range of the speed sweep [km/h]
+GROWTH_CUT = 4.0  # plotted histories end when a torque exceeds this multiple of M_ad
+PLOT_BUCKETS = 1000  # min/max decimation of each time history for the browser (CSV keeps all)
+RESPONSE_FS = 10_000.0  # sampling of the time histories [Hz]: 33 samples per period of the
+# 298 Hz driving-shaft mode, so a sampled peak is within 1 − cos(π/33) = 0.5 % of the true one
+
+TORQUES = ("driving_shaft.torque", "disc_clutch.torque")
+FORCES = ("disc_clutch.force_x", "disc_clutch.force_y", "disc_clutch.force_z")
+RESPONSE_OUTPUTS = tuple(f"{d}.{q}" for d in ("ID1", "ID2") for q in TORQUES + FORCES)
+
+
+class ModelRejected(ValueError):
+    """A parameter combination the model rejects (message shown to the user)."""
+
+
+# --- model -----------------------------------------------------------------------------------
+
+@pn.cache(max_items=24)
+def parameters(params_path: str, rail: str):
+    """The parameter set in use: the file (``""``: calibrated default) or a design variant of
+    it (set key ``"FILE|name:value,…"``, :mod:`app.results.variants`) with the rail's creep law
+    (``"calibrated"`` keeps the set's, ``"dry"``/``"wet"``: Polach's presets)."""
+    from app.results.variants import parameters_of_key
+
+    p = parameters_of_key(params_path)
+    if rail == "calibrated":
+        return p
+    if rail not in CREEP_PRESETS:
+        raise ModelRejected(f"unknown rail condition '{rail}'; allowed: {', '.join(RAIL_CONDITIONS)}")
+    return p.replace(**CREEP_PRESETS[rail])
+
+
+@pn.cache(max_items=24)
+def model(params_path: str, rail: str):
+    """The assembled model (shared read-only between sessions)."""
+    return build_model(parameters(params_path, rail))
+
+
+def operating_point(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                    b_M: float) -> OperatingPoint:
+    return OperatingPoint.from_kmh(float(s0), float(v_kmh), float(N0_kN) * 1e3, float(b_M))
+
+
+# --- eigenvalues, modes, creep characteristic at the current point ---------------------------
+
+@dataclass(frozen=True)
+class Mode:
+    """One complex mode (upper eigenvalue of a pair)."""
+
+    number: int  # ν, by ascending frequency
+    eigenvalue: complex  # [1/s]
+    im_hz: float  # Im λ / 2π [Hz]
+    damping_ratio: float  # −Re λ / |λ| [-]
+    description: str  # generated from energy shares (model.analysis.modes)
+    displacement: dict[str, np.ndarray]  # drawn point -> real translation (x, y, z), unit max
+    kinetic: dict[str, float] = field(default_factory=dict)  # component -> kinetic-energy share
+    strain: dict[str, float] = field(default_factory=dict)  # element group -> strain-energy share
+
+
+@dataclass(frozen=True)
+class PointResult:
+    """Eigen-analysis of one operating point, reshaped for the views."""
+
+    key: tuple  # (params_path, rail, s0, v_kmh, N0_kN, b_M)
+    eigenvalues: np.ndarray  # all non-rigid eigenvalues [1/s]
+    stable: bool
+    max_real_part: float  # [1/s]
+    flutter: int  # unstable complex pairs
+    divergence: int  # positive real eigenvalues
+    n_rigid: int  # identified rigid-body zero eigenvalues
+    modes: list[Mode]  # first N_COMPLEX_TABLE complex pairs
+    real: np.ndarray  # real eigenvalues, largest first (first N_REAL_TABLE) [1/s]
+    creep_s: np.ndarray  # creepage grid [-]
+    creep_mu: np.ndarray  # μ(s, v) on it [-]
+    mu0: float  # μ(s0, v) [-]
+    s_max: float  # creepage of the creep maximum [-]
+    mu_max: float  # μ_max(v) [-]
+    M_ad: float  # maximal adhesion moment 2 N0 r0 μ_max [N m]
+
+
+def drawing_owner(model_, point: str) -> tuple[str, bool]:
+    """(body whose coordinates move ``point``, whether the point has its own translations)."""
+    names = set(model_.dofs.names)
+    if f"{point}.x" in names:
+        return point, True
+    if point.startswith("secondary."):
+        return "BF", False
+    drive = point.split(".")[0]
+    return f"{drive}.stator", False
+
+
+def _point_displacements_direct(model_, q: np.ndarray) -> dict[str, np.ndarray]:
+    """:func:`point_displacements` point by point (u + θ × r for points carried by a body);
+    used once per model to build the linear map, and by the test that checks the map."""
+    index = {name: i for i, name in enumerate(model_.dofs.names)}
+    out: dict[str, np.ndarray] = {}
+    for point, position in model_.positions.items():
+        if point == "CB":
+            out[point] = np.array([0.0, 0.0, q[index["CB.z"]].real])
+            continue
+        owner, own = drawing_owner(model_, point)
+        u = np.array([q[index[f"{owner}.{a}"]].real for a in ("x", "y", "z")])
+        theta = np.array([q[index[f"{owner}.{a}"]].real for a in ("rx", "ry", "rz")])
+        if not own:
+            u = u + np.cross(theta, np.asarray(position) - model_.positions[owner])
+        out[point] = u
+    return out
+
+
+def _displacement_map(model_) -> tuple[list[str], np.ndarray]:
+    """(drawn points, D) with the translations of all points = D Δq (3·points x n), built once
+    per model from the kinematics above (it is linear in Δq)."""
+    cached = model_.__dict__.get("_displacement_map")
+    if cached is None:
+        names = list(model_.positions)
+        columns = []
+        for j in range(model_.n):
+            unit = np.zeros(model_.n)
+            unit[j] = 1.0
+            moved = _point_displacements_direct(model_, unit)
+            columns.append(np.concatenate([moved[name] for name in names]))
+        cached = (names, np.array(columns).T)
+        model_.__dict__["_displacement_map"] = cached
+    return cached
+
+
+def point_displacements(model_, q: np.ndarray) -> dict[str, np.ndarray]:
+    """Real translation (x, y, z) [m per unit mode amplitude] of every drawn point of
+    ``model.positions`` for the displacement vector Δq (rigid-body kinematics for points carried
+    by a body: u + θ × r)."""
+    names, D = _displacement_map(model_)
+    moved = (D @ np.real(q)).reshape(len(names), 3)
+    return dict(zip(names, moved, strict=True))
+
+
+@pn.cache(max_items=256)
+def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                 b_M: float) -> PointResult:
+    """Eigenvalues, stability, mode descriptions and creep characteristic at one point."""
+    m = model(params_path, rail)
+    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
+    result = eigen_analysis(m, op)
+    modes = []
+    for number, i in enumerate(result.complex_index[:N_COMPLEX_TABLE], start=1):
+        character = mode_character(m, result, int(i))
+        lam = complex(result.eigenvalues[i])
+        modes.append(Mode(number, lam, lam.imag / (2 * math.pi), character.damping_ratio,
+                          character.description,
+                          point_displacements(m, result.mode_shape(int(i))),
+                          dict(character.kinetic), dict(character.strain)))
+    law = creep_law(m.parameters, op.N0)
+    s_max, mu_max = law.maximum(op.v)
+    s_grid = np.linspace(0.0, max(0.03, 1.5 * op.s0), 301)
+    return PointResult(
+        key=(params_path, rail, s0, v_kmh, N0_kN, b_M), eigenvalues=result.eigenvalues,
+        stable=result.stable, max_real_part=result.max_real_part, flutter=result.flutter,
+        divergence=result.divergence, n_rigid=result.n_rigid, modes=modes,
+        real=result.real[:N_REAL_TABLE], creep_s=s_grid, creep_mu=np.asarray(law.mu(s_grid, op.v)),
+        mu0=float(law.mu(op.s0, op.v)), s_max=s_max, mu_max=mu_max,
+        M_ad=adhesion_moment(m.parameters, op.v, op.N0))
+
+
+@pn.cache(max_items=64)
+def mode_near(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
+              re: float, im: float) -> Mode:
+    """The mode whose eigenvalue is nearest to re + i·im [1/s] at an operating point (a tapped
+    root-locus point): shape, description and energy shares; ``number`` is its rank among the
+    complex pairs by frequency (0 for a real eigenvalue)."""
+    m = model(params_path, rail)
+    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
+    result = eigen_analysis(m, op)
+    index = int(np.argmin(np.abs(result.eigenvalues - complex(re, im))))
+    character = mode_character(m, result, index)
+    lam = complex(result.eigenvalues[index])
+    ranks = {int(i): k for k, i in enumerate(result.complex_index, start=1)}
+    return Mode(ranks.get(index, 0), lam, lam.imag / (2 * math.pi), character.damping_ratio,
+                character.description, point_displacements(m, result.mode_shape(index)),
+                dict(character.kinetic), dict(character.strain))
+
+
+# --- stability limit ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class LimitResult:
+    s0_limit: float | None  # s0*(v) [-], None if there is none in the searched range
+    message: str  # why there is none ("" otherwise)
+
+
+@pn.cache(max_items=128)
+def limit_result(params_path: str, rail: str, v_kmh: float, N0_kN: float,
+                 b_M: float) -> LimitResult:
+    """The stability limit s0*(v) at the current speed (model.analysis.stability)."""
+    from model.analysis.stability import stability_limit
+
+    m = model(params_path, rail)
+    # the root locus over s0 at this speed (usually cached: the dashboard shows it) brackets
+    # the first crossing between two of its points: ≈ 8 eigen-analyses instead of ≈ 20
+    locus = locus_result(params_path, rail, "s0", v_kmh, N0_kN, b_M)
+    turns = np.flatnonzero(~locus.stable[1:] & locus.stable[:-1])
+    bracket = None
+    if len(turns) and locus.stable[:turns[0] + 1].all():
+        bracket = (float(locus.values[turns[0]]), float(locus.values[turns[0] + 1]))
+    try:
+        limit = stability_limit(m, v_kmh * KMH, N0_kN * 1e3, b_M, s0_low=LOCUS_S0[0] / 2,
+                                xtol=LIMIT_XTOL, bracket=bracket)
+    except NoStabilityLimit as error:
+        return LimitResult(None, str(error))
+    return LimitResult(limit.s0_limit, "")
+
+
+# --- root locus --------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class LocusResult:
+    parameter: str  # "s0" [-] or "v" (values in km/h here)
+    values: np.ndarray  # (n_points,) in display units ([-] or [km/h])
+    eigenvalues: np.ndarray  # (n_points, n_branches) upper branches [1/s]
+    stable: np.ndarray  # (n_points,) bool
+    dense: bool = False  # the dense sweep (else the coarse one shown first)
+    # (n_points - 1, n_branches) bool: the step from point i to i + 1 is a jump (a branch that
+    # meets another one, or moves faster than the grid resolves): the line is broken there
+    jumps: np.ndarray | None = field(default=None, repr=False)
+
+
+def _sweep_range(parameter: str) -> tuple[float, float]:
+    if parameter == "s0":
+        return LOCUS_S0
+    if parameter == "v":
+        return LOCUS_V_KMH
+    raise ModelRejected(f"root locus parameter must be 's0' or 'v', got '{parameter}'")
+
+
+def _sweep(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float, b_M: float,
+           shown: np.ndarray, dense: bool) -> LocusResult:
+    """Root locus over ``shown`` (display units) at the fixed quantities."""
+    from model.analysis.locus import root_locus
+
+    m = model(params_path, rail)
+    if parameter == "s0":
+        op = operating_point(params_path, rail, float(shown[0]), fixed, N0_kN, b_M)
+        locus = root_locus(m, op, "s0", shown, max_frequency_hz=LOCUS_MAX_HZ)
+    else:
+        op = operating_point(params_path, rail, fixed, float(shown[0]), N0_kN, b_M)
+        locus = root_locus(m, op, "v", shown * KMH, max_frequency_hz=LOCUS_MAX_HZ)
+    upper = np.flatnonzero(locus.eigenvalues[0].imag >= 0)
+    lam = locus.eigenvalues[:, upper]
+    return LocusResult(parameter, shown, lam, np.asarray(locus.stable), dense, locus_jumps(shown, lam))
+
+
+@pn.cache(max_items=64)
+def locus_result(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
+                 b_M: float) -> LocusResult:
+    """The coarse sweep (LOCUS_POINTS evenly spaced): tracked branches over s0 (at speed
+    ``fixed`` [km/h]) or over v (at creepage ``fixed``).  Shown first; brackets s0*(v)."""
+    shown = np.linspace(*_sweep_range(parameter), LOCUS_POINTS)
+    return _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=False)
+
+
+@pn.cache(max_items=64)
+def dense_locus_result(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
+                       b_M: float) -> LocusResult:
+    """The dense sweep (LOCUS_DENSE_POINTS), denser where the coarse sweep's branches move fast
+    (:func:`refine_grid`); replaces the coarse one on screen."""
+    coarse = locus_result(params_path, rail, parameter, fixed, N0_kN, b_M)
+    shown = refine_grid(coarse.values, coarse.eigenvalues, LOCUS_DENSE_POINTS)
+    return _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=True)
+
+
+def _step_lengths(eigenvalues: np.ndarray, re_unit: float, im_unit: float) -> np.ndarray:
+    """(n_points - 1, n_branches) step lengths of the branches, Re counted in ``re_unit`` and
+    Im in ``im_unit`` [1/s]."""
+    steps = np.diff(eigenvalues, axis=0)
+    return np.hypot(steps.real / re_unit, steps.imag / im_unit)
+
+
+def _plot_shares(eigenvalues: np.ndarray) -> np.ndarray:
+    """Step lengths as shares of the plot: Re and Im divided by the sweep's spans of Re and Im
+    (the axes' extent when the whole sweep is shown)."""
+    finite = eigenvalues[np.isfinite(eigenvalues)]
+    spans = [np.ptp(part) if finite.size and np.ptp(part) > 0 else 1.0
+             for part in (finite.real, finite.imag)]
+    return _step_lengths(eigenvalues, *spans)
+
+
+def _plot_steps(eigenvalues: np.ndarray) -> np.ndarray:
+    """Step lengths in plot units (Re [1/s], Im [Hz])."""
+    return _step_lengths(eigenvalues, 1.0, 2 * math.pi)
+
+
+def refine_grid(values: np.ndarray, eigenvalues: np.ndarray, n_points: int) -> np.ndarray:
+    """``n_points`` parameter values from values[0] to values[-1], denser where the branches of
+    a coarse sweep (``eigenvalues`` at ``values``) move fast: each coarse interval gets a share
+    LOCUS_UNIFORM_SHARE / intervals of the points plus a share of the rest proportional to the
+    largest distance any branch travels across it on the plot (Re [1/s], Im [Hz])."""
+    values = np.asarray(values, dtype=float)
+    intervals = len(values) - 1
+    motion = np.nan_to_num(_plot_steps(eigenvalues).max(axis=1)) if eigenvalues.size else \
+        np.zeros(intervals)
+    weight = np.full(intervals, LOCUS_UNIFORM_SHARE / intervals)
+    if motion.sum() > 0:
+        weight += (1.0 - LOCUS_UNIFORM_SHARE) * motion / motion.sum()
+    else:
+        weight = np.full(intervals, 1.0 / intervals)
+    steps = np.maximum(1, np.floor(weight / weight.sum() * (n_points - 1)).astype(int))
+    while steps.sum() < n_points - 1:  # hand the rounding remainder to the busiest intervals
+        steps[np.argmax(weight / steps)] += 1
+    pieces = [np.linspace(values[i], values[i + 1], steps[i] + 1)[:-1] for i in range(intervals)]
+    return np.concatenate([*pieces, values[-1:]])
+
+
+def locus_jumps(values: np.ndarray, eigenvalues: np.ndarray) -> np.ndarray:
+    """Steps that are jumps (a branch meeting another one and turning, or moving faster than the
+    grid resolves): per unit of the swept parameter, more than LOCUS_JUMP_FACTOR times as fast
+    as in both neighbouring steps of the same branch, and longer than LOCUS_JUMP_MIN plot units
+    (Re [1/s], Im [Hz]); or longer than LOCUS_JUMP_LONG of the plot (Re and Im measured in
+    shares of the sweep's spans, as they appear on the plot) and more than LOCUS_JUMP_SIDE times
+    as fast as one of its neighbouring steps (a branch accelerating into a collision with
+    another one grows its steps geometrically, 10, 16, 50 [1/s], and no grid resolves the last
+    ones).  The plots break the line there instead of drawing a straight segment across the
+    plane; the points themselves stay."""
+    steps = _plot_steps(eigenvalues)
+    if len(steps) < 3:
+        return np.zeros(steps.shape, dtype=bool)
+    rate = steps / np.diff(np.asarray(values, dtype=float))[:, None]
+    before = np.vstack([rate[1:2], rate[:-1]])  # the first / last step: their only neighbour
+    after = np.vstack([rate[1:], rate[-2:-1]])
+    both = (rate > LOCUS_JUMP_FACTOR * np.maximum(before, after)) & (steps > LOCUS_JUMP_MIN)
+    one = (rate > LOCUS_JUMP_SIDE * np.minimum(before, after)) & \
+        (_plot_shares(eigenvalues) > LOCUS_JUMP_LONG)
+    return both | one
+
+
+def broken_columns(series: np.ndarray, jumps: np.ndarray | None) -> list[np.ndarray]:
+    """One float array per branch (column of ``series``, (n_points, n_branches) real) with NaN
+    inserted at its jumps: Bokeh breaks a line at NaN."""
+    out = []
+    for b in range(series.shape[1]):
+        y = np.asarray(series[:, b], dtype=float)
+        if jumps is not None and jumps[:, b].any():
+            y = np.insert(y, np.flatnonzero(jumps[:, b]) + 1, np.nan)
+        out.append(np.ascontiguousarray(y))
+    return out
+
+
+# --- short-circuit response --------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class ResponseView:
+    """Time histories of both drives, full resolution (CSV) and decimated (plots)."""
+
+    t: np.ndarray  # [s]
+    outputs: dict[str, np.ndarray]  # RESPONSE_OUTPUTS -> total value [N m or N]
+    M_C: np.ndarray  # short-circuit torque [N m]
+    peaks: dict[str, float]  # signed total of largest magnitude
+    peak_times: dict[str, float]  # [s]
+    units: dict[str, str]
+    M_ad: float  # [N m]
+    truncated_at: float | None  # [s]
+    crossings: list[tuple[str, str, float, float]]  # (output, limit name, time [s], value)
+    plot_cut: float | None = None  # plots end here [s]: a torque exceeded GROWTH_CUT x M_ad
+    # per series (outputs and "M_C"): (t [s], value), min/max-decimated, float32 for the browser
+    plot: dict[str, tuple[np.ndarray, np.ndarray]] = field(repr=False, default=None)
+
+
+def decimate(t: np.ndarray, ys: list[np.ndarray], buckets: int = PLOT_BUCKETS):
+    """Min/max decimation for plotting: keeps every extreme (peaks stay visible).  The samples
+    are cut into ``buckets`` runs of equal length; each run keeps its first sample and, of every
+    series, its largest and smallest."""
+    n = len(t)
+    if n <= 2 * buckets:
+        return t, ys
+    size = -(-n // buckets)
+    runs = -(-n // size)
+    starts = np.arange(runs) * size
+    picks = [starts, [n - 1]]
+    for y in ys:
+        padded = np.concatenate([y, np.full(runs * size - n, y[-1])]).reshape(runs, size)
+        picks.append(starts + padded.argmax(axis=1))
+        picks.append(starts + padded.argmin(axis=1))
+    index = np.unique(np.minimum(np.concatenate(picks), n - 1))
+    return t[index], [y[index] for y in ys]
+
+
+@pn.cache(max_items=64)
+def response_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                    b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
+                    t_end: float) -> ResponseView:
+    """Short-circuit response of both drives (model.analysis.response)."""
+    from model.analysis.response import ShortCircuit, short_circuit_response
+
+    m = model(params_path, rail)
+    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
+    excitation = ShortCircuit(M0=float(M0_kNm) * 1e3, f=float(f), D=float(D),
+                              dt=None if dt_ms is None else float(dt_ms) * 1e-3)
+    fs = max(RESPONSE_FS, 20.0 * float(f))
+    r = short_circuit_response(m, op, excitation, t_end=float(t_end), fs=fs,
+                               outputs=list(RESPONSE_OUTPUTS))
+    outputs = {name: np.asarray(r.outputs[name]) for name in RESPONSE_OUTPUTS}
+    M_ad = float(r.limits["M_ad"])
+    # plots stop where a torque grows beyond GROWTH_CUT x M_ad (unstable: exponential growth
+    # would flatten everything before it); the CSV keeps the whole history
+    torques = np.array([np.abs(outputs[n]) for n in RESPONSE_OUTPUTS if n.endswith("torque")])
+    beyond = np.flatnonzero(torques.max(axis=0) > GROWTH_CUT * M_ad)
+    stop = int(beyond[0]) + 1 if len(beyond) else len(r.t)
+    plot = {}
+    for name, y in [*outputs.items(), ("M_C", r.M_C)]:
+        td, (yd,) = decimate(r.t[:stop], [y[:stop]])
+        plot[name] = (td.astype(np.float32), yd.astype(np.float32))
+    return ResponseView(
+        t=r.t, outputs=outputs, M_C=np.asarray(r.M_C),
+        peaks={k: float(r.peaks[k]) for k in RESPONSE_OUTPUTS},
+        peak_times={k: float(r.peak_times[k]) for k in RESPONSE_OUTPUTS},
+        units={k: r.units[k] for k in RESPONSE_OUTPUTS}, M_ad=M_ad,
+        plot_cut=float(r.t[stop - 1]) if stop < len(r.t) else None,
+        truncated_at=r.truncated_at,
+        crossings=[(c.output, c.limit_name, c.time, c.value) for c in r.limit_crossings
+                   if c.output in outputs],
+        plot=plot)

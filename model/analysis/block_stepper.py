@@ -1,0 +1,285 @@
+"""Step loop of :mod:`model.analysis.nonlinear` in numpy and scipy (see that module's docstring for the
+scheme): the creep remainders of a whole block of steps are solved together.
+
+Within a block of ``L`` steps (``L ≤ SUB_STEPS``), the channel values (the four contact
+velocities and ID2's slope torque) are linear in the block's unknown remainders r:
+
+    z = a + T r(z),        a_i = Re(W ζ⁻_i) without the block's remainders,
+                           T = block lower-triangular Toeplitz:  D1 on the diagonal,
+                               Re(W E^(l−1) Q) l steps below (Q = diag(E) P1 + P0),
+
+because the modal state obeys ``ζ⁻_{i+1} = E ζ⁻_i + F_i + Q r_i`` (the end-of-step input of step
+i folded into step i+1; ``ζ_i = ζ⁻_i + P1 r_i``).  The 5L equations are solved by Newton with the
+Jacobian ``T diag(r') − I`` less the within-step coupling between channels (≈ 10⁻⁸ of the
+diagonal, measured; the residual keeps it, so the solution is that of the coupled equations):
+that Jacobian is lower triangular, one ``solve_triangular`` per iteration, and the creep law is
+evaluated on all 4L contact values at once.  What stays per step in Python is one vectorised
+O(modes) recurrence (the block's forced state).  The outputs y = Re(V ζ) are formed the same way
+as the channels: ``y = Re(V ζ_forced) + T_V r`` with the Toeplitz ``T_V`` of V (``Re(V P1)`` on the
+diagonal, ``Re(V E^(l−1) Q)`` below), and the state carried to the next block is the block's last
+one only (``ζ_(L−1) = ζ_forced,(L−1) + Σ_j E^(L−2−j) Q r_j + P1 r_(L−1)``): the modal states of
+the steps inside a block are never formed.
+
+A block that does not converge is halved (down to one step, the plain one-step implicit
+scheme); a block in which the anti-slip protection trips is cut where the torque reduction
+starts (it depends on the detection time) and the next block starts there.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.linalg import get_lapack_funcs
+
+SUB_STEPS = 32  # steps solved together
+TOLERANCE = 1e-12  # relative change of the channel values at which Newton stops
+MAX_ITERATIONS = 40  # per block before it is halved
+
+
+def polach(s: np.ndarray, v: float, mu0: float, A: float, B: float, kA: float, kS: float,
+           slope: float) -> tuple[np.ndarray, np.ndarray]:
+    """Polach's μ(s, v) [-] and ∂μ/∂s [-] (as :class:`model.contact.creep.PolachLaw`: odd in s,
+    friction falling with the slip velocity |s|·v [m/s])."""
+    Bv = B * v
+    decay = np.exp(-Bv * np.abs(s))
+    c1 = mu0 * (1.0 - A)
+    mu_f = c1 * decay + mu0 * A
+    dmu_f = np.copysign(decay, s)  # sign(s)·decay; at s = 0 its factor F is 0 either way
+    dmu_f *= -c1 * Bv
+    inverse = 1.0 / mu_f
+    eps = (slope * s) * inverse
+    deps = (slope - eps * dmu_f) * inverse
+    a = kA * eps
+    k = kS * eps
+    a2 = a * a
+    aa = 1.0 + a2
+    F = a / aa + np.arctan(k)
+    dF = kA * (1.0 - a2) / (aa * aa) + kS / (1.0 + k * k)
+    c = 2.0 / math.pi
+    return c * mu_f * F, c * (dmu_f * F + mu_f * dF * deps)
+
+
+def _toeplitz(W: np.ndarray, E: np.ndarray, Q: np.ndarray, D1: np.ndarray, L: int) -> np.ndarray:
+    """T (L·rows x L·nc): row block i, column block j holds D1 (i = j) or Re(W E^(i−j−1) Q)
+    (W: rows x m, Q: m x nc, D1: rows x nc)."""
+    rows, nc = W.shape[0], Q.shape[1]
+    powers = E[None, :] ** np.arange(L - 1)[:, None]  # (L−1) x m
+    lags = np.einsum("cm,lm,md->lcd", W, powers, Q).real  # (L−1) x rows x nc
+    T = np.zeros((L, rows, L, nc))
+    for i in range(L):
+        T[i, :, i, :] = D1
+        for j in range(i):
+            T[i, :, j, :] = lags[i - j - 1]
+    return T.reshape(L * rows, L * nc)
+
+
+class _Blocks:
+    """The matrices of one step loop, built once per run (≈ 4 ms): the channels' Toeplitz T and
+    its triangular part for Newton, the outputs' Toeplitz T_V, the powers of E and the index
+    patterns of a block."""
+
+    def __init__(self, W, E, Q, D1, P1, V, creep):
+        self.Q, self.P1 = Q, P1
+        self.channels = nc = W.shape[0]
+        self.creep = creep  # channels: creep (True) or ID2's slope torque
+        self.rows_out = V.shape[0]
+        self.full = _toeplitz(W, E, Q, D1, SUB_STEPS)
+        # the Newton matrix's part: T without the within-step coupling between channels
+        self.triangular = np.tril(self.full)
+        for i in range(SUB_STEPS):
+            block = self.triangular[i * nc:(i + 1) * nc, i * nc:(i + 1) * nc]
+            block[np.triu_indices(nc, 1)] = 0.0  # np.tril kept the lower part of D1 only
+            block[np.tril_indices(nc, -1)] = 0.0
+        self.outputs = _toeplitz(V, E, Q, (V @ P1).real, SUB_STEPS)
+        self.projection = np.ascontiguousarray(np.vstack([W, V]).T)  # m x (nc + outputs)
+        self.powers = E[None, :] ** np.arange(SUB_STEPS)[:, None]  # E^k, k = 0 … L−1
+        self.doubling = [E]  # E^(2^k) for the doubling scan
+        while 2 ** len(self.doubling) < SUB_STEPS:
+            self.doubling.append(self.doubling[-1] * self.doubling[-1])
+        self.is_creep = np.tile(creep, SUB_STEPS)
+        self.trtrs = get_lapack_funcs("trtrs", (self.triangular,))
+        self._newton: dict[int, np.ndarray] = {}
+
+    def newton_matrix(self, L: int, slopes: np.ndarray) -> np.ndarray:
+        """Newton's Jacobian T_triangular diag(r') − I of the first L steps, in a buffer of the
+        run (overwritten by the next call)."""
+        n = L * self.channels
+        J = self._newton.get(L)
+        if J is None:
+            J = self._newton[L] = np.empty((n, n))
+        np.multiply(self.triangular[:n, :n], slopes[None, :], out=J)
+        J.flat[::n + 1] -= 1.0
+        return J
+
+
+def step_matrices(W, E, P0, P1, D1, V, n_creep) -> _Blocks:
+    """The matrices of a run's step loop (Q = diag(E) P1 + P0; V: outputs x m, y = Re(V ζ);
+    the first ``n_creep`` of the channels are creep channels), built once per run and passed to
+    every :func:`march` call of it (one per output block of 2 048 steps)."""
+    return _Blocks(W, E, E[:, None] * P1 + P0, D1, P1, V, np.arange(W.shape[0]) < n_creep)
+
+
+def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, p0_2, p1_2,
+          contact_scale, law_params, s0, v, N0, mu_s0, dmu_s0, tangent,
+          detect_rows, threshold, det_state, M_step, delay, rate, floor, Y_out, z_out,
+          phi_out, u2_out, iterations, blocks):
+    """Steps k0 → k1 (exclusive of k0's state, which is given).  Writes the outputs Re(V ζ)
+    (``blocks``' V), contact velocities, remainder forces and ΔM_2 of steps k0+1 … k1 into rows
+    0 … of ``Y_out``, ``z_out``, ``phi_out``, ``u2_out``; updates zeta, phi, z, u2_now, det_state
+    in place; ``blocks``: the run's :func:`step_matrices`.  Returns 0, or the step at which Newton
+    failed (negative)."""
+    nc = z.shape[0]
+    law = tuple(float(x) for x in law_params)
+    creep = blocks.creep
+    detect = np.asarray(detect_rows, dtype=float)
+    scale = float(contact_scale)
+    slope = np.zeros(nc)  # r'(z) of the given step (Newton's start of the first block)
+    if not tangent:
+        slope[creep] = N0 / v * (polach(s0 + z[creep] / v, v, *law)[1] - dmu_s0)
+    state = _LoopState(zeta.copy(), phi.copy(), z.copy(), float(u2_now), float(det_state[0]),
+                       slope)
+    basis = np.vstack([cp, cm, p0_2, p1_2]).astype(complex)  # 4 x m
+    row, L = 0, SUB_STEPS
+    while row < k1 - k0:
+        L = min(L, k1 - k0 - row)
+        done = _block(state, k0 + row, L, row, h, blocks, E, inc_step, basis, g_step, g0, P0,
+                      law, s0, v, N0, mu_s0, dmu_s0, tangent, creep, detect, threshold, M_step,
+                      delay, rate, floor, scale, Y_out, z_out, phi_out, u2_out, iterations)
+        if done == 0:
+            if L == 1:
+                return -(k0 + row + 1)
+            L = max(1, L // 2)  # not converged: a shorter block
+            continue
+        row += done
+        L = SUB_STEPS
+    zeta[:], phi[:], z[:] = state.zeta, state.phi, state.z
+    det_state[0] = state.detection
+    return 0
+
+
+def _recurrence(doubling: list[np.ndarray], f: np.ndarray) -> np.ndarray:
+    """x_i = E x_(i−1) + f_i (x_(−1) = 0) for all rows i of f at once, in place: a doubling scan
+    (after the round with shift d, row i holds the sum over f_(i−2d+1 … i)), log2(rows)
+    vectorised rounds instead of a Python step per row; ``doubling``: E, E², E⁴, …"""
+    d = 1
+    for power in doubling:
+        if d >= len(f):
+            break
+        f[d:] += power * f[:-d]
+        d *= 2
+    return f
+
+
+class _LoopState:
+    """What carries over from one block to the next (the last accepted step)."""
+
+    def __init__(self, zeta, phi, z, u2, detection, slope):
+        self.zeta = zeta  # modal state ζ (after the step's end input)
+        self.phi = phi  # remainders r of the step [N] / slope torque change [N m]
+        self.z = z  # channel values of the step
+        self.u2 = u2  # ΔM_2 at the step [N m]
+        self.detection = detection  # detection time [s], < 0: not yet
+        self.slope = slope  # r'(z) of the creep channels at the step [N s/m]
+
+
+def _block(state, kb, L, row0, h, blocks, E, inc_step, basis, g_step, g0, P0, law, s0, v, N0,
+           mu_s0, dmu_s0, tangent, creep, detect, threshold, M_step, delay, rate, floor, scale,
+           Y_out, z_out, phi_out, u2_out, iterations) -> int:
+    """Solve steps kb+1 … kb+L from ``state``; returns the number of accepted steps (0: Newton
+    did not converge) and advances ``state`` to the last of them."""
+    nc = state.z.shape[0]
+    t1 = (kb + 1 + np.arange(L)) * h  # ends of the steps
+    # ΔM_2 and the slope channel's scaling ρ at the end of each step (detection known so far)
+    reduction = np.zeros(L)
+    if state.detection >= 0.0:
+        reduction = (1.0 - floor) * np.clip(rate * (t1 - state.detection - delay), 0.0, 1.0)
+    u2 = -M_step * reduction
+    u2_before = np.concatenate([[state.u2], u2[:-1]])
+    # forced modal states without the block's remainders: b_0 = E ζ + F + P0 φ, b_(i+1) = E b_i + …
+    inputs = np.empty((L, 4), dtype=complex)  # the weights of cp, cm, p0_2, p1_2 (``basis``)
+    inputs[:, 0] = g0 * np.power(complex(g_step), np.arange(kb, kb + L))
+    inputs[:, 1] = inputs[:, 0].conj()
+    inputs[:, 2] = u2_before
+    inputs[:, 3] = u2
+    forcing = inputs @ basis
+    forcing += inc_step
+    forcing[0] += E * state.zeta + P0 @ state.phi
+    forced = _recurrence(blocks.doubling, forcing)
+    projected = (forced @ blocks.projection).real  # L x (channels, outputs)
+    a = projected[:, :nc].reshape(-1)  # L·nc
+    T = blocks.full[:L * nc, :L * nc]
+    is_creep = blocks.is_creep[:L * nc]
+    slope_scale = -np.repeat(reduction, nc)[~is_creep]
+    dr = np.zeros(L * nc)
+    dr[~is_creep] = slope_scale
+    tangent_slope = N0 * dmu_s0 / v
+    trtrs = blocks.trtrs
+    # Newton's start: the block solved with the remainders linearized about the last step,
+    # r ≈ r_last + r'_last (z − z_last) (one triangular solve, no evaluation of the law)
+    dr[is_creep] = np.tile(state.slope[creep], L)
+    offset = np.tile(state.phi - state.slope * state.z, L)
+    offset[~is_creep] = 0.0
+    zf, info = trtrs(blocks.newton_matrix(L, dr), -(a + T @ offset), lower=1)
+    if info != 0:
+        return 0
+    r = np.empty(L * nc)
+    count = 0
+    while True:
+        zc = zf[is_creep]
+        if tangent:
+            r[is_creep] = N0 * ((mu_s0 + dmu_s0 * (zc / v)) - mu_s0) - tangent_slope * zc
+        else:
+            mu_v, dmu_v = polach(s0 + zc / v, v, *law)
+            r[is_creep] = N0 * (mu_v - mu_s0) - tangent_slope * zc
+            dr[is_creep] = N0 / v * (dmu_v - dmu_s0)
+        r[~is_creep] = slope_scale * zf[~is_creep]
+        residual = a + T @ r - zf
+        step, info = trtrs(blocks.newton_matrix(L, dr), residual, lower=1)
+        if info != 0:
+            return 0
+        zf = zf - step
+        r = r - dr * step  # the remainders at the new values to first order (O(step²) ≈ 1e-24)
+        count += 1
+        change = float(np.max(np.abs(step) / (np.abs(zf) + scale)))
+        if not math.isfinite(change):
+            return 0
+        if change <= TOLERANCE:
+            break
+        if count >= MAX_ITERATIONS:
+            return 0
+    zb = zf.reshape(L, nc)
+    rb = r.reshape(L, nc)
+    # detection on ID2's wheelset slip velocity (mean of its wheels); the block is cut where the
+    # torque reduction that follows from it starts
+    accepted = L
+    if state.detection < 0.0:
+        slip = zb @ detect
+        over = np.flatnonzero(np.abs(slip) > threshold)
+        if len(over):
+            i = int(over[0])
+            before = abs(float(state.z @ detect)) if i == 0 else abs(float(slip[i - 1]))
+            fraction = (threshold - before) / (abs(slip[i]) - before) if before < threshold else 0.0
+            state.detection = float(t1[i] - h + h * min(1.0, max(0.0, fraction)))
+            late = np.flatnonzero(t1[i + 1:] > state.detection + delay)
+            if len(late):
+                accepted = i + 1 + int(late[0])
+    # outputs with the remainders: y_i = Re(V ζ_forced,i) + Σ_j Re(V E^(i−1−j) Q) r_j + Re(V P1) r_i;
+    # the last state: ζ_(n−1) = ζ_forced,(n−1) + Σ_(j < n−1) E^(n−2−j) Q r_j + P1 r_(n−1)
+    n_out = blocks.rows_out
+    Y_out[row0:row0 + accepted] = projected[:accepted, nc:] + (
+        blocks.outputs[:accepted * n_out, :accepted * nc] @ r[:accepted * nc]).reshape(accepted, n_out)
+    last = forced[accepted - 1] + blocks.P1 @ rb[accepted - 1]
+    if accepted > 1:
+        weights = blocks.powers[accepted - 2::-1].T @ rb[:accepted - 1]  # m x nc
+        last += (blocks.Q * weights).sum(axis=1)
+    z_out[row0:row0 + accepted] = zb[:accepted]
+    phi_out[row0:row0 + accepted] = rb[:accepted]
+    u2_out[row0:row0 + accepted] = u2[:accepted]
+    state.zeta = last
+    state.phi = rb[accepted - 1].copy()
+    state.slope = np.where(creep, dr.reshape(L, nc)[accepted - 1], 0.0)
+    state.z = zb[accepted - 1].copy()
+    state.u2 = float(u2[accepted - 1])
+    iterations[0] += count * accepted  # every accepted step took part in `count` iterations
+    return accepted

@@ -1,0 +1,149 @@
+"""Eigenvalues and stability of the linearized bogie (eqs. 21–22 in first-order form).
+
+State ``u = [Δq; Δq̇]``, ``u̇ = A u`` with ``A = [[0, I], [−M⁻¹K, −M⁻¹B_total]]``.  The rigid-body
+zero eigenvalues are *identified*, not guessed: every vector ``r`` with ``K r = 0`` (the rigid spin
+of each whole drivetrain, known from the kinematics and checked against K) gives the exact
+eigenpair ``(0, [r; 0])`` whatever the damping, and the invariant subspace they span is deflated
+before the eigenvalues of the rest are computed (:mod:`model.analysis.linear_system`).  The decomposition
+with vectors is shared with the short-circuit response through :func:`bogie_system`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg as sla
+
+from model.analysis.linear_system import LinearSystem, SystemCache
+from model.mechanics.assembly import BogieModel
+from model.mechanics.operating_point import OperatingPoint, damping_matrix
+
+
+@dataclass
+class StateSpace:
+    """Constant pieces of the first-order form, computed once per model."""
+
+    model: BogieModel
+
+    @cached_property
+    def inverse_mass(self) -> np.ndarray:
+        n = self.model.n
+        return sla.cho_solve(sla.cho_factor(self.model.M), np.eye(n))
+
+    def system(self, B_total: np.ndarray) -> LinearSystem:
+        """The first-order form with damping ``B_total`` (input: M_C, as :func:`bogie_system`)."""
+        m = self.model
+        return LinearSystem(m.M, B_total, m.K, m.short_circuit_force, m.rigid_body_modes,
+                            self.inverse_mass)
+
+    def state_matrix(self, B_total: np.ndarray) -> np.ndarray:
+        """A (2n x 2n) with damping ``B_total`` [1/s and 1/s² blocks]."""
+        return self.system(B_total).A
+
+
+def state_space(model: BogieModel) -> StateSpace:
+    """The (cached) first-order pieces of a model."""
+    cache = model.__dict__.setdefault("_state_space", None)
+    if cache is None:
+        cache = StateSpace(model)
+        model.__dict__["_state_space"] = cache
+    return cache
+
+
+def state_matrix(model: BogieModel, op: OperatingPoint) -> np.ndarray:
+    """A (2n x 2n) at an operating point [1/s and 1/s² blocks]."""
+    return state_space(model).state_matrix(damping_matrix(model, op))
+
+
+@dataclass(frozen=True)
+class EigenResult:
+    """All eigenvalues at an operating point.  Re in 1/s; ``im_hz`` = Im/(2π) in Hz."""
+
+    operating_point: OperatingPoint
+    eigenvalues: np.ndarray  # the 2n − n_rigid non-rigid eigenvalues [1/s], unsorted
+    vectors: np.ndarray | None  # state eigenvectors (2n x len(eigenvalues)), [Δq; Δq̇]
+    n_rigid: int  # identified rigid-body zero eigenvalues
+
+    @property
+    def complex_index(self) -> np.ndarray:
+        """Indices of complex eigenvalues with Im > 0, by ascending Im."""
+        idx = np.flatnonzero(self.eigenvalues.imag > 0)
+        return idx[np.argsort(self.eigenvalues.imag[idx], kind="stable")]
+
+    @property
+    def real_index(self) -> np.ndarray:
+        """Indices of real eigenvalues, from the largest down."""
+        idx = np.flatnonzero(self.eigenvalues.imag == 0)
+        return idx[np.argsort(-self.eigenvalues.real[idx], kind="stable")]
+
+    @property
+    def complex_pairs(self) -> np.ndarray:
+        """Upper-half complex eigenvalues sorted by imaginary part [1/s]."""
+        return self.eigenvalues[self.complex_index]
+
+    @property
+    def real(self) -> np.ndarray:
+        """Real eigenvalues from the largest down [1/s]."""
+        return self.eigenvalues.real[self.real_index]
+
+    @property
+    def max_real_part(self) -> float:
+        return float(self.eigenvalues.real.max())
+
+    @property
+    def flutter(self) -> int:
+        """Number of unstable complex pairs."""
+        return int(np.count_nonzero(self.complex_pairs.real > 0))
+
+    @property
+    def divergence(self) -> int:
+        """Number of positive real eigenvalues."""
+        return int(np.count_nonzero(self.real > 0))
+
+    @property
+    def stable(self) -> bool:
+        return self.max_real_part <= 0.0
+
+    def mode_shape(self, index: int) -> np.ndarray:
+        """Displacement part Δq of eigenvector ``index``, scaled to unit largest entry."""
+        if self.vectors is None:
+            raise ValueError("eigenvectors were not computed")
+        n = self.vectors.shape[0] // 2
+        q = self.vectors[:n, index]
+        return q / q[np.argmax(np.abs(q))]
+
+
+def bogie_system(model: BogieModel, op: OperatingPoint, cached: bool = True) -> LinearSystem:
+    """The bogie at ``op`` as a :class:`LinearSystem` (input: the short-circuit torque M_C on
+    ID1's rotor and stator).  ``cached``: kept with the last few operating points of the model, so
+    that the eigen-analysis and the response at one point share one eigendecomposition."""
+    def build() -> LinearSystem:
+        return state_space(model).system(damping_matrix(model, op))
+    if not cached:
+        return build()
+    cache = model.__dict__.setdefault("_systems", SystemCache())
+    return cache.get(op, build)
+
+
+def forget_systems(model: BogieModel) -> None:
+    """Drop the cached per-operating-point systems of ``model`` (cold timings in benchmarks)."""
+    model.__dict__.pop("_systems", None)
+
+
+def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) -> EigenResult:
+    """All eigenvalues (and eigenvectors) at ``op`` with the rigid-body ones deflated.
+
+    With ``vectors`` the decomposition is cached for the operating point (the response reuses
+    it); without, a point already decomposed is not decomposed again, and a new one is not kept
+    (root finding and sweeps would only evict the points the user is looking at)."""
+    n_rigid = model.rigid_body_modes.shape[1]
+    if not vectors:
+        cache = model.__dict__.get("_systems")
+        system = cache.peek(op) if cache is not None else None
+        if system is None:
+            system = bogie_system(model, op, cached=False)
+        return EigenResult(op, system.eigenvalues(), None, n_rigid)
+    system = bogie_system(model, op)
+    return EigenResult(op, system.eigen[0], system.state_vectors(), n_rigid)

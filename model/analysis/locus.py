@@ -1,0 +1,376 @@
+"""Root locus over creepage s0 or speed v, with branches tracked by eigenvector similarity (MAC).
+
+Method — a reduced model whose error is estimated at every point and bounded by dense checks:
+
+1. Along a sweep only ``B_ad`` changes, a combination of four fixed patterns,
+   ``B_ad = b11 P11 + b22 P22 + b23 P23 + b33 P33`` (:func:`creep_patterns`).
+2. The displacement space is reduced to ``Φ`` = orthonormal basis of the rigid-body modes and the
+   real and imaginary parts of the exact eigenvectors (displacement part) of all eigenvalues with
+   |λ| < 2π f_max at the first and the last point of the sweep.  The second-order structure is
+   kept: ``Φᵀ M Φ``, ``Φᵀ K Φ``, ``Φᵀ (B + b_M B_M) Φ`` and ``Φᵀ P_k Φ`` are formed once, so a point
+   costs one small eigenproblem (Galerkin projection of eq. 20).
+3. At every point each tracked Ritz pair's residual in the *full* model,
+   ``r = (λ² M + λ B_total + K) Φ x``, gives a first-order error estimate
+   ``|δλ| ≈ ‖r‖ / ‖(2λ M + B_total) Φ x‖`` (conservative here: the measured errors are 10–30 times
+   smaller).  The tolerance is enforced for branches inside the disc |λ| < 1.5·2π f_max (a heavily
+   damped branch that leaves it is still tracked and its estimate recorded).  Where the estimate
+   exceeds ``rtol·|λ|`` for a few branches, those are refined by Newton's method on the full
+   model (quadratic convergence; the last step size is the recorded error); where it fails for
+   many, or the MAC tracking is ambiguous, the point is solved densely (exact there).
+   The reduced eigenproblems of the inner points are independent of each other and are solved
+   first, on ``workers`` threads; tracking and error control then run through them in order.
+   The start of a sweep (the exact end points, the basis and the projected matrices) and the
+   reduced solutions of a short sweep are kept (:class:`_SweepStart`, a few per process): a
+   denser sweep over the same range — the dashboard's dense locus after its coarse one — reuses
+   them and solves only its new points (same basis, so bitwise the same values where both have
+   a point).
+4. Branches are continued from point to point by an optimal assignment on ``1 − MAC`` plus the
+   normalized eigenvalue distance, so branches do not swap at near-crossings.
+
+The naive reference (:func:`dense_generalized_eigenvalues`) solves the generalized eigenproblem
+(21)–(22) densely at a point; ``scripts/bench_locus.py`` compares both.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from collections import OrderedDict
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import linear_sum_assignment
+
+from model.analysis.eigen import eigen_analysis
+from model.contact.creep import creep_block
+from model.mechanics.assembly import BogieModel
+from model.mechanics.operating_point import OperatingPoint, creep_coefficients, damping_matrix
+
+
+@dataclass(frozen=True)
+class RootLocus:
+    """Tracked eigenvalues along a parameter sweep."""
+
+    parameter: str  # "s0" [-] or "v" [m/s]
+    values: np.ndarray  # (n_points,) parameter values, SI
+    eigenvalues: np.ndarray  # (n_points, n_branches) complex [1/s]; column = one tracked branch
+    error_estimate: np.ndarray  # (n_points, n_branches) estimated relative error (0: exact)
+    dense_points: np.ndarray  # (n_points,) bool: solved densely (exact) at that point
+    operating_point: OperatingPoint  # the fixed quantities of the sweep
+    basis_size: int  # columns of the reduction basis Φ
+    newton_refinements: int  # branch-points refined by Newton's method on the full model
+
+    @property
+    def max_real_part(self) -> np.ndarray:
+        """Largest real part of the tracked branches at each point [1/s]."""
+        return self.eigenvalues.real.max(axis=1)
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Tracked branches all in the closed left half-plane, per point."""
+        return self.max_real_part <= 0.0
+
+    @property
+    def upper_branches(self) -> np.ndarray:
+        """Indices of branches with Im ≥ 0 at the first point (one of each conjugate pair)."""
+        return np.flatnonzero(self.eigenvalues[0].imag >= 0)
+
+
+def creep_patterns(model: BogieModel) -> list[np.ndarray]:
+    """The four n x n patterns P11, P22, P23, P33 of B_ad (coefficient 1 each)."""
+    r0 = model.parameters["wheel_radius"]
+    patterns = []
+    for unit in np.eye(4):
+        block = creep_block(*unit, r0=r0)
+        P = np.zeros((model.n, model.n))
+        for index in model.rims.values():
+            P[np.ix_(index, index)] += block
+        patterns.append(P)
+    return patterns
+
+
+def _coefficients(model: BogieModel, op: OperatingPoint) -> np.ndarray:
+    cc = creep_coefficients(model.parameters, op)
+    return np.array([cc.b11, cc.b22, cc.b23, cc.b33])
+
+
+class _Reduced:
+    """Projected matrices of the sweep on a basis Φ."""
+
+    def __init__(self, model: BogieModel, op: OperatingPoint, patterns, vectors: list[np.ndarray]):
+        U, s, _ = np.linalg.svd(np.hstack(vectors), full_matrices=False)
+        Phi = U[:, s > 1e-12 * s[0]]
+        self.Phi = Phi
+        self.M_Phi = model.M @ Phi
+        self.K_Phi = model.K @ Phi
+        C0 = model.B + op.b_M * model.motor_pattern
+        self.C0_Phi = C0 @ Phi
+        self.P_Phi = [P @ Phi for P in patterns]
+        # mass-normalize the reduced coordinates: Φᵀ M Φ = L Lᵀ
+        L = np.linalg.cholesky(Phi.T @ self.M_Phi)
+        self.Linv = sla.solve_triangular(L, np.eye(len(L)), lower=True)
+        project = lambda X: self.Linv @ (Phi.T @ X) @ self.Linv.T  # noqa: E731
+        self.K_r = project(self.K_Phi)
+        self.C0_r = project(self.C0_Phi)
+        self.P_r = [project(P) for P in self.P_Phi]
+
+    @property
+    def size(self) -> int:
+        return self.Phi.shape[1]
+
+    def solve(self, c: np.ndarray):
+        """Ritz values and displacement vectors (Φ coordinates, unit norm) at coefficients c."""
+        r = self.size
+        C = self.C0_r + sum(ck * Pk for ck, Pk in zip(c, self.P_r, strict=True))
+        A = np.zeros((2 * r, 2 * r))
+        A[:r, r:] = np.eye(r)
+        A[r:, :r] = -self.K_r
+        A[r:, r:] = -C
+        lam, V = np.linalg.eig(A)  # numpy releases the GIL: the points run on several threads
+        X = self.Linv.T @ V[:r]  # back from mass-normalized to Φ coordinates
+        X /= np.linalg.norm(X, axis=0)
+        return lam, X
+
+    def damping_Phi(self, c: np.ndarray) -> np.ndarray:
+        """C(c) Φ: the full damping matrix at creep coefficients c times the basis [N s/m]."""
+        return self.C0_Phi + sum(ck * P for ck, P in zip(c, self.P_Phi, strict=True))
+
+    def error_estimate(self, c: np.ndarray, lam: np.ndarray, X: np.ndarray,
+                       C_Phi: np.ndarray | None = None) -> np.ndarray:
+        """First-order relative eigenvalue error from the full-model residual (``C_Phi``:
+        :meth:`damping_Phi` at c, if already formed)."""
+        if C_Phi is None:
+            C_Phi = self.damping_Phi(c)
+        CX = C_Phi @ X
+        MX = self.M_Phi @ X
+        residual = lam**2 * MX + lam * CX + self.K_Phi @ X
+        derivative = 2 * lam * MX + CX
+        return (np.linalg.norm(residual, axis=0) / np.linalg.norm(derivative, axis=0)
+                / np.maximum(np.abs(lam), 1e-300))
+
+
+@dataclass
+class _SweepStart:
+    """What a sweep over a range starts from: the exact end points (eigenvalues, unit
+    displacement vectors), the reduced model built on them, and reduced solutions by their
+    creep coefficients (those of the last short sweep over the range)."""
+
+    model: BogieModel
+    first: tuple[np.ndarray, np.ndarray]
+    last: tuple[np.ndarray, np.ndarray]
+    reduced: _Reduced
+    solutions: dict[bytes, tuple[np.ndarray, np.ndarray]]
+
+
+_SWEEP_STARTS: OrderedDict[tuple, _SweepStart] = OrderedDict()
+_SWEEP_STARTS_KEPT = 8  # sweep starts kept per process (≈ 5 MB each with 32 kept solutions)
+_SOLUTIONS_KEPT = 32  # a sweep with at most this many inner points keeps its solutions
+_SWEEP_STARTS_LOCK = threading.Lock()
+
+
+def _sweep_start_key(model: BogieModel, first: OperatingPoint, last: OperatingPoint,
+                     radius: float) -> tuple:
+    return (id(model), first, last, radius)
+
+
+def clear_sweep_starts() -> None:
+    """Forget the kept sweep starts (tests; the cache is bounded anyway)."""
+    with _SWEEP_STARTS_LOCK:
+        _SWEEP_STARTS.clear()
+
+
+_POOLS: dict[tuple[int, int], ThreadPoolExecutor] = {}
+_POOLS_LOCK = threading.Lock()
+
+
+def thread_niceness() -> int:
+    """The scheduling niceness of the calling thread (Linux schedules threads one by one; 0
+    where that is not available)."""
+    try:
+        return os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+    except (AttributeError, OSError):
+        return 0
+
+
+def set_thread_niceness(niceness: int) -> None:
+    try:
+        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), niceness)
+    except (AttributeError, OSError):
+        pass  # another OS, or not allowed: the threads keep the process's priority
+
+
+def _solver_pool(workers: int) -> ThreadPoolExecutor:
+    """A persistent pool of ``workers`` threads per process and per caller's niceness, shared by
+    all root loci (the dashboard computes many; no threads are created and torn down per call).
+    The threads run at the niceness of the thread that asks (a root locus the dashboard computes
+    in the background must not take the cores from the answer to the next change)."""
+    niceness = thread_niceness()
+    with _POOLS_LOCK:
+        if (workers, niceness) not in _POOLS:
+            _POOLS[workers, niceness] = ThreadPoolExecutor(
+                max_workers=workers, thread_name_prefix=f"bogie-locus-n{niceness}",
+                initializer=set_thread_niceness, initargs=(niceness,))
+        return _POOLS[workers, niceness]
+
+
+def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
+               max_frequency_hz: float = 20.0, rtol: float = 1e-6, workers: int = 2) -> RootLocus:
+    """Track the non-rigid eigenvalues with |λ| < 2π·max_frequency_hz (at the first value) while
+    ``parameter`` ("s0" [-] or "v" [m/s]) runs through ``values``; the other quantities of the
+    operating point ``op`` stay fixed.  ``workers`` threads solve the reduced eigenproblems
+    (default 2, the cores of the target machine).  A real eigenvalue inside the disc that meets a
+    real one outside it continues as one half of the new complex pair (the other half is not
+    tracked); pairs that start complex stay conjugate pairs."""
+    if parameter not in ("s0", "v"):
+        raise ValueError(f"parameter must be 's0' or 'v', got '{parameter}'")
+    values = np.asarray(values, dtype=float)
+    if values.ndim != 1 or len(values) < 2 or not np.all(np.isfinite(values)):
+        raise ValueError("need at least two finite parameter values")
+    points = [replace(op, **{parameter: float(x)}) for x in values]  # validates each point
+    coefficients = np.array([_coefficients(model, p) for p in points])
+    patterns = creep_patterns(model)
+    radius = 2 * np.pi * max_frequency_hz
+    controlled = 1.5 * radius  # accuracy is enforced for branches inside this disc
+    n, n_points = model.n, len(values)
+
+    def exact(i: int):
+        result = eigen_analysis(model, points[i])
+        q = result.vectors[:n]
+        return result.eigenvalues, q / np.linalg.norm(q, axis=0)
+
+    def modes(lam, Q):
+        chosen = Q[:, np.abs(lam) < radius]
+        return [chosen.real, chosen.imag]
+
+    key = _sweep_start_key(model, points[0], points[-1], radius)
+    with _SWEEP_STARTS_LOCK:
+        start = _SWEEP_STARTS.get(key)
+        if start is not None and start.model is model:
+            _SWEEP_STARTS.move_to_end(key)
+        else:
+            start = None
+    if start is None:
+        # the two exact end points at once (they decide the basis; numpy releases the GIL)
+        if workers > 1:
+            last_future = _solver_pool(workers).submit(exact, n_points - 1)
+            first = exact(0)
+            last = last_future.result()
+        else:
+            first, last = exact(0), exact(n_points - 1)
+        reduced = _Reduced(model, op, patterns,
+                           [model.rigid_body_modes, *modes(*first), *modes(*last)])
+        start = _SweepStart(model, first, last, reduced, {})
+    first, last, reduced = start.first, start.last, start.reduced
+    # the reduced eigenproblems of the inner points do not depend on each other: they are solved
+    # on ``workers`` threads (numpy's LAPACK calls release the GIL) while this thread tracks and
+    # checks the points in order as their solutions come in (tracking after all the solves left
+    # a core idle for ≈ 0.8 s of a 200-point sweep); a point the kept start has solved already
+    # is not solved again
+    inner = coefficients[1:-1]
+    keys = [c.tobytes() for c in inner]
+    missing = [i for i, k in enumerate(keys) if k not in start.solutions]
+    if workers > 1:
+        found = _solver_pool(workers).map(reduced.solve, inner[missing])  # in order, as solved
+    else:
+        found = (reduced.solve(c) for c in inner[missing])
+    unsolved = set(missing)
+    solutions: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def solution(i: int) -> tuple[np.ndarray, np.ndarray]:
+        """The reduced solution of inner point i (asked for in order)."""
+        solutions.append(next(found) if i in unsolved else start.solutions[keys[i]])
+        return solutions[i]
+
+    tracked = np.flatnonzero(np.abs(first[0]) < radius)
+    eigenvalues = np.zeros((n_points, len(tracked)), dtype=complex)
+    errors = np.zeros((n_points, len(tracked)))
+    dense = np.zeros(n_points, dtype=bool)
+    eigenvalues[0], dense[0] = first[0][tracked], True
+    previous_values, previous_vectors = first[0][tracked], first[1][:, tracked]
+    refined = 0
+
+    for i in range(1, n_points):
+        if i != n_points - 1:
+            lam, X = solution(i - 1)
+            X_full = reduced.Phi @ X
+            chosen, ok = _assign(previous_vectors, previous_values, X_full, lam)
+            estimate = reduced.error_estimate(coefficients[i], lam[chosen], X[:, chosen])
+            values_i, vectors_i = lam[chosen], X_full[:, chosen]
+            failing = np.flatnonzero((estimate > rtol) & (np.abs(values_i) < controlled))
+            if ok and len(failing) <= max(2, len(chosen) // 4):
+                # refine the few inaccurate branches by Newton's method in the full model
+                C = damping_matrix(model, points[i]) if len(failing) else None
+                for b in failing:
+                    values_i[b], vectors_i[:, b], estimate[b] = _newton(
+                        model.M, C, model.K, values_i[b], vectors_i[:, b], rtol)
+                if np.all((estimate <= rtol) | (np.abs(values_i) >= controlled)):
+                    refined += len(failing)
+                    eigenvalues[i], errors[i] = values_i, estimate
+                    previous_values, previous_vectors = values_i, vectors_i
+                    continue
+        lam, Q = last if i == n_points - 1 else exact(i)  # dense: exact at this point
+        chosen, _ = _assign(previous_vectors, previous_values, Q, lam)
+        eigenvalues[i], dense[i] = lam[chosen], True
+        previous_values, previous_vectors = lam[chosen], Q[:, chosen]
+    with _SWEEP_STARTS_LOCK:
+        if len(inner) <= _SOLUTIONS_KEPT:
+            start = _SweepStart(model, first, last, reduced, dict(zip(keys, solutions, strict=True)))
+        _SWEEP_STARTS[key] = start
+        _SWEEP_STARTS.move_to_end(key)
+        while len(_SWEEP_STARTS) > _SWEEP_STARTS_KEPT:
+            _SWEEP_STARTS.popitem(last=False)
+    return RootLocus(parameter, values, eigenvalues, errors, dense, op, reduced.size, refined)
+
+
+def _newton(M, C, K, lam: complex, x: np.ndarray, rtol: float, iterations: int = 6,
+            floor: float = 1e-300):
+    """Newton's method (nonlinear inverse iteration) for ``(λ² M + λ C + K) x = 0`` from a close
+    start; returns (λ, unit x, size of the last step relative to max(|λ|, ``floor``) [floor in
+    1/s]; the default measures it relative to |λ|)."""
+    return nonlinear_inverse_iteration(lambda lam: lam * lam * M + lam * C + K,
+                                       lambda lam: 2 * lam * M + C, lam, x, rtol, iterations,
+                                       floor)
+
+
+def nonlinear_inverse_iteration(matrix, derivative, lam: complex, x: np.ndarray, rtol: float,
+                                iterations: int = 6, floor: float = 1e-300):
+    """Newton's method for ``matrix(λ) x = 0`` (``derivative(λ)`` = d matrix / dλ, both square)
+    from a close start (λ [1/s], x); stops when a step is below 0.01·rtol relative to
+    max(|λ|, ``floor``).  Returns (λ, unit x, last step relative to max(|λ|, floor))."""
+    v = x.conj()
+    x = x / (v @ x)
+    step = np.inf
+    for _ in range(iterations):
+        u = sla.lu_solve(sla.lu_factor(matrix(lam), check_finite=False), derivative(lam) @ x,
+                         check_finite=False)
+        correction = (v @ x) / (v @ u)
+        lam = lam - correction
+        x = u / (v @ u)
+        step = abs(correction) / max(abs(lam), floor)
+        if step < 0.01 * rtol:
+            break
+    return lam, x / np.linalg.norm(x), step
+
+
+def _assign(previous_vectors, previous_values, vectors, values):
+    """Columns of ``vectors`` continuing each previous branch (MAC + eigenvalue distance)."""
+    mac = np.abs(previous_vectors.conj().T @ vectors) ** 2  # unit vectors: MAC in [0, 1]
+    scale = np.maximum(np.abs(previous_values), 1.0)[:, None]
+    distance = np.abs(previous_values[:, None] - values[None, :]) / scale
+    rows, columns = linear_sum_assignment((1 - mac) + distance)
+    chosen = np.empty(len(previous_values), dtype=int)
+    chosen[rows] = columns
+    # unambiguous: similar mode shape, or (for near-repeated twins of ID1/ID2, whose eigenvectors
+    # mix freely) an eigenvalue that moved by less than 5 % of its size
+    return chosen, bool(np.all((mac[rows, columns] > 0.5) | (distance[rows, columns] < 0.05)))
+
+
+def dense_generalized_eigenvalues(model: BogieModel, op: OperatingPoint) -> np.ndarray:
+    """All 2n eigenvalues of ``[λ N + P] u = 0`` (eqs. 21–22), dense QZ — the naive reference."""
+    n = model.n
+    Z = np.zeros((n, n))
+    N = np.block([[Z, model.M], [model.M, damping_matrix(model, op)]])
+    P = np.block([[-model.M, Z], [Z, model.K]])
+    return sla.eig(-P, N, right=False, check_finite=False)

@@ -1,0 +1,491 @@
+"""Nonlinear short-circuit response (spec §6): the longitudinal creep forces are the creep law
+itself, with an anti-slip protection on the healthy drive's motor torque.
+
+API::
+
+    from model.analysis.nonlinear import AntiSlip, nonlinear_response
+    r = nonlinear_response(model, op, ShortCircuit(), t_end=2.0, fs=10_000.0,
+                           creep="nonlinear", anti_slip=AntiSlip(delay=0.1))
+    r.outputs["ID2.disc_clutch.torque"]   # totals, the same names as the linear response [N m]
+    r.creepage["ID2.rim12"], r.slip_velocity[...], r.utilisation[...]   # per wheel
+    r.motor_torques["ID2.motor.torque"]    # after protection [N m]
+
+Equations.  With the creepage formed from the state (eq. 14), ``Δs_i v = H_i Δq̇`` (H: contacts
+x n, :func:`creep_velocity_map`), the longitudinal creep force at contact i is
+``T_i = N0 μ(s0 + Δs_i, v)`` and
+
+    M Δq̈ + B_nl Δq̇ + K Δq = f_mc M_C(t) + f_m2 ΔM_2(t) + G N0 [μ(s0 + H Δq̇/v) − μ(s0)]
+
+``B_nl`` = ``B + b_M B_M + B_ad`` without eq. 19's b11 terms (:func:`damping_without_longitudinal_
+creep`), ``G`` = ``−Hᵀ`` (n x contacts, :func:`creep_force_map`) puts a unit creep force on a rim
+(``e_x − r0 e_ry``), ``f_m2`` a unit driving torque of ID2's motor (rotor, stator reaction) and
+``ΔM_2(t)`` the anti-slip reduction of that torque.  With μ replaced by its tangent at s0 this is
+eq. 20 again: ``B + b_M B_M + B_ad = B_nl − G diag(N0 μ'(s0)/v) H``.  Kept linear as in the study:
+the lateral and spin creep forces (Kalker, eq. 9–10), the vertical wheel forces (N = N0 in the
+creep law; the track's m_R, b_R, k_R stay in M, B, K), the healthy motor's slope b_M.
+
+Method (exact linear part, implicit remainder). The equation is split at the tangent:
+
+    M Δq̈ + B_total Δq̇ + K Δq = f_mc M_C + f_m2 ΔM_2 + G r(H Δq̇),
+    r_i(z) = N0 [μ(s0 + z/v) − μ(s0)] − N0 μ'(s0) z/v        (zero with zero slope at z = 0)
+
+The linear part is the closed form's system (:func:`model.analysis.eigen.bogie_system`, the *same* cached
+eigendecomposition, rigid spins deflated) in its eigenbasis ``ζ``, stepped exactly: each mode by
+``e^(λh)``, the step and the damped sinusoid of M_C by their exact integrals over the step. The
+four remainder forces and ΔM_2 enter as piecewise-linear inputs (first-order hold; exact modal
+weights ``h(φ1 − φ2)``, ``h φ2``), and the remainder at the end of each step is solved implicitly
+from the four contact velocities ``z = H Δq̇`` by a Newton iteration (5 x 5 with the anti-slip
+channel below; the creep feedback is stiff: ``N0 μ'/v`` reaches 10⁶ N s/m on a rim of ≈ 200 kg).
+Why split at the tangent and not at ``B_nl``: without the b11 terms the drivetrain spins lose their
+only damping (a double zero eigenvalue, a Jordan block the modal basis cannot hold), the linear
+part would need its own eigendecomposition, and the whole creep feedback would carry the hold
+error; at the tangent the linear part is exact, the remainder is O(Δs²), and ``creep="tangent"`` (μ
+replaced by its tangent in the *same* loop: the remainder evaluates to rounding) reproduces the
+closed form to rounding. The loop is numpy and scipy (:mod:`model.analysis.block_stepper`): the
+remainders of a block of 32 steps are solved together by Newton with a triangular Jacobian (the
+creep law on all of the block's contact values at once), the block's forced modal states by a
+vectorised doubling scan, its outputs from them and the remainders by a Toeplitz matrix product
+(the modal states inside a block are never formed, only the last one, carried on). Every step
+the anti-slip logic sees the contact velocities (a block is cut where a reduction starts).
+
+Anti-slip protection (:class:`AntiSlip`): detection when the slip velocity of ID2's wheelset
+(mean of its two wheels) departs from its pre-fault value by more than ``threshold``, action
+``delay`` seconds later; then ID2's motor torque — the pre-fault M(s0, v) *and* its slope part
+``−b_M Δω`` (eq. 6), i.e. the whole characteristic — is scaled by ρ(t), which ramps from 1 at
+``rate`` (per second) down to ``floor``.  The slope part depends on the state, so ρ·(−b_M Δω) is
+solved with the creep forces in the same Newton iteration (a fifth channel).  ID1's motor is the
+one that short-circuited: its torque is the fault torque M_C(t) of its machine, which no converter
+controls, so the protection cannot act on it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from model.analysis.eigen import bogie_system
+from model.analysis.response import (
+    LIMITED,
+    MAX_POINTS,
+    LimitCrossing,
+    ResponseError,
+    ShortCircuit,
+    time_grid_points,
+)
+from model.mechanics.assembly import DRIVES, RIM_NODES, BogieModel
+from model.mechanics.operating_point import (
+    OperatingPoint,
+    adhesion_moment,
+    creep_coefficients,
+    creep_law,
+    longitudinal_creep_pattern,
+    motor_torque,
+)
+from model.mechanics.outputs import output_matrices
+
+CREEP_MODELS = ("nonlinear", "tangent")
+BLOCK_STEPS = 2048  # steps per compiled block (modal states of a block: ≈ 6 MB)
+NEWTON_TOL = 1e-12  # relative change of the contact velocities at which Newton stops
+NEWTON_MAX = 60
+
+
+class NonlinearError(ResponseError):
+    """Bad input for a nonlinear response (one-line message)."""
+
+
+# --- maps between the state and the contacts -------------------------------------------------------
+
+def creep_force_map(model: BogieModel) -> np.ndarray:
+    """G (n x contacts): generalized force of a unit longitudinal creep force (+x on the wheel at
+    the contact point) at each rim, in ``model.rims`` order [1 for x, m for ry]."""
+    return longitudinal_creep_pattern(model)
+
+
+def creep_velocity_map(model: BogieModel) -> np.ndarray:
+    """H (contacts x n): ``Δs_i v = H_i Δq̇``, the rim's slip velocity ``r0 ṙy − ẋ`` [m/s per unit
+    velocity]."""
+    return -longitudinal_creep_pattern(model).T
+
+
+def damping_without_longitudinal_creep(model: BogieModel, op: OperatingPoint) -> np.ndarray:
+    """B_nl = B + b_M B_M + B_ad without the b11 terms of eq. 19 (n x n) [N s/m, …]."""
+    from model.mechanics.operating_point import damping_matrix
+
+    G = creep_force_map(model)
+    b11 = creep_coefficients(model.parameters, op).b11
+    return damping_matrix(model, op) - b11 * (G @ G.T)
+
+
+def contact_names(model: BogieModel) -> list[str]:
+    """Names of the contacts (rims) in the order of G's columns and H's rows."""
+    return list(model.rims)
+
+
+# --- anti-slip protection -----------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class AntiSlip:
+    """Anti-slip protection of the healthy drive ID2 (see docs/nonlinear.md for the sources).
+
+    Defaults (assumptions, said as such in the docs):
+
+    * ``threshold = 0.3 m/s``: ≈ 1 km/h of extra slip speed of the wheelset, the order of the
+      slip-speed thresholds of wheel-slip detection in traction control (a few tenths of a m/s to a
+      few km/h); the pre-fault slip speed s0·v (0.17 m/s at s0 = 0.005, 0.47 m/s at 0.014,
+      120 km/h) is not counted.
+    * ``delay = 0.1 s``: the reaction time under study (the study: "within about 0.35 s").
+    * ``rate = 10 1/s``: the converter takes the full torque (characteristic) away in 0.1 s.
+    * ``floor = 0``: the torque is taken away completely (with ID1 failed, traction on that bogie is
+      cut) and held there for the rest of the run.
+    """
+
+    enabled: bool = True
+    delay: float = 0.1  # reaction delay τ after detection [s], ≥ 0
+    threshold: float = 0.3  # |Δ slip velocity| of ID2's wheelset that trips it [m/s], > 0
+    rate: float = 10.0  # torque reduction rate [fraction of M(s0, v) per s], > 0
+    floor: float = 0.0  # torque kept after the reduction [fraction of M(s0, v)], 0 ≤ floor < 1
+
+    def __post_init__(self) -> None:
+        checks = (("anti-slip delay (s)", self.delay, 0.0, 60.0, True, "in [0, 60] s"),
+                  ("anti-slip threshold (m/s)", self.threshold, 0.0, 100.0, False,
+                   "> 0 and at most 100 m/s"),
+                  ("anti-slip rate (1/s)", self.rate, 0.0, 1e6, False, "> 0 and at most 1e6 1/s"),
+                  ("anti-slip floor", self.floor, 0.0, 1.0, True, "in [0, 1)"))
+        for label, value, low, high, closed_low, allowed in checks:
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise NonlinearError(f"{label} must be a number, got {value!r}")
+            ok = (low <= value if closed_low else low < value) and value <= high
+            if label.endswith("floor") and value >= 1.0:
+                ok = False
+            if not math.isfinite(value) or not ok:
+                raise NonlinearError(f"{label} = {value} is not allowed: must be {allowed}")
+
+
+# --- step loop ---------------------------------------------------------------------------------------
+
+def _kernel():
+    """The step loop (:func:`model.analysis.block_stepper.march`) and the matrices it takes
+    (:func:`model.analysis.block_stepper.step_matrices`)."""
+    from model.analysis.block_stepper import march, step_matrices
+
+    return march, step_matrices
+
+
+
+
+def _phi12(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """φ1(x) = (eˣ − 1)/x and φ2(x) = (eˣ − 1 − x)/x² (complex x), with series near 0."""
+    x = np.asarray(x, dtype=complex)
+    small = np.abs(x) < 1e-2
+    xs = np.where(small, 1.0, x)
+    phi1 = np.where(small, 1 + x / 2 + x**2 / 6 + x**3 / 24 + x**4 / 120 + x**5 / 720,
+                    np.expm1(xs) / xs)
+    phi2 = np.where(small, 0.5 + x / 6 + x**2 / 24 + x**3 / 120 + x**4 / 720 + x**5 / 5040,
+                    (np.expm1(xs) - xs) / xs**2)
+    return phi1, phi2
+
+
+# --- result ---------------------------------------------------------------------------------------------
+
+@dataclass
+class NonlinearResult:
+    """Nonlinear short-circuit time histories (plain data; module docstring)."""
+
+    t: np.ndarray  # time points [s]
+    outputs: dict[str, np.ndarray]  # name -> total (the linear response's names) [units]
+    units: dict[str, str]  # name -> SI unit
+    steady: dict[str, float]  # name -> pre-fault value [units]
+    M_C: np.ndarray  # short-circuit torque of ID1 M_C(t) (eq. 23) [N m]
+    motor_torques: dict[str, np.ndarray]  # "ID1.motor.torque", "ID2.motor.torque": totals [N m]
+    creepage: dict[str, np.ndarray]  # rim -> total creepage s0 + Δs [-]
+    slip_velocity: dict[str, np.ndarray]  # rim -> s·v [m/s]
+    utilisation: dict[str, np.ndarray]  # rim -> μ(s, v)/μ_max(v) [-] (signed)
+    peaks: dict[str, float]  # name -> signed total of largest magnitude [units]
+    peak_times: dict[str, float]  # name -> its time [s]
+    perturbation_peaks: dict[str, float]  # name -> signed Δy of largest magnitude [units]
+    limit_crossings: list[LimitCrossing]  # totals beyond the limits, by time
+    limits: dict[str, float]  # "M_ad", "M_ad/p" [N m], "mu_max N0" [N], "strength" if given
+    operating_point: OperatingPoint
+    excitation: ShortCircuit
+    creep_model: str  # "nonlinear" or "tangent"
+    anti_slip: AntiSlip | None
+    detection_time: float | None  # when the protection detected the slip [s] (None: never)
+    action_time: float | None  # detection + delay [s] (None: never)
+    motor_torque: float  # M(s0, v) before the fault [N m]
+    mu_max: float  # μ_max(v) [-]
+    newton_iterations: float  # mean Newton iterations per step
+    torque_reduction: np.ndarray  # change of ID2's motor torque by the protection [N m]
+    contact_velocity: np.ndarray | None = None  # N x contacts: H Δq̇ [m/s] (for checks)
+    remainder_force: np.ndarray | None = None  # N x contacts: r(H Δq̇) [N]
+    states: np.ndarray | None = None  # N x 2n: [Δq; Δq̇] without the rigid angles, if asked
+
+    def perturbation(self, name: str) -> np.ndarray:
+        """Δy(t) = total − pre-fault value [unit of the output]."""
+        return self.outputs[name] - self.steady[name]
+
+
+# --- the computation --------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class _Setup:
+    """Per (model, operating point, step) pieces of the stepping (built once, cached)."""
+
+    E: np.ndarray  # e^(λh) per kept mode
+    w0: np.ndarray  # first-order-hold weights h(φ1 − φ2) per mode
+    w1: np.ndarray  # h φ2
+    beta_mc: np.ndarray  # modal input of M_C
+    P0: np.ndarray  # m x channels: β_c w0
+    P1: np.ndarray  # m x channels: β_c w1
+    p0_2: np.ndarray  # m: β_2 w0 (ID2 motor torque)
+    p1_2: np.ndarray
+    W: np.ndarray  # channels x m: [H; slope row] Δq̇ = Re(W ζ) (4 contacts + ID2's slope torque)
+    D1: np.ndarray  # channels x channels: Re(W P1)
+    lam: np.ndarray  # kept eigenvalues [1/s]
+    modal_to_state: np.ndarray  # 2n x m: x = Re(X ζ) (rigid angles left out)
+
+
+def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
+    key = ("nonlinear_setup", h)
+    system = bogie_system(model, op)
+    cached = system._cache.get(key)
+    if cached is not None:
+        return cached
+    n = model.n
+    lam, Y, _, _, scale = system.modal
+    deflation = system.deflation
+    r = system.R.shape[1]
+    keep = lam.imag >= 0
+    weight = np.where(lam.imag > 0, 2.0, 1.0)[keep]
+    Minv = system.Minv
+    G = creep_force_map(model)
+    f_m2 = motor2_force(model)
+    # inputs: M_C, ΔM_2, the creep remainders, ID2's motor torque again (the channel through
+    # which the protection scales the motor's slope torque b_M Δω)
+    inputs = np.zeros((2 * n, 3 + G.shape[1]))
+    inputs[n:, 0] = Minv @ model.short_circuit_force
+    inputs[n:, 1] = Minv @ f_m2
+    inputs[n:, 2:-1] = Minv @ G
+    inputs[n:, -1] = Minv @ f_m2
+    rhs = deflation.apply_transpose(inputs)[r:] / scale[:, None]
+    beta = system.solve_eigenvectors(rhs)[keep]  # m x (2 + contacts)
+    lam_k = lam[keep]
+    E = np.exp(lam_k * h)
+    phi1, phi2 = _phi12(lam_k * h)
+    w1 = h * phi2
+    w0 = h * phi1 - w1
+    # modal state -> full state (rigid angles left out: loads and velocities do not see them)
+    Xc = deflation.apply(np.vstack([np.zeros((r, keep.sum())), (Y[:, keep] * scale[:, None])]))
+    X = Xc * weight[None, :]
+    H = creep_velocity_map(model)
+    rotor2 = model.dofs.index("ID2.rotor.ry")
+    slope_row = op.b_M * model.motor_pattern[rotor2]  # ID2's slope torque change = row · Δq̇
+    W = np.vstack([H, slope_row]) @ X[n:]
+    P1 = beta[:, 2:] * w1[:, None]
+    setup = _Setup(E=E, w0=w0, w1=w1, beta_mc=beta[:, 0], P0=beta[:, 2:] * w0[:, None], P1=P1,
+                   p0_2=beta[:, 1] * w0, p1_2=beta[:, 1] * w1, W=np.ascontiguousarray(W),
+                   D1=np.ascontiguousarray((W @ P1).real), lam=lam_k, modal_to_state=X)
+    with system._lock:
+        system._cache[key] = setup
+    return setup
+
+
+def motor2_force(model: BogieModel) -> np.ndarray:
+    """Generalized force of a unit driving torque of ID2's motor (rotor −ry, stator +ry)."""
+    f = np.zeros(model.n)
+    f[model.dofs.index("ID2.rotor.ry")] = -1.0
+    f[model.dofs.index("ID2.stator.ry")] = 1.0
+    return f
+
+
+def nonlinear_response(model: BogieModel, op: OperatingPoint,
+                       excitation: ShortCircuit | None = None, t_end: float = 2.0,
+                       fs: float = 10_000.0, creep: str = "nonlinear",
+                       anti_slip: AntiSlip | None = None, outputs: list[str] | None = None,
+                       strength: float | None = None, keep_states: bool = False,
+                       substeps: int = 1, excitation_scale: float = 1.0) -> NonlinearResult:
+    """Time histories after the short circuit of ID1's motor with nonlinear longitudinal creep.
+
+    ``creep``: "nonlinear" (the law) or "tangent" (its tangent at s0, through the same loop);
+    ``anti_slip``: None or disabled = no protection; ``outputs``: names of
+    :func:`model.mechanics.outputs.output_matrices` (default all); ``strength`` [N m]: a design strength
+    reported as limit "strength" for the disc clutch, claw clutch and (referred by p) driving
+    shaft torques; ``substeps``: integration steps per output sample (step h = 1/(fs·substeps));
+    ``keep_states``: also return the states [Δq; Δq̇] at the samples (memory N x 2n);
+    ``excitation_scale``: M_C(t) (step and oscillation) multiplied by this factor (checks of the
+    small-amplitude limit; the result's ``M_C`` is the scaled torque).
+    """
+    excitation = ShortCircuit() if excitation is None else excitation
+    if creep not in CREEP_MODELS:
+        raise NonlinearError(f"creep model '{creep}' is not allowed: nonlinear or tangent")
+    if anti_slip is not None and not isinstance(anti_slip, AntiSlip):
+        raise NonlinearError("anti_slip must be an AntiSlip or None")
+    if strength is not None and (isinstance(strength, bool) or not isinstance(strength, int | float)
+                                 or not math.isfinite(strength) or strength <= 0):
+        raise NonlinearError(f"strength = {strength!r} is not allowed: must be a positive number "
+                             "[N m]")
+    if isinstance(substeps, bool) or not isinstance(substeps, int) or not 1 <= substeps <= 64:
+        raise NonlinearError(f"substeps = {substeps!r} is not allowed: a whole number 1…64")
+    n_points = time_grid_points(t_end, fs, NonlinearError)
+    n_steps = (n_points - 1) * substeps
+    if n_steps + 1 > 4 * MAX_POINTS:
+        raise NonlinearError("t_end × fs × substeps is too many steps")
+    matrices = output_matrices(model, op)
+    names = list(matrices.names) if outputs is None else list(outputs)
+    if not names:
+        raise NonlinearError("no outputs requested")
+    for name in names:
+        if name not in matrices.names:
+            raise NonlinearError(f"unknown output '{name}': use an output name "
+                                 f"({', '.join(matrices.names[:3])}, …)")
+    h = 1.0 / (fs * substeps)
+    setup = _setup(model, op, h)
+    n = model.n
+    p = model.parameters
+    law = creep_law(p, op.N0)
+    coefficients = creep_coefficients(p, op)
+    mu_s0, dmu_s0 = coefficients.mu, coefficients.dmu_ds
+    step = motor_torque(p, op)
+    u0, a, mu = excitation.terms(step)
+    if isinstance(excitation_scale, bool) or not isinstance(excitation_scale, int | float) \
+            or not math.isfinite(excitation_scale):
+        raise NonlinearError(f"excitation_scale = {excitation_scale!r} must be a finite number")
+    u0, a = u0 * excitation_scale, a * excitation_scale
+    # exact per-step increments of the excitation (a step and a damped complex exponential)
+    lam = setup.lam
+    phi1_step, _ = _phi12(lam * h)
+    inc_step = setup.beta_mc * u0 * h * phi1_step
+    if excitation.M0 > 0 and excitation_scale != 0:
+        phi_p, _ = _phi12((mu - lam) * h)
+        phi_m, _ = _phi12((np.conj(mu) - lam) * h)
+        cp = setup.beta_mc * 0.5 * a * setup.E * h * phi_p
+        cm = setup.beta_mc * 0.5 * np.conj(a) * setup.E * h * phi_m
+    else:
+        cp = cm = np.zeros_like(lam)
+    g_step = complex(np.exp(mu * h))
+    rims = contact_names(model)
+    # channels: the four contacts, then ID2's slope torque (not a detection signal)
+    detect_rows = np.array([0.5 if rim.startswith("ID2.") else 0.0 for rim in rims] + [0.0])
+    protection = anti_slip if anti_slip is not None and anti_slip.enabled else None
+    threshold = protection.threshold if protection else math.inf
+    delay = protection.delay if protection else 0.0
+    rate = protection.rate if protection else 1.0
+    floor = protection.floor if protection else 0.0
+    law_params = np.array([law.mu0, law.A, law.B, law.kA, law.kS, law.slope])
+    march, step_matrices = _kernel()
+    m = len(lam)
+    nc = len(rims) + 1
+    zeta = np.zeros(m, dtype=complex)
+    phi = np.zeros(nc)
+    z = np.zeros(nc)
+    det_state = np.array([-1.0])
+    iterations = np.zeros(1, dtype=np.int64)
+    # outputs: y = Re(V ζ) for the loads; the creep forces from z
+    loads = [name for name in names if not name.endswith(("creep_force", "adhesion_moment"))]
+    C = np.array([np.concatenate([matrices.C_q[matrices.index(nm)], matrices.C_v[matrices.index(nm)]])
+                  for nm in loads]).reshape(len(loads), 2 * n)
+    V = C @ setup.modal_to_state  # loads x m
+    if keep_states:  # the states x = Re(X ζ) as further outputs of the loop
+        V = np.vstack([V, setup.modal_to_state])
+    Y = np.empty((n_points, V.shape[0]))
+    Y[0] = 0.0
+    z_hist = np.zeros((n_points, nc))
+    r_hist = np.zeros((n_points, nc))
+    u2_hist = np.zeros(n_points)
+    block = BLOCK_STEPS - BLOCK_STEPS % substeps
+    Y_out = np.empty((block, V.shape[0]))
+    z_out = np.empty((block, nc))
+    phi_out = np.empty((block, nc))
+    u2_out = np.empty(block)
+    u2_now = 0.0
+    scale = max(op.s0 * op.v, 1e-3)
+    blocks = step_matrices(setup.W, setup.E, setup.P0, setup.P1, setup.D1, V, len(rims))
+    k = 0
+    while k < n_steps:
+        k1 = min(n_steps, k + block)
+        status = march(k, k1, h, zeta, phi, z, u2_now, setup.E, inc_step, cp, cm, g_step,
+                       complex(1.0), setup.P0, setup.p0_2, setup.p1_2, scale, law_params, op.s0,
+                       op.v, op.N0, mu_s0, dmu_s0, creep == "tangent", detect_rows, threshold,
+                       det_state, step, delay, rate, floor, Y_out, z_out, phi_out, u2_out,
+                       iterations, blocks)
+        if status < 0:
+            raise NonlinearError(f"the creep-force iteration did not converge at t = "
+                                 f"{-status * h:.6g} s")
+        sel = np.arange(substeps - 1, k1 - k, substeps)  # block rows that are samples
+        samples = (k + sel + 1) // substeps
+        u2_now = float(u2_out[k1 - k - 1])
+        Y[samples] = Y_out[sel]
+        z_hist[samples] = z_out[sel]
+        r_hist[samples] = phi_out[sel]
+        u2_hist[samples] = u2_out[sel]
+        k = k1
+    t = np.arange(n_points) / fs
+    X_hist = Y[:, len(loads):] if keep_states else None
+    if not np.all(np.isfinite(Y)) or not np.all(np.isfinite(z_hist)):
+        raise NonlinearError("the nonlinear response is not finite")
+    totals, units, steady = {}, {}, {}
+    for j, name in enumerate(loads):
+        i = matrices.index(name)
+        totals[name] = Y[:, j] + matrices.steady[i]
+    slope_torque, slope_cut = z_hist[:, -1], r_hist[:, -1]
+    z_hist, r_hist = z_hist[:, :-1], r_hist[:, :-1]
+    creep_total = np.asarray(law.mu(op.s0 + z_hist / op.v, op.v)) if creep == "nonlinear" \
+        else mu_s0 + dmu_s0 * z_hist / op.v
+    forces = op.N0 * creep_total  # N x contacts, totals
+    r0 = p["wheel_radius"]
+    _, mu_max = law.maximum(op.v)
+    for i, rim in enumerate(rims):
+        totals_name = f"{rim}.creep_force"
+        if totals_name in names:
+            totals[totals_name] = forces[:, i]
+    for drive in DRIVES:
+        name = f"{drive}.wheelset.adhesion_moment"
+        if name in names:
+            columns = [rims.index(f"{drive}.rim{k}") for k in RIM_NODES]
+            totals[name] = r0 * forces[:, columns].sum(axis=1)
+    outputs_total = {name: totals[name] for name in names}
+    for name in names:
+        i = matrices.index(name)
+        units[name], steady[name] = matrices.units[i], float(matrices.steady[i])
+    M_C = excitation.torque(t, step) * excitation_scale
+    motor = {"ID1.motor.torque": step + M_C,
+             "ID2.motor.torque": step + slope_torque + u2_hist + slope_cut}
+    creepage = {rim: op.s0 + z_hist[:, i] / op.v for i, rim in enumerate(rims)}
+    slip = {rim: creepage[rim] * op.v for rim in rims}
+    utilisation = {rim: creep_total[:, i] / mu_max for i, rim in enumerate(rims)}
+    peaks, peak_times, pert_peaks = {}, {}, {}
+    for name, y in outputs_total.items():
+        kk = int(np.argmax(np.abs(y)))
+        peaks[name], peak_times[name] = float(y[kk]), float(t[kk])
+        d = y - steady[name]
+        pert_peaks[name] = float(d[int(np.argmax(np.abs(d)))])
+    M_ad = adhesion_moment(p, op.v, op.N0)
+    limits = {"M_ad": M_ad, "M_ad/p": M_ad / p["gear_ratio"], "mu_max N0": float(mu_max) * op.N0}
+    checks = list(LIMITED)
+    if strength is not None:
+        limits["strength"] = float(strength)
+        limits["strength/p"] = float(strength) / p["gear_ratio"]
+        checks += [("disc_clutch.torque", "strength"), ("claw_clutch.torque", "strength"),
+                   ("driving_shaft.torque", "strength/p")]
+    crossings = []
+    for name, y in outputs_total.items():
+        for suffix, limit_name in checks:
+            if name.endswith(suffix):
+                over = np.flatnonzero(np.abs(y) > limits[limit_name] * (1 + 1e-12))
+                if len(over):
+                    kk = int(over[0])
+                    crossings.append(LimitCrossing(name, limit_name, limits[limit_name],
+                                                   float(t[kk]), float(y[kk])))
+    crossings.sort(key=lambda c: c.time)
+    detection = float(det_state[0]) if det_state[0] >= 0 else None
+    return NonlinearResult(
+        t=t, outputs=outputs_total, units=units, steady=steady, M_C=M_C, motor_torques=motor,
+        creepage=creepage, slip_velocity=slip, utilisation=utilisation, peaks=peaks,
+        peak_times=peak_times, perturbation_peaks=pert_peaks, limit_crossings=crossings,
+        limits=limits, operating_point=op, excitation=excitation, creep_model=creep,
+        anti_slip=protection, detection_time=detection,
+        action_time=None if detection is None else detection + delay, motor_torque=step,
+        mu_max=float(mu_max), newton_iterations=float(iterations[0]) / max(n_steps, 1),
+        torque_reduction=u2_hist + slope_cut,
+        contact_velocity=z_hist, remainder_force=r_hist, states=X_hist)

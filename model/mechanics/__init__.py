@@ -1,0 +1,8 @@
+"""Mechanics: the parameter set, the DOFs, the elements and the assembled linearized bogie.
+
+Holds the parameter set and its TOML format (:mod:`.parameters`), the one DOF naming scheme
+(:mod:`.dofs`), the elements (beam, rigid bodies, spring–damper connections), the assembly of
+M, B, K (:mod:`.assembly`), the operating point's creep and motor terms (:mod:`.operating_point`)
+and the output quantities (torques, forces) as rows over the DOFs (:mod:`.outputs`).  May use
+:mod:`model.contact`; never the analyses, the studies or ``app``.
+"""

@@ -1,0 +1,331 @@
+"""Assembly of the bogie: subsystems ID1, BFCB, ID2 (in that order), from named elements.
+
+Drive 1 is described once (:func:`_drive`); drive 2 is the same description turned by 180° about
+the vertical axis through the bogie centre (positions and geometric directions mapped by
+``diag(−1, −1, 1)``).  The constant matrices ``M``, ``B`` (structural damping), ``K`` are
+assembled once; an operating point only adds the motor slope ``B_M`` and the creep blocks
+``B_ad`` (see :mod:`model.mechanics.operating_point`).
+
+DOF layout (193 coordinates; the study had 189 without stating its breakdown):
+
+* per drive ``IDk`` (93): ``rotor.ry``, ``pinion.ry``, ``gear.ry`` (spins in the gear housing;
+  they translate and tilt with the stator), ``stator.{x,y,z,rx,ry,rz}``, hollow shaft beam nodes
+  ``hs5…hs9`` (6 each; disc clutch at 5, claw clutch at 9), axle beam nodes ``ax10…ax16``
+  (6 each; claw clutch at 10, journals 11 and 15, wheels 12 and 14, centre 13, under the gear 16),
+  wheel rims ``rim12``, ``rim14`` (6 each);
+* ``BF.{x,y,z,rx,ry,rz}`` bogie frame, ``CB.z`` half car body (vertical only: its other motions
+  are restrained by the whole locomotive and are not part of the study's table of modes).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from itertools import pairwise
+
+import numpy as np
+
+from model.mechanics.beam import TubeSection, beam_global_matrices
+from model.mechanics.bodies import Body, carried_body, free_body, rigid_mass_matrix
+from model.mechanics.connections import Spring, SpringDamper, axis_springs
+from model.mechanics.dofs import AXES6, DofMap
+from model.mechanics.parameters import Parameters
+
+HOLLOW_SHAFT_NODES = (5, 6, 7, 8, 9)
+AXLE_NODES = (10, 11, 12, 13, 14, 15, 16)
+RIM_NODES = (12, 14)
+DRIVES = ("ID1", "ID2")
+CENTRAL_SYMMETRY = np.diag([-1.0, -1.0, 1.0])  # drive 2 = drive 1 turned 180° about z
+
+
+def dof_names() -> tuple[str, ...]:
+    """All coordinate names in the order of q = [q_ID1, q_BFCB, q_ID2]."""
+
+    def drive(prefix: str) -> list[str]:
+        names = [f"{prefix}.rotor.ry", f"{prefix}.pinion.ry", f"{prefix}.gear.ry"]
+        names += [f"{prefix}.stator.{a}" for a in AXES6]
+        for node in HOLLOW_SHAFT_NODES:
+            names += [f"{prefix}.hs{node}.{a}" for a in AXES6]
+        for node in AXLE_NODES:
+            names += [f"{prefix}.ax{node}.{a}" for a in AXES6]
+        for node in RIM_NODES:
+            names += [f"{prefix}.rim{node}.{a}" for a in AXES6]
+        return names
+
+    return tuple(drive("ID1") + [f"BF.{a}" for a in AXES6] + ["CB.z"] + drive("ID2"))
+
+
+@dataclass(frozen=True)
+class Part:
+    """A matrix contribution restricted to the coordinates it touches."""
+
+    index: np.ndarray  # global coordinate indices
+    matrix: np.ndarray  # len(index) x len(index)
+
+
+@dataclass
+class BogieModel:
+    """The assembled linear model: constant matrices plus what an operating point needs."""
+
+    parameters: Parameters
+    dofs: DofMap
+    M: np.ndarray  # mass matrix [kg, kg m, kg m^2]
+    K: np.ndarray  # stiffness (incl. track) [N/m, N, N m/rad]
+    B: np.ndarray  # structural damping (incl. track), without B_M and B_ad [N s/m, …]
+    mass_parts: dict[str, Part]  # component name -> its share of M (kinetic energy bookkeeping)
+    stiffness_parts: dict[str, Part]  # element group -> its share of K (strain energy)
+    connections: list[SpringDamper]  # every connection, for output quantities
+    rims: dict[str, np.ndarray]  # "ID1.rim12" -> indices of [x, y, z, rx, ry, rz]
+    motor_pattern: np.ndarray  # n x n: B_M for b_M = 1 (ID2 rotor–stator, relative form)
+    short_circuit_force: np.ndarray  # generalized force per unit M_C on ID1 (rotor, stator)
+    rigid_body_modes: np.ndarray  # n x 2: rigid spin of each whole drivetrain (K r = 0)
+    positions: dict[str, np.ndarray] = field(default_factory=dict)  # part -> reference point [m]
+
+    @property
+    def n(self) -> int:
+        return len(self.dofs)
+
+
+class _Assembler:
+    def __init__(self, dofs: DofMap, dtype=float):
+        self.dofs = dofs
+        n = len(dofs)
+        self.M = np.zeros((n, n), dtype=dtype)
+        self.K = np.zeros((n, n), dtype=dtype)
+        self.B = np.zeros((n, n), dtype=dtype)
+        self.mass_parts: dict[str, np.ndarray] = {}
+        self.stiffness_parts: dict[str, np.ndarray] = {}
+        self.connections: list[SpringDamper] = []
+
+    def _add_part(self, store: dict, name: str, matrix: np.ndarray) -> None:
+        store[name] = store.get(name, 0.0) + matrix
+
+    def add_mass(self, component: str, body: Body, M6: np.ndarray) -> None:
+        contribution = body.W.T @ M6 @ body.W
+        self.M += contribution
+        self._add_part(self.mass_parts, component, contribution)
+
+    def add_beam(self, group: str, component: str, node_a: Body, node_b: Body,
+                 section: TubeSection, p: Parameters) -> None:
+        K12, M12 = beam_global_matrices(node_a.origin, node_b.origin, section, p["young_modulus"],
+                                        p["poisson_ratio"], p["steel_density"])
+        G = np.vstack([node_a.W, node_b.W])
+        K = G.T @ K12 @ G
+        M = G.T @ M12 @ G
+        self.K += K
+        self.B += p["shaft_loss_time"] * K
+        self.M += M
+        self._add_part(self.stiffness_parts, group, K)
+        self._add_part(self.mass_parts, component, M)
+
+    def add_connection(self, connection: SpringDamper) -> None:
+        K, B = connection.matrices()
+        self.K += K
+        self.B += B
+        self._add_part(self.stiffness_parts, connection.group, K)
+        self.connections.append(connection)
+
+    def add_ground_spring(self, group: str, index: int, stiffness: float, damping: float,
+                          mass: float, component: str) -> None:
+        self.K[index, index] += stiffness
+        self.B[index, index] += damping
+        self.M[index, index] += mass
+        k = np.zeros_like(self.K)
+        k[index, index] = stiffness
+        self._add_part(self.stiffness_parts, group, k)
+        m = np.zeros_like(self.M)
+        m[index, index] = mass
+        self._add_part(self.mass_parts, component, m)
+
+
+def _parts(store: dict[str, np.ndarray]) -> dict[str, Part]:
+    parts = {}
+    for name, matrix in store.items():
+        index = np.flatnonzero(np.any(matrix != 0, axis=0) | np.any(matrix != 0, axis=1))
+        parts[name] = Part(index, matrix[np.ix_(index, index)].copy())
+    return parts
+
+
+def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.ndarray,
+           axle_x: float, positions: dict[str, np.ndarray]) -> dict[str, Body]:
+    """Add one individual wheelset drive.  ``sign`` maps drive-1 geometry to this drive's."""
+    dofs = asm.dofs
+    pos = lambda x, y, z: sign @ np.array([x, y, z], dtype=np.result_type(x, y, z, float))  # noqa: E731
+    direction = lambda v: sign @ np.asarray(v, dtype=np.result_type(*v, float))  # noqa: E731
+    loss_rubber, loss_steel = p["rubber_loss_time"], p["shaft_loss_time"]
+
+    ratio, r_gear = p["gear_ratio"], p["gear_radius"]
+    r_pinion = r_gear / ratio
+    y_gear, y_claw = p["gear_lateral_position"], p["claw_clutch_lateral_position"]
+    x_motor = axle_x - (r_gear + r_pinion)  # motor axis towards the bogie centre
+
+    stator = free_body(f"{prefix}.stator", pos(x_motor + p["stator_offset_x"], 0.0,
+                                               p["stator_offset_z"]), dofs)
+    rotor = carried_body(f"{prefix}.rotor", pos(x_motor, 0.0, 0.0), stator, dofs)
+    pinion = carried_body(f"{prefix}.pinion", pos(x_motor, y_gear, 0.0), stator, dofs)
+    gear = carried_body(f"{prefix}.gear", pos(axle_x, y_gear, 0.0), stator, dofs)
+    asm.add_mass(f"{prefix}.stator", stator, rigid_mass_matrix(
+        p["stator_mass"], (p["stator_inertia_x"], p["stator_inertia_y"], p["stator_inertia_z"])))
+    for body, mass, inertia in ((rotor, "rotor_mass", "rotor_inertia"),
+                                (pinion, "pinion_mass", "pinion_inertia"),
+                                (gear, "gear_mass", "gear_inertia")):
+        J = p[inertia]
+        asm.add_mass(body.name, body, rigid_mass_matrix(p[mass], (J / 2, J, J / 2)))
+
+    # hollow shaft and axle beam nodes
+    hs_y = np.linspace(y_gear, y_claw, len(HOLLOW_SHAFT_NODES))
+    hs = {k: free_body(f"{prefix}.hs{k}", pos(axle_x, y, 0.0), dofs)
+          for k, y in zip(HOLLOW_SHAFT_NODES, hs_y, strict=True)}
+    c, j = p["contact_half_distance"], p["journal_half_distance"]
+    axle_y = {11: -j, 12: -c, 10: y_claw, 13: 0.0, 16: y_gear, 14: c, 15: j}
+    ax = {k: free_body(f"{prefix}.ax{k}", pos(axle_x, y, 0.0), dofs) for k, y in axle_y.items()}
+    hollow = TubeSection(p["hollow_shaft_outer_radius"], p["hollow_shaft_inner_radius"])
+    for k1, k2 in pairwise(HOLLOW_SHAFT_NODES):
+        asm.add_beam(f"{prefix}.hollow_shaft", f"{prefix}.hollow_shaft", hs[k1], hs[k2], hollow, p)
+    axle_order = sorted(axle_y, key=lambda k: np.real(axle_y[k]))
+    solid = TubeSection(p["axle_radius"])
+    for k1, k2 in pairwise(axle_order):
+        asm.add_beam(f"{prefix}.axle", f"{prefix}.wheelset", ax[k1], ax[k2], solid, p)
+    for k in RIM_NODES:  # wheel discs
+        Jd = p["wheel_disc_diametral_inertia"]
+        asm.add_mass(f"{prefix}.wheelset", ax[k], rigid_mass_matrix(
+            p["wheel_disc_mass"], (Jd, p["wheel_disc_polar_inertia"], Jd)))
+    for k in (11, 15):  # axle boxes: translate with the journal, do not spin
+        asm.add_mass(f"{prefix}.wheelset", ax[k], np.diag([p["axle_box_mass"]] * 3 + [0, 0, 0]))
+
+    # rims (elastic wheels) and track
+    rims = {}
+    for k in RIM_NODES:
+        rim = free_body(f"{prefix}.rim{k}", ax[k].origin, dofs)
+        rims[k] = rim
+        Jr = p["rim_diametral_inertia"]
+        asm.add_mass(rim.name, rim, rigid_mass_matrix(p["rim_mass"], (Jr, p["rim_polar_inertia"], Jr)))
+        kt = np.array([p["rim_radial_stiffness"], p["rim_axial_stiffness"], p["rim_radial_stiffness"]])
+        kr = np.array([p["rim_tilt_stiffness"], p["rim_torsional_stiffness"], p["rim_tilt_stiffness"]])
+        asm.add_connection(SpringDamper(
+            f"{prefix}.rim{k}_spring", f"{prefix}.rim_springs", ax[k], rim, rim.origin,
+            axis_springs(kt, loss_rubber * kt) + axis_springs(kr, loss_rubber * kr, rotational=True)))
+        asm.add_ground_spring("track", dofs.index(f"{rim.name}.z"), p["track_stiffness"],
+                              p["track_damping"], p["track_mass"], "track")
+
+    # drive train couplings
+    asm.add_connection(SpringDamper(
+        f"{prefix}.driving_shaft", f"{prefix}.driving_shaft", pinion, rotor, rotor.origin,
+        (Spring(np.array([0.0, -1.0, 0.0]), p["driving_shaft_stiffness"],
+                loss_steel * p["driving_shaft_stiffness"], True, "torque"),)))
+    # driving-shaft torque in the motor's driving sense (the rotor turns −ry when running forward):
+    # M_DS = k_DS (φ_rotor − φ_pinion) with angles counted in that sense, positive in traction
+    alpha = p["pressure_angle"]
+    pitch_point = pos(x_motor + r_pinion, y_gear, 0.0)
+    asm.add_connection(SpringDamper(
+        f"{prefix}.gear_mesh", f"{prefix}.gear_mesh", pinion, gear, pitch_point,
+        (Spring(direction([-np.sin(alpha), 0.0, -np.cos(alpha)]), p["gear_mesh_stiffness"],
+                loss_steel * p["gear_mesh_stiffness"], False, "force"),)))
+    k_dc = np.array([p["disc_clutch_radial_stiffness"], p["disc_clutch_axial_stiffness"],
+                     p["disc_clutch_radial_stiffness"]])
+    k_dc_rot = np.array([p["disc_clutch_tilt_stiffness"], p["disc_clutch_torsional_stiffness"],
+                         p["disc_clutch_tilt_stiffness"]])
+    asm.add_connection(SpringDamper(
+        f"{prefix}.disc_clutch", f"{prefix}.disc_clutch", hs[5], gear, hs[5].origin,
+        axis_springs(k_dc, loss_rubber * k_dc, channels=("force_x", "force_y", "force_z"))
+        + axis_springs(k_dc_rot, loss_rubber * k_dc_rot, True, ("", "torque", ""))))
+    k_cc = np.array([p["claw_clutch_radial_stiffness"], p["claw_clutch_axial_stiffness"],
+                     p["claw_clutch_radial_stiffness"]])
+    k_cc_rot = np.array([p["claw_clutch_tilt_stiffness"], p["claw_clutch_torsional_stiffness"],
+                         p["claw_clutch_tilt_stiffness"]])
+    asm.add_connection(SpringDamper(
+        f"{prefix}.claw_clutch", f"{prefix}.claw_clutch", ax[10], hs[9], hs[9].origin,
+        axis_springs(k_cc, loss_rubber * k_cc)
+        + axis_springs(k_cc_rot, loss_rubber * k_cc_rot, True, ("", "torque", ""))))
+
+    # drive to frame: silent blocks A, B, C
+    k_sb = np.array([p["silent_block_stiffness_x"], p["silent_block_stiffness_y"],
+                     p["silent_block_stiffness_z"]])
+    blocks = {"A": pos(x_motor - p["silent_block_upper_x"], p["silent_block_half_y"], p["silent_block_upper_z"]),
+              "B": pos(x_motor - p["silent_block_upper_x"], -p["silent_block_half_y"], p["silent_block_upper_z"]),
+              "C": pos(x_motor + p["silent_block_lower_x"], y_gear, p["silent_block_lower_z"])}
+    for label, point in blocks.items():
+        asm.add_connection(SpringDamper(f"{prefix}.silent_block_{label}", f"{prefix}.silent_blocks",
+                                        frame, stator, point, axis_springs(k_sb, loss_rubber * k_sb)))
+        positions[f"{prefix}.silent_block_{label}"] = point
+
+    # wheelset to frame: primary suspension and longitudinal wheelset guides at the journals
+    k_p = np.array([p["primary_stiffness_x"], p["primary_stiffness_y"], p["primary_stiffness_z"]])
+    c_p = np.array([0.0, 0.0, p["primary_damping_z"]])
+    for k in (11, 15):
+        asm.add_connection(SpringDamper(f"{prefix}.primary{k}", f"{prefix}.primary", frame, ax[k],
+                                        ax[k].origin, axis_springs(k_p, c_p)))
+
+    bodies = {"stator": stator, "rotor": rotor, "pinion": pinion, "gear": gear,
+              **{f"hs{k}": b for k, b in hs.items()}, **{f"ax{k}": b for k, b in ax.items()},
+              **{f"rim{k}": b for k, b in rims.items()}}
+    for name, body in bodies.items():
+        positions[f"{prefix}.{name}"] = body.origin
+    positions[f"{prefix}.pitch_point"] = pitch_point
+    return bodies
+
+
+def build_model(parameters: Parameters) -> BogieModel:
+    """Assemble the constant matrices of the bogie for a parameter set."""
+    p = parameters
+    dofs = DofMap(dof_names())
+    # complex values (a complex-step perturbation, model.analysis.sensitivity) give complex matrices
+    dtype = complex if any(isinstance(value, complex) for value in p.values.values()) else float
+    asm = _Assembler(dofs, dtype)
+    positions: dict[str, np.ndarray] = {}
+    n = len(dofs)
+
+    frame = free_body("BF", (0.0, 0.0, p["frame_height"]), dofs)
+    asm.add_mass("BF", frame, rigid_mass_matrix(
+        p["frame_mass"], (p["frame_inertia_x"], p["frame_inertia_y"], p["frame_inertia_z"])))
+    car_body = free_body("CB", (0.0, 0.0, p["secondary_height"] + 1.0), dofs, axes=("z",))
+    asm.add_mass("CB", car_body, np.diag([0, 0, p["car_body_mass"], 0, 0, 0]))
+    positions["BF"], positions["CB"] = frame.origin, car_body.origin
+
+    half_base = p["wheelbase"] / 2
+    drives = {}
+    for prefix, sign in (("ID1", np.eye(3)), ("ID2", CENTRAL_SYMMETRY)):
+        drives[prefix] = _drive(asm, p, prefix, frame, sign, half_base, positions)
+
+    # secondary suspension: frame to half car body
+    sx, sy, sh = p["secondary_half_base_x"], p["secondary_half_base_y"], p["secondary_height"]
+    k_s = np.array([p["secondary_stiffness_x"], p["secondary_stiffness_y"], p["secondary_stiffness_z"]])
+    c_s = np.array([0.0, 0.0, p["secondary_damping_z"]])
+    for i, (x, y) in enumerate(((sx, sy), (-sx, sy), (sx, -sy), (-sx, -sy)), start=1):
+        point = np.array([x, y, sh])
+        asm.add_connection(SpringDamper(f"secondary.P{i}", "secondary", frame, car_body, point,
+                                        axis_springs(k_s, c_s)))
+        positions[f"secondary.P{i}"] = point
+    for side in (1.0, -1.0):
+        asm.add_connection(SpringDamper(
+            "secondary.lateral_damper", "secondary", frame, car_body, np.array([0.0, side * sy, sh]),
+            axis_springs((0, 0, 0), (0, p["secondary_damping_y"], 0))))
+        asm.add_connection(SpringDamper(
+            "secondary.yaw_damper", "secondary", frame, car_body,
+            np.array([0.0, side * p["yaw_damper_half_base_y"], p["yaw_damper_height"]]),
+            axis_springs((0, 0, 0), (p["yaw_damping"], 0, 0))))
+
+    # healthy motor (ID2): torque depends on the rotor's speed relative to the stator
+    motor = np.zeros((n, n))
+    rotor2, stator2 = dofs.index("ID2.rotor.ry"), dofs.index("ID2.stator.ry")
+    motor[np.ix_([rotor2, stator2], [rotor2, stator2])] = [[1.0, -1.0], [-1.0, 1.0]]
+
+    # short circuit torque on ID1: M_C in the driving sense.  Forward running spins the wheels
+    # +ry and, through one external gear mesh, the rotor −ry: a driving torque is −ry on the rotor
+    # and its reaction +ry on the stator.
+    short_circuit = np.zeros(n)
+    short_circuit[dofs.index("ID1.rotor.ry")] = -1.0
+    short_circuit[dofs.index("ID1.stator.ry")] = 1.0
+
+    rigid = np.zeros((n, 2), dtype=dtype)
+    for column, prefix in enumerate(DRIVES):
+        for name in dofs.names:
+            if name.startswith(prefix) and name.endswith(".ry") and ".stator." not in name:
+                rigid[dofs.index(name), column] = 1.0
+        for part in ("rotor", "pinion"):
+            rigid[dofs.index(f"{prefix}.{part}.ry"), column] = -p["gear_ratio"]
+
+    rims = {f"{prefix}.rim{k}": dofs.indices([f"{prefix}.rim{k}.{a}" for a in AXES6])
+            for prefix in DRIVES for k in RIM_NODES}
+    return BogieModel(p, dofs, asm.M, asm.K, asm.B, _parts(asm.mass_parts),
+                      _parts(asm.stiffness_parts), asm.connections, rims, motor, short_circuit,
+                      rigid, positions)

@@ -1,0 +1,243 @@
+"""Parameter sets: the schema, validation and TOML file I/O.
+
+A parameter file is a TOML table of entries ``name = { value = …, unit = "…", note = "…" }``.
+Every value is in SI units (the unit string must equal the schema's); the note says where the
+value comes from (public fact, estimate and why, or calibration output).  The schema below is the
+single list of what the model needs; unknown or missing names are errors.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+ASSETS = Path(__file__).resolve().parents[2] / "assets" / "parameters"  # model/mechanics/ -> project
+ESTIMATE_FILE = ASSETS / "estimate.toml"
+CALIBRATED_FILE = ASSETS / "calibrated.toml"
+
+
+class ParameterError(ValueError):
+    """A parameter file or value is missing, malformed, unknown or out of range."""
+
+
+# name -> (unit, short description, (lower, upper, lower bound allowed?)); the upper bound is
+# inclusive.  These are validity bounds (what the model can compute with), not calibration bounds.
+_POS = (0.0, math.inf, False)
+_NONNEG = (0.0, math.inf, True)
+SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
+    # --- wheel/rail geometry and contact -------------------------------------------------------
+    "wheel_radius": ("m", "nominal rolling radius r0", _POS),
+    "contact_half_distance": ("m", "half lateral distance of the wheel-rail contact points", _POS),
+    "rail_head_radius": ("m", "transverse radius of the rail head (Hertz contact)", _POS),
+    "young_modulus": ("Pa", "Young's modulus of wheel, rail, shafts (steel)", _POS),
+    "poisson_ratio": ("1", "Poisson's ratio of steel", (0.0, 0.49, False)),
+    "steel_density": ("kg/m^3", "density of the shafts' steel", _POS),
+    "wheel_force": ("N", "static vertical wheel force N0", _POS),
+    # --- creep law (Polach) --------------------------------------------------------------------
+    "polach_mu0": ("1", "Polach: maximum friction coefficient at zero slip velocity", _POS),
+    "polach_A": ("1", "Polach: ratio of limit friction at infinite slip velocity to mu0", (0.0, 1.0, True)),
+    "polach_B": ("s/m", "Polach: exponential friction decrease rate with slip velocity", (0.0, 1e3, False)),
+    "polach_kA": ("1", "Polach: reduction factor in the area of adhesion", (0.0, 1.0, True)),
+    "polach_kS": ("1", "Polach: reduction factor in the area of slip (kS <= kA)", (0.0, 1.0, True)),
+    "creep_slope": ("1", "initial creep slope G*pi*a*b*C11/(4*N0) of the creep law", _POS),
+    # --- geometry of the bogie ------------------------------------------------------------------
+    "wheelbase": ("m", "distance of the two wheelsets", _POS),
+    "journal_half_distance": ("m", "half lateral distance of the axle journals (axle boxes)", _POS),
+    "frame_height": ("m", "height of the bogie frame's centre of mass above the axle centres", (-2, 2, False)),
+    "secondary_half_base_x": ("m", "longitudinal half distance of the secondary springs", _POS),
+    "secondary_half_base_y": ("m", "lateral half distance of the secondary springs", _POS),
+    "secondary_height": ("m", "height of the secondary spring seats above the axle centres", (-2, 2, False)),
+    "yaw_damper_half_base_y": ("m", "lateral half distance of the longitudinal (yaw) dampers", _POS),
+    "yaw_damper_height": ("m", "height of the yaw dampers' line of action above the axle centres", (-2, 2, False)),
+    "gear_radius": ("m", "pitch radius of the driven gear; pinion radius = gear_radius/gear_ratio", _POS),
+    "gear_ratio": ("1", "gear ratio p = rotor speed / wheel speed", _POS),
+    "pressure_angle": ("rad", "working pressure angle of the gear mesh", (0.0, 0.8, False)),
+    "gear_lateral_position": ("m", "lateral position y of gear and disc clutch (drive 1)", (-1, 1, False)),
+    "claw_clutch_lateral_position": ("m", "lateral position y of the claw clutch (drive 1)", (-1, 1, False)),
+    "stator_offset_x": ("m", "stator centre of mass: x offset from the motor axis", (-1, 1, False)),
+    "stator_offset_z": ("m", "vertical offset of the stator's centre of mass from the motor axis", (-1, 1, False)),
+    "silent_block_upper_x": ("m", "silent blocks A, B: x offset to the bogie centre", (-2, 2, False)),
+    "silent_block_half_y": ("m", "lateral half distance of silent blocks A and B", _POS),
+    "silent_block_upper_z": ("m", "height of silent blocks A, B above the motor axis", (-2, 2, False)),
+    "silent_block_lower_x": ("m", "silent block C: x offset towards the axle", (-2, 2, False)),
+    "silent_block_lower_z": ("m", "height of silent block C above the motor axis", (-2, 2, False)),
+    "hollow_shaft_outer_radius": ("m", "outer radius of the hollow shaft", _POS),
+    "hollow_shaft_inner_radius": ("m", "inner radius of the hollow shaft", _POS),
+    "axle_radius": ("m", "radius of the (solid) wheelset axle", _POS),
+    # --- masses and inertias ----------------------------------------------------------------------
+    "car_body_mass": ("kg", "half car body mass carried by this bogie", _POS),
+    "frame_mass": ("kg", "bogie frame mass", _POS),
+    "frame_inertia_x": ("kg m^2", "bogie frame roll inertia", _POS),
+    "frame_inertia_y": ("kg m^2", "bogie frame pitch inertia", _POS),
+    "frame_inertia_z": ("kg m^2", "bogie frame yaw inertia", _POS),
+    "stator_mass": ("kg", "stator with gear housing (without rotor, pinion, gear)", _POS),
+    "stator_inertia_x": ("kg m^2", "stator+housing inertia about x through its centre of mass", _POS),
+    "stator_inertia_y": ("kg m^2", "stator+housing inertia about y through its centre of mass", _POS),
+    "stator_inertia_z": ("kg m^2", "stator+housing inertia about z through its centre of mass", _POS),
+    "rotor_mass": ("kg", "rotor mass", _POS),
+    "rotor_inertia": ("kg m^2", "rotor polar moment of inertia", _POS),
+    "pinion_mass": ("kg", "pinion mass", _POS),
+    "pinion_inertia": ("kg m^2", "pinion polar moment of inertia", _POS),
+    "gear_mass": ("kg", "driven gear mass", _POS),
+    "gear_inertia": ("kg m^2", "driven gear polar moment of inertia", _POS),
+    "wheel_disc_mass": ("kg", "wheel disc (centre) mass, lumped at the wheel node", _POS),
+    "wheel_disc_polar_inertia": ("kg m^2", "wheel disc inertia about the axle", _POS),
+    "wheel_disc_diametral_inertia": ("kg m^2", "wheel disc inertia about a diameter", _POS),
+    "axle_box_mass": ("kg", "axle box mass (translates with the journal, does not spin)", _POS),
+    "rim_mass": ("kg", "wheel rim (tyre) mass", _POS),
+    "rim_polar_inertia": ("kg m^2", "wheel rim inertia about the axle", _POS),
+    "rim_diametral_inertia": ("kg m^2", "wheel rim inertia about a diameter", _POS),
+    "track_mass": ("kg", "track mass m_R under each wheel (eq. 11)", _POS),
+    # --- stiffnesses -------------------------------------------------------------------------------
+    "driving_shaft_stiffness": ("N m/rad", "torsional stiffness k_DS of the driving shaft rotor-pinion", _POS),
+    "gear_mesh_stiffness": ("N/m", "gear mesh stiffness k_G along the line of action", _POS),
+    "disc_clutch_torsional_stiffness": ("N m/rad", "disc clutch torsional stiffness k_DC", _POS),
+    "disc_clutch_axial_stiffness": ("N/m", "disc clutch axial stiffness", _POS),
+    "disc_clutch_radial_stiffness": ("N/m", "disc clutch radial stiffness (x and z)", _POS),
+    "disc_clutch_tilt_stiffness": ("N m/rad", "disc clutch tilting stiffness (about x and z)", _POS),
+    "claw_clutch_torsional_stiffness": ("N m/rad", "claw clutch torsional stiffness k_CC", _POS),
+    "claw_clutch_axial_stiffness": ("N/m", "claw clutch axial stiffness", _POS),
+    "claw_clutch_radial_stiffness": ("N/m", "claw clutch radial stiffness (x and z)", _POS),
+    "claw_clutch_tilt_stiffness": ("N m/rad", "claw clutch tilting stiffness (about x and z)", _POS),
+    "rim_radial_stiffness": ("N/m", "wheel rim to disc radial stiffness (x and z)", _POS),
+    "rim_axial_stiffness": ("N/m", "wheel rim to disc axial stiffness (y)", _POS),
+    "rim_torsional_stiffness": ("N m/rad", "wheel rim to disc torsional stiffness (about the axle)", _POS),
+    "rim_tilt_stiffness": ("N m/rad", "wheel rim to disc tilting stiffness (about x and z)", _POS),
+    "silent_block_stiffness_x": ("N/m", "silent block stiffness, longitudinal, per block", _POS),
+    "silent_block_stiffness_y": ("N/m", "silent block stiffness, lateral, per block", _POS),
+    "silent_block_stiffness_z": ("N/m", "silent block stiffness, vertical, per block", _POS),
+    "primary_stiffness_x": ("N/m", "longitudinal wheelset guide stiffness per axle box", _POS),
+    "primary_stiffness_y": ("N/m", "primary lateral stiffness per axle box", _POS),
+    "primary_stiffness_z": ("N/m", "primary vertical stiffness per axle box", _POS),
+    "secondary_stiffness_x": ("N/m", "secondary longitudinal stiffness per spring (incl. traction link share)", _POS),
+    "secondary_stiffness_y": ("N/m", "secondary lateral stiffness per spring", _POS),
+    "secondary_stiffness_z": ("N/m", "secondary vertical stiffness per spring", _POS),
+    "track_stiffness": ("N/m", "track stiffness k_R under each wheel (eq. 11)", _POS),
+    # --- damping -----------------------------------------------------------------------------------
+    "primary_damping_z": ("N s/m", "primary vertical damper per axle box", _NONNEG),
+    "secondary_damping_z": ("N s/m", "secondary vertical damper per spring position", _NONNEG),
+    "secondary_damping_y": ("N s/m", "secondary lateral damper per bogie side", _NONNEG),
+    "yaw_damping": ("N s/m", "longitudinal (yaw) damper per bogie side", _NONNEG),
+    "track_damping": ("N s/m", "track damping b_R under each wheel (eq. 11)", _NONNEG),
+    "shaft_loss_time": ("s", "stiffness-proportional damping of steel parts", (0.0, 1.0, True)),
+    "rubber_loss_time": ("s", "stiffness-proportional damping of rubber parts", (0.0, 1.0, True)),
+    "motor_slope": ("N m s/rad", "b_M: falling slope of the healthy motor's torque-speed characteristic", _NONNEG),
+}
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """A complete, validated parameter set (SI units)."""
+
+    values: Mapping[str, float]  # name -> value in the schema's unit
+    notes: Mapping[str, str] = field(default_factory=dict)  # name -> provenance note
+    source: str = "<memory>"  # file it was read from
+
+    def __getitem__(self, name: str) -> float:
+        return self.values[name]
+
+    def replace(self, **changes: float) -> Parameters:
+        """A copy with some values changed (validated)."""
+        values = dict(self.values)
+        for name, value in changes.items():
+            values[name] = _check_value(name, value)
+        return Parameters(values, self.notes, self.source)
+
+
+def parameter_hash(parameters: Parameters) -> str:
+    """SHA-256 (hex) of the values of a parameter set: names in schema order, each value as the
+    shortest decimal that round-trips (``repr``).  Notes and the source file do not count: two
+    sets with equal values have equal hashes.  Results of studies carry it, and a stored study
+    is resumed only with the same hash."""
+    canonical = json.dumps([[name, repr(float(parameters.values[name]))] for name in SCHEMA],
+                           separators=(",", ":"))
+    return hashlib.sha256(canonical.encode("utf-8")).hexdigest()
+
+
+def _check_value(name: str, value: object) -> float:
+    if name not in SCHEMA:
+        raise ParameterError(f"unknown parameter '{name}'; allowed: see model/mechanics/parameters.py SCHEMA")
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ParameterError(f"parameter '{name}' must be a number, got {value!r}")
+    value = float(value)
+    unit, _, (low, high, low_allowed) = SCHEMA[name]
+    if not math.isfinite(value):
+        raise ParameterError(f"parameter '{name}' must be finite, got {value}")
+    if not (low < value <= high or (low_allowed and value == low)):
+        bracket = "[" if low_allowed else "("
+        raise ParameterError(
+            f"parameter '{name}' = {value} {unit} is outside {bracket}{low}, {high}]")
+    return value
+
+
+def parse_parameters(table: Mapping[str, object], source: str = "<memory>") -> Parameters:
+    """Validate a parsed TOML table into :class:`Parameters` (raises :class:`ParameterError`)."""
+    values: dict[str, float] = {}
+    notes: dict[str, str] = {}
+    for name, entry in table.items():
+        if name not in SCHEMA:
+            raise ParameterError(f"{source}: unknown parameter '{name}'")
+        if not isinstance(entry, Mapping) or "value" not in entry or "unit" not in entry:
+            raise ParameterError(
+                f"{source}: parameter '{name}' must be a table {{ value = …, unit = \"…\", note = \"…\" }}")
+        unit = SCHEMA[name][0]
+        if entry["unit"] != unit:
+            raise ParameterError(
+                f"{source}: parameter '{name}' has unit '{entry['unit']}', expected '{unit}'")
+        try:
+            values[name] = _check_value(name, entry["value"])
+        except ParameterError as error:
+            raise ParameterError(f"{source}: {error}") from None
+        notes[name] = str(entry.get("note", ""))
+    missing = [name for name in SCHEMA if name not in values]
+    if missing:
+        hint = ""
+        if "yaw_damper_height" in missing:  # a set written before the parameter existed
+            hint = ("; yaw_damper_height (m, added with the calibration by rank) was the "
+                    "secondary spring height in earlier sets: yaw_damper_height = { value = "
+                    "<secondary_height>, unit = \"m\" } reproduces them")
+        raise ParameterError(f"{source}: missing parameter(s) {', '.join(missing)}{hint}")
+    if values["polach_kS"] > values["polach_kA"]:
+        raise ParameterError(f"{source}: polach_kS must not exceed polach_kA")
+    if values["hollow_shaft_inner_radius"] >= values["hollow_shaft_outer_radius"]:
+        raise ParameterError(f"{source}: hollow_shaft_inner_radius must be below the outer radius")
+    return Parameters(values, notes, source)
+
+
+def load_parameters(path: str | Path | None = None) -> Parameters:
+    """Read a parameter file; ``None`` gives the calibrated default set."""
+    path = Path(path) if path is not None else CALIBRATED_FILE
+    if not path.is_file():
+        raise ParameterError(f"parameter file '{path}' does not exist")
+    try:
+        table = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise ParameterError(f"parameter file '{path}' is not valid TOML: {error}") from None
+    return parse_parameters(table, source=str(path))
+
+
+def _toml_string(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def dumps_parameters(parameters: Parameters, header: str = "") -> str:
+    """TOML text of a parameter set, in schema order, each value with unit and note."""
+    lines = [f"# {line}" if line else "#" for line in header.splitlines()]
+    if lines:
+        lines.append("")
+    for name, (unit, _, _) in SCHEMA.items():
+        value = parameters.values[name]
+        note = parameters.notes.get(name, "")
+        lines.append(f"{name} = {{ value = {value!r}, unit = {_toml_string(unit)}, "
+                     f"note = {_toml_string(note)} }}")
+    return "\n".join(lines) + "\n"
+
+
+def save_parameters(parameters: Parameters, path: str | Path, header: str = "") -> None:
+    """Write a parameter set as TOML (see :func:`dumps_parameters`)."""
+    Path(path).write_text(dumps_parameters(parameters, header), encoding="utf-8")
