@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The project's two commands (see README.md):
 #   bash run.sh app    -> install into .venv (first time) and serve the dashboard on http://localhost:5006/app
-#   bash run.sh test   -> install into .venv (+ Debian's chromium) and run ruff and the whole test suite
+#   bash run.sh test   -> install into .venv (+ Debian's chromium) and run ruff, the import contract and
+#                         the whole test suite
 set -euo pipefail
 cd "$(dirname "$0")"
 PY=${PYTHON:-python3}
@@ -37,6 +38,7 @@ case "${1:-}" in
             DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium buildah debootstrap >/dev/null
         fi
         "$VENV/bin/ruff" check model app tests scripts
+        "$VENV/bin/lint-imports"  # the import contract of pyproject.toml (docs/architecture.md)
         exec "$VENV/bin/python" -m pytest "$@"
         ;;
     *)

@@ -64,7 +64,8 @@ def app_server():
     import panel as pn
     from panel.io.state import state
 
-    from app.server.serve import create_app, limit_blas_threads
+    from app.server.serve import create_app
+    from app.services.thread_pools import limit_blas_threads
 
     limit_blas_threads()
     server_id = f"bogie-test-{uuid.uuid4().hex[:8]}"

@@ -38,7 +38,7 @@ def run(argv: list[str], capsys) -> tuple[int, str, str]:
 
 
 def run_process(argv: list[str], timeout: float = 300) -> subprocess.CompletedProcess:
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}  # see app.server.serve.limit_blas_threads
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}  # see app.services.thread_pools.limit_blas_threads
     return subprocess.run([sys.executable, "-m", "app", *argv], capture_output=True, text=True,
                           timeout=timeout, check=False, env=env)
 

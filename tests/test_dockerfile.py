@@ -123,13 +123,19 @@ def test_dockerignore_keeps_the_venv_git_and_caches_out():
     assert not ignored & {"model", "app", "assets", "pyproject.toml", "README.md"}
 
 
-def test_serve_origins_from_the_environment(monkeypatch):
+def test_serve_origins_from_the_environment(monkeypatch, tmp_path):
     """app.server.serve.serve(): BOGIE_ALLOWED_ORIGINS (default localhost only), liveness on."""
     pn = pytest.importorskip("panel")
     import app.server.serve
     from app.server.serve import serve
+    from app.services import settings as server_settings
+    from app.services import study_queue
 
-    monkeypatch.setattr(app.server.serve, "limit_blas_threads", lambda: None, raising=False)
+    monkeypatch.setattr(app.server.serve, "limit_blas_threads", lambda: None)
+    # the process's settings and study queue as they were (serve() installs its own)
+    monkeypatch.setattr(server_settings, "_current", server_settings._current)
+    monkeypatch.setattr(study_queue, "_QUEUE", study_queue._QUEUE)
+    settings = server_settings.ServerSettings(studies_dir=tmp_path / "studies")
 
     calls, handlers, stops = [], {}, []
     monkeypatch.setattr(pn, "serve", lambda *args, **kwargs: calls.append(kwargs))
@@ -138,7 +144,7 @@ def test_serve_origins_from_the_environment(monkeypatch):
     monkeypatch.setattr(app.server.serve, "_stop_now", lambda *args: stops.append(args))
 
     monkeypatch.delenv("BOGIE_ALLOWED_ORIGINS", raising=False)
-    serve(port=5123.0, address="0.0.0.0")  # the command line gives a float
+    serve(port=5123.0, address="0.0.0.0", settings=settings)  # the command line gives a float
     assert calls[-1]["websocket_origin"] == ["localhost:5123", "127.0.0.1:5123"]
     assert calls[-1]["liveness"] is True
     assert calls[-1]["address"] == "0.0.0.0"
@@ -148,8 +154,8 @@ def test_serve_origins_from_the_environment(monkeypatch):
     assert len(stops) == 1  # and so does the end of pn.serve (Ctrl-C: Panel stops its loop)
 
     monkeypatch.setenv("BOGIE_ALLOWED_ORIGINS", " bogie.example.org , localhost:8080,")
-    serve(port=5006)
+    serve(port=5006, settings=settings)
     assert calls[-1]["websocket_origin"] == ["bogie.example.org", "localhost:8080"]
 
-    serve(port=5006, allow_websocket_origin=["cli.example.org"])  # the option wins
+    serve(port=5006, allow_websocket_origin=["cli.example.org"], settings=settings)  # the option wins
     assert calls[-1]["websocket_origin"] == ["cli.example.org"]

@@ -72,7 +72,7 @@ def build_report(set_key: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
                  progress=None, now: datetime.datetime | None = None) -> str:
     """The report as one HTML text.  Arguments as in :mod:`app.results.compute` (``set_key``: the
     parameter set, a bundled file or a variant of it, :mod:`app.results.variants`)."""
-    from app.dashboard.dashboard import eigen_table_html, mode_table_html, peaks_html
+    from app.results.tables import eigen_table_html, mode_table_html, peaks_html
 
     say = progress or (lambda _text: None)
     point_args = (set_key, rail, s0, v_kmh, N0_kN, b_M)

@@ -11,28 +11,9 @@ from __future__ import annotations
 import os
 import threading
 
+from app.services.thread_pools import limit_blas_threads
+
 TITLE = "Bogie drive dynamics"
-
-
-_BLAS_LIMITED = threading.Lock()
-_blas_limited = False
-
-
-def limit_blas_threads() -> None:
-    """One BLAS thread per computation, set once per process before any computation thread
-    starts (never per call from worker threads: OpenBLAS's thread count is process-wide).  The
-    dashboard runs computations of several sessions in parallel, and OpenBLAS's own threads on a
-    busy 2-core machine made a single eigen-analysis 30-90x slower (measured: 0.2 s vs 9-18 s)."""
-    global _blas_limited
-    with _BLAS_LIMITED:
-        if _blas_limited:
-            return
-        import numpy  # noqa: F401 - load both BLAS libraries before limiting them
-        import scipy.linalg  # noqa: F401
-        from threadpoolctl import threadpool_limits
-
-        threadpool_limits(1)
-        _blas_limited = True
 
 
 def create_app(params: str | None = None):
