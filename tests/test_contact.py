@@ -183,3 +183,24 @@ def test_kalker_creep_coefficients_scale_with_the_contact_size():
     # c ∝ N^(1/3): f22 ∝ N^(2/3) at a fixed ellipse shape
     k8 = kalker_creep_coefficients(8 * N, r_wheel, r_rail, E, nu)
     assert k8.f22 / k.f22 == pytest.approx(4.0, rel=1e-10)
+
+
+def test_polach_one_law_real_and_complex_branches_agree():
+    """The one implementation of Polach's law (used by PolachLaw and by the nonlinear step loop):
+    its ∂μ/∂s equals the complex-step derivative of its own μ (the complex branch continues |s|
+    as sign(Re s)·s), and it is odd in s.  Complex step h = 1e-30: no subtraction, so agreement
+    to rounding (1e-12 relative) is expected."""
+    from model.contact.creep import polach_mu_and_slope
+
+    law = (0.45, 0.4, 0.6, 0.9, 0.3, 250.0)  # mu0, A, B [s/m], kA, kS, slope
+    v = 120 / 3.6
+    s = np.concatenate([-np.logspace(-6, 0, 40), np.logspace(-6, 0, 40)])
+    mu, dmu = polach_mu_and_slope(s, v, *law)
+    h = 1e-30
+    mu_c, _ = polach_mu_and_slope(s + 1j * h, v, *law)
+    np.testing.assert_allclose(mu_c.real, mu, rtol=1e-14)
+    np.testing.assert_allclose(mu_c.imag / h, dmu, rtol=1e-12)
+    mu_neg, dmu_neg = polach_mu_and_slope(-s, v, *law)
+    np.testing.assert_allclose(mu_neg, -mu, rtol=1e-14)
+    np.testing.assert_allclose(dmu_neg, dmu, rtol=1e-14)
+    assert polach_mu_and_slope(0.0, v, *law)[0] == 0.0

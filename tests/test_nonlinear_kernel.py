@@ -25,19 +25,6 @@ def bogie():
     return parameters, build_model(parameters)
 
 
-def test_polach_matches_the_law(bogie):
-    """The vectorised law of the loop is the model's PolachLaw (both branches, both signs)."""
-    parameters, _ = bogie
-    from model.mechanics.operating_point import creep_law
-
-    law = creep_law(parameters)
-    s = np.concatenate([-np.logspace(-6, 0, 50), [0.0], np.logspace(-6, 0, 50)])
-    v = 120 / 3.6
-    mu, dmu = kernel.polach(s, v, law.mu0, law.A, law.B, law.kA, law.kS, law.slope)
-    np.testing.assert_allclose(mu, law.mu(s, v), rtol=1e-13, atol=1e-15)
-    np.testing.assert_allclose(dmu, law.dmu_ds(s, v), rtol=1e-12, atol=1e-12)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize(("s0", "anti_slip"), [(0.005, None),
                                                (0.014, AntiSlip(delay=0.0, threshold=0.05))])

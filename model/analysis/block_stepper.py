@@ -32,32 +32,11 @@ import math
 import numpy as np
 from scipy.linalg import get_lapack_funcs
 
+from model.contact.creep import polach_mu_and_slope
+
 SUB_STEPS = 32  # steps solved together
 TOLERANCE = 1e-12  # relative change of the channel values at which Newton stops
 MAX_ITERATIONS = 40  # per block before it is halved
-
-
-def polach(s: np.ndarray, v: float, mu0: float, A: float, B: float, kA: float, kS: float,
-           slope: float) -> tuple[np.ndarray, np.ndarray]:
-    """Polach's μ(s, v) [-] and ∂μ/∂s [-] (as :class:`model.contact.creep.PolachLaw`: odd in s,
-    friction falling with the slip velocity |s|·v [m/s])."""
-    Bv = B * v
-    decay = np.exp(-Bv * np.abs(s))
-    c1 = mu0 * (1.0 - A)
-    mu_f = c1 * decay + mu0 * A
-    dmu_f = np.copysign(decay, s)  # sign(s)·decay; at s = 0 its factor F is 0 either way
-    dmu_f *= -c1 * Bv
-    inverse = 1.0 / mu_f
-    eps = (slope * s) * inverse
-    deps = (slope - eps * dmu_f) * inverse
-    a = kA * eps
-    k = kS * eps
-    a2 = a * a
-    aa = 1.0 + a2
-    F = a / aa + np.arctan(k)
-    dF = kA * (1.0 - a2) / (aa * aa) + kS / (1.0 + k * k)
-    c = 2.0 / math.pi
-    return c * mu_f * F, c * (dmu_f * F + mu_f * dF * deps)
 
 
 def _toeplitz(W: np.ndarray, E: np.ndarray, Q: np.ndarray, D1: np.ndarray, L: int) -> np.ndarray:
@@ -136,7 +115,7 @@ def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, 
     scale = float(contact_scale)
     slope = np.zeros(nc)  # r'(z) of the given step (Newton's start of the first block)
     if not tangent:
-        slope[creep] = N0 / v * (polach(s0 + z[creep] / v, v, *law)[1] - dmu_s0)
+        slope[creep] = N0 / v * (polach_mu_and_slope(s0 + z[creep] / v, v, *law)[1] - dmu_s0)
     state = _LoopState(zeta.copy(), phi.copy(), z.copy(), float(u2_now), float(det_state[0]),
                        slope)
     basis = np.vstack([cp, cm, p0_2, p1_2]).astype(complex)  # 4 x m
@@ -230,7 +209,7 @@ def _block(state, kb, L, row0, h, blocks, E, inc_step, basis, g_step, g0, P0, la
         if tangent:
             r[is_creep] = N0 * ((mu_s0 + dmu_s0 * (zc / v)) - mu_s0) - tangent_slope * zc
         else:
-            mu_v, dmu_v = polach(s0 + zc / v, v, *law)
+            mu_v, dmu_v = polach_mu_and_slope(s0 + zc / v, v, *law)
             r[is_creep] = N0 * (mu_v - mu_s0) - tangent_slope * zc
             dr[is_creep] = N0 / v * (dmu_v - dmu_s0)
         r[~is_creep] = slope_scale * zf[~is_creep]

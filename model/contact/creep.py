@@ -124,31 +124,17 @@ class PolachLaw:
     kS: float  # [-]
     slope: float  # [-] initial creep slope (dμ/ds at s = 0 is (2/π)(kA + kS) slope μ_f/μ_f)
 
-    def _parts(self, s, v):
-        s = np.asarray(s)
-        s = s.astype(complex if np.iscomplexobj(s) else float)  # complex step (model.analysis.sensitivity)
-        # friction falls with the slip speed |s v|; for a complex step (about s ≠ 0) |s| is
-        # continued analytically as sign(Re s)·s
-        sign = np.sign(s.real)
-        decay = np.exp(-self.B * sign * s * v)
-        mu_f = self.mu0 * ((1 - self.A) * decay + self.A)
-        dmu_f = self.mu0 * (1 - self.A) * decay * (-self.B * v) * sign
-        eps = self.slope * s / mu_f
-        deps = self.slope / mu_f - self.slope * s * dmu_f / mu_f**2
-        a, k = self.kA * eps, self.kS * eps
-        F = a / (1 + a * a) + np.arctan(k)
-        dF = self.kA * (1 - a * a) / (1 + a * a) ** 2 + self.kS / (1 + k * k)
-        return mu_f, dmu_f, eps, deps, F, dF
+    def coefficients(self) -> tuple[float, float, float, float, float, float]:
+        """(mu0, A, B, kA, kS, slope): the arguments of :func:`polach_mu_and_slope`."""
+        return self.mu0, self.A, self.B, self.kA, self.kS, self.slope
 
     def mu(self, s, v):
         """Adhesion coefficient μ(s, v) [-] at creepage s [-] and speed v [m/s]."""
-        mu_f, _, _, _, F, _ = self._parts(s, v)
-        return 2 / np.pi * mu_f * F
+        return polach_mu_and_slope(s, v, *self.coefficients())[0]
 
     def dmu_ds(self, s, v):
         """∂μ/∂s at (s, v) [-]."""
-        mu_f, dmu_f, _, deps, F, dF = self._parts(s, v)
-        return 2 / np.pi * (dmu_f * F + mu_f * dF * deps)
+        return polach_mu_and_slope(s, v, *self.coefficients())[1]
 
     def maximum(self, v: float) -> tuple[float, float]:
         """(s at the creep maximum, μ_max) at speed v [m/s]."""
@@ -160,6 +146,38 @@ class PolachLaw:
                 raise ValueError("creep law has no maximum below s = 1")
         s_max = brentq(f, lo, hi, xtol=1e-14, rtol=1e-12)
         return s_max, float(self.mu(s_max, v))
+
+
+def polach_mu_and_slope(s, v: float, mu0: float, A: float, B: float, kA: float, kS: float,
+                        slope: float):
+    """Polach's μ(s, v) [-] and ∂μ/∂s [-] (:class:`PolachLaw`), for a creepage s [-] (scalar or
+    array; real, or complex for a complex-step derivative: |s| is then continued analytically as
+    sign(Re s)·s) at the speed v [m/s].  The one implementation of the law: the nonlinear step
+    loop calls it every Newton iteration on a few wheels, so it is written with few array
+    operations."""
+    s = np.asarray(s)
+    if np.iscomplexobj(s):
+        sign = np.sign(s.real)
+        decay = np.exp(-(B * v) * (sign * s))
+        signed_decay = sign * decay
+    else:  # (a parameter may still be complex: a complex step in B, v …)
+        s = s.astype(float, copy=False)
+        decay = np.exp(-(B * v) * np.abs(s))
+        signed_decay = np.sign(s) * decay  # at s = 0 its factor F is 0 anyway
+    c1 = mu0 * (1.0 - A)
+    mu_f = c1 * decay + mu0 * A  # friction falling with the slip speed |s| v
+    dmu_f = signed_decay * (-c1 * B * v)
+    inverse = 1.0 / mu_f
+    eps = (slope * s) * inverse
+    deps = (slope - eps * dmu_f) * inverse
+    a = kA * eps
+    k = kS * eps
+    a2 = a * a
+    aa = 1.0 + a2
+    F = a / aa + np.arctan(k)
+    dF = kA * (1.0 - a2) / (aa * aa) + kS / (1.0 + k * k)
+    c = 2.0 / math.pi
+    return c * mu_f * F, c * (dmu_f * F + mu_f * dF * deps)
 
 
 CREEP_PRESETS = {
