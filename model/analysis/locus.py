@@ -222,7 +222,12 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     operating point ``op`` stay fixed.  ``workers`` threads solve the reduced eigenproblems
     (default 2, the cores of the target machine).  A real eigenvalue inside the disc that meets a
     real one outside it continues as one half of the new complex pair (the other half is not
-    tracked); pairs that start complex stay conjugate pairs."""
+    tracked); pairs that start complex stay conjugate pairs.
+
+    Stages: the start of the sweep (both ends solved exactly, the reduction basis; kept for a
+    repeated sweep), the reduced solutions of the inner points (on worker threads), the tracking
+    point by point (Newton refinement or an exact solve where the reduced one is not accurate
+    enough), and keeping the start for the next call."""
     if parameter not in ("s0", "v"):
         raise ValueError(f"parameter must be 's0' or 'v', got '{parameter}'")
     values = np.asarray(values, dtype=float)
@@ -230,59 +235,83 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
         raise ValueError("need at least two finite parameter values")
     points = [replace(op, **{parameter: float(x)}) for x in values]  # validates each point
     coefficients = np.array([_coefficients(model, p) for p in points])
-    patterns = creep_patterns(model)
     radius = 2 * np.pi * max_frequency_hz
-    controlled = 1.5 * radius  # accuracy is enforced for branches inside this disc
-    n, n_points = model.n, len(values)
+    key = _sweep_start_key(model, points[0], points[-1], radius)
+    start = _sweep_start(model, op, points, key, radius, workers)
+    inner_keys = [c.tobytes() for c in coefficients[1:-1]]
+    solution = _InnerSolutions(start, coefficients[1:-1], inner_keys, workers)
+    eigenvalues, errors, dense, refined = _track(model, points, coefficients, start, solution,
+                                                 radius, rtol)
+    _keep_sweep_start(key, start, inner_keys, solution.solved)
+    return RootLocus(parameter, values, eigenvalues, errors, dense, op, start.reduced.size,
+                     refined)
 
-    def exact(i: int):
-        result = eigen_analysis(model, points[i])
-        q = result.vectors[:n]
-        return result.eigenvalues, q / np.linalg.norm(q, axis=0)
+
+def _exact(model: BogieModel, point: OperatingPoint) -> tuple[np.ndarray, np.ndarray]:
+    """All eigenvalues at ``point`` [1/s] and their displacement parts, unit norm."""
+    result = eigen_analysis(model, point)
+    q = result.vectors[:model.n]
+    return result.eigenvalues, q / np.linalg.norm(q, axis=0)
+
+
+def _sweep_start(model: BogieModel, op: OperatingPoint, points: list, key, radius: float,
+                 workers: int) -> _SweepStart:
+    """The exact end points and the reduction basis of a sweep: the kept ones of an earlier
+    sweep with the same ends, else computed (both ends at once: numpy releases the GIL)."""
+    with _SWEEP_STARTS_LOCK:
+        start = _SWEEP_STARTS.get(key)
+        if start is not None and start.model is model:
+            _SWEEP_STARTS.move_to_end(key)
+            return start
+    if workers > 1:
+        last_future = _solver_pool(workers).submit(_exact, model, points[-1])
+        first = _exact(model, points[0])
+        last = last_future.result()
+    else:
+        first, last = _exact(model, points[0]), _exact(model, points[-1])
 
     def modes(lam, Q):
         chosen = Q[:, np.abs(lam) < radius]
         return [chosen.real, chosen.imag]
 
-    key = _sweep_start_key(model, points[0], points[-1], radius)
-    with _SWEEP_STARTS_LOCK:
-        start = _SWEEP_STARTS.get(key)
-        if start is not None and start.model is model:
-            _SWEEP_STARTS.move_to_end(key)
-        else:
-            start = None
-    if start is None:
-        # the two exact end points at once (they decide the basis; numpy releases the GIL)
+    reduced = _Reduced(model, op, creep_patterns(model),
+                       [model.rigid_body_modes, *modes(*first), *modes(*last)])
+    return _SweepStart(model, first, last, reduced, {})
+
+
+class _InnerSolutions:
+    """The reduced solutions of a sweep's inner points, asked for in order.  They do not depend
+    on each other: they are solved on ``workers`` threads (numpy's LAPACK calls release the GIL)
+    while the caller tracks the points in order as the solutions come in (tracking after all the
+    solves left a core idle for ≈ 0.8 s of a 200-point sweep); a point the kept start has solved
+    already is not solved again."""
+
+    def __init__(self, start: _SweepStart, inner: np.ndarray, keys: list[bytes], workers: int):
+        self.start, self.keys = start, keys
+        missing = [i for i, k in enumerate(keys) if k not in start.solutions]
+        self.unsolved = set(missing)
         if workers > 1:
-            last_future = _solver_pool(workers).submit(exact, n_points - 1)
-            first = exact(0)
-            last = last_future.result()
+            self.found = _solver_pool(workers).map(start.reduced.solve, inner[missing])
         else:
-            first, last = exact(0), exact(n_points - 1)
-        reduced = _Reduced(model, op, patterns,
-                           [model.rigid_body_modes, *modes(*first), *modes(*last)])
-        start = _SweepStart(model, first, last, reduced, {})
+            self.found = (start.reduced.solve(c) for c in inner[missing])
+        self.solved: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def __call__(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """The reduced solution (eigenvalues, reduced vectors) of inner point i."""
+        self.solved.append(next(self.found) if i in self.unsolved
+                           else self.start.solutions[self.keys[i]])
+        return self.solved[i]
+
+
+def _track(model: BogieModel, points: list, coefficients: np.ndarray, start: _SweepStart,
+           solution: _InnerSolutions, radius: float, rtol: float):
+    """(eigenvalues, error estimates, dense flags, refined count) of the tracked branches along
+    the sweep: each point's reduced solution is matched to the previous point's branches; the
+    few branches that are not accurate enough are refined by Newton's method in the full model,
+    and a point with too many (or an ambiguous match) is solved exactly."""
     first, last, reduced = start.first, start.last, start.reduced
-    # the reduced eigenproblems of the inner points do not depend on each other: they are solved
-    # on ``workers`` threads (numpy's LAPACK calls release the GIL) while this thread tracks and
-    # checks the points in order as their solutions come in (tracking after all the solves left
-    # a core idle for ≈ 0.8 s of a 200-point sweep); a point the kept start has solved already
-    # is not solved again
-    inner = coefficients[1:-1]
-    keys = [c.tobytes() for c in inner]
-    missing = [i for i, k in enumerate(keys) if k not in start.solutions]
-    if workers > 1:
-        found = _solver_pool(workers).map(reduced.solve, inner[missing])  # in order, as solved
-    else:
-        found = (reduced.solve(c) for c in inner[missing])
-    unsolved = set(missing)
-    solutions: list[tuple[np.ndarray, np.ndarray]] = []
-
-    def solution(i: int) -> tuple[np.ndarray, np.ndarray]:
-        """The reduced solution of inner point i (asked for in order)."""
-        solutions.append(next(found) if i in unsolved else start.solutions[keys[i]])
-        return solutions[i]
-
+    controlled = 1.5 * radius  # accuracy is enforced for branches inside this disc
+    n_points = len(points)
     tracked = np.flatnonzero(np.abs(first[0]) < radius)
     eigenvalues = np.zeros((n_points, len(tracked)), dtype=complex)
     errors = np.zeros((n_points, len(tracked)))
@@ -290,7 +319,6 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     eigenvalues[0], dense[0] = first[0][tracked], True
     previous_values, previous_vectors = first[0][tracked], first[1][:, tracked]
     refined = 0
-
     for i in range(1, n_points):
         if i != n_points - 1:
             lam, X = solution(i - 1)
@@ -300,7 +328,6 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
             values_i, vectors_i = lam[chosen], X_full[:, chosen]
             failing = np.flatnonzero((estimate > rtol) & (np.abs(values_i) < controlled))
             if ok and len(failing) <= max(2, len(chosen) // 4):
-                # refine the few inaccurate branches by Newton's method in the full model
                 C = damping_matrix(model, points[i]) if len(failing) else None
                 for b in failing:
                     values_i[b], vectors_i[:, b], estimate[b] = _newton(
@@ -310,18 +337,23 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
                     eigenvalues[i], errors[i] = values_i, estimate
                     previous_values, previous_vectors = values_i, vectors_i
                     continue
-        lam, Q = last if i == n_points - 1 else exact(i)  # dense: exact at this point
+        lam, Q = last if i == n_points - 1 else _exact(model, points[i])  # dense: exact here
         chosen, _ = _assign(previous_vectors, previous_values, Q, lam)
         eigenvalues[i], dense[i] = lam[chosen], True
         previous_values, previous_vectors = lam[chosen], Q[:, chosen]
+    return eigenvalues, errors, dense, refined
+
+
+def _keep_sweep_start(key, start: _SweepStart, inner_keys: list[bytes], solved: list) -> None:
+    """Keep the sweep's start (and, for a short sweep, its reduced solutions) for the next one."""
     with _SWEEP_STARTS_LOCK:
-        if len(inner) <= _SOLUTIONS_KEPT:
-            start = _SweepStart(model, first, last, reduced, dict(zip(keys, solutions, strict=True)))
+        if len(inner_keys) <= _SOLUTIONS_KEPT:
+            start = _SweepStart(start.model, start.first, start.last, start.reduced,
+                                dict(zip(inner_keys, solved, strict=True)))
         _SWEEP_STARTS[key] = start
         _SWEEP_STARTS.move_to_end(key)
         while len(_SWEEP_STARTS) > _SWEEP_STARTS_KEPT:
             _SWEEP_STARTS.popitem(last=False)
-    return RootLocus(parameter, values, eigenvalues, errors, dense, op, reduced.size, refined)
 
 
 def _newton(M, C, K, lam: complex, x: np.ndarray, rtol: float, iterations: int = 6,
