@@ -1,4 +1,4 @@
-"""Benchmark of the nonlinear response (issue 10): speed against scipy.signal.lsim on the linear
+"""Benchmark of the nonlinear response (docs/nonlinear.md): speed against scipy.signal.lsim on the linear
 system and against Radau on the same nonlinear system; accuracy against Radau at tight tolerance
 (short horizon) and by step halving (2 s).
 

@@ -1,4 +1,4 @@
-"""Dashboard latency of the nonlinear creep model in a real browser (issue 10 target: the
+"""Dashboard latency of the nonlinear creep model in a real browser (target: the
 nonlinear result on screen ≤ 1.5 s after a change, median; the linear path still ≤ 300 ms).
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/bench_nonlinear_app.py [--presses 12]

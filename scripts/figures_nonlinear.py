@@ -1,4 +1,4 @@
-"""Figures and numbers of the nonlinear response (issue 10, docs/nonlinear.md).
+"""Figures and numbers of the nonlinear response (docs/nonlinear.md).
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/figures_nonlinear.py [--params FILE]
         [--out assets/figures] [--quick]

@@ -1,4 +1,4 @@
-"""Write the golden regression file tests/golden/nonlinear.json (issue 10).
+"""Write the golden regression file tests/golden/nonlinear.json (the nonlinear response, docs/nonlinear.md).
 
     .venv/bin/python scripts/make_golden_nonlinear.py                 # the calibrated default set
     .venv/bin/python scripts/make_golden_nonlinear.py --params FILE   # another set

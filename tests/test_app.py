@@ -87,7 +87,7 @@ def test_views_show_the_current_point(dash):
     shown = np.array(dash.locus_plot.current.data["x"]) + 1j * np.array(
         dash.locus_plot.current.data["y"]) * 2 * np.pi
     # two dense eigen-solves of the same matrix (the dashboard's worker and this test) agree to
-    # about eps·κ(λ): on the re-calibrated set (issue 11) the heavily damped pair −11.4 ± 10.9j
+    # about eps·κ(λ): on the set calibrated by rank the heavily damped pair −11.4 ± 10.9j
     # differed by 4.3e-9 relative (1e-9 held on the previous set); 1e-7 is still 5 decades
     # below any difference between neighbouring modes
     np.testing.assert_allclose(shown, result.complex_pairs[: len(shown)], rtol=1e-7)

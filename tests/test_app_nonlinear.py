@@ -1,4 +1,4 @@
-"""Dashboard part of issue 10 without a browser: the creep-model switch, the anti-slip controls,
+"""The dashboard's nonlinear creep without a browser: the creep-model switch, the anti-slip controls,
 the overlays, the creepage paths and the required reaction time in the status.
 
 Expectations come from model/ (the dashboard must show what the model computes).  Tests that

@@ -1,4 +1,4 @@
-"""The dashboard as a design-review tool (issue 14), without a server: the dense root locus and
+"""The dashboard as a design-review tool, without a server: the dense root locus and
 Fig. 6, shareable URL state, design variants, the report, click-through modes and the fuzz of
 user input.
 

@@ -1,4 +1,4 @@
-"""The design-review features in headless Chromium (issue 14): the dense root locus and Fig. 6,
+"""The design-review features in headless Chromium: the dense root locus and Fig. 6,
 a shared link restoring the state (and a bad one giving a notice), design variants (upload,
 comparison), the offline report, and click-through modes.
 

@@ -5,7 +5,7 @@ catch a lost or wrong root.  Real components, no mocks.
 
 Tolerances.  Both sides carry rounding errors of the order of eps·‖A‖·cond(λ): ‖A‖ ≈ 3·10⁵ 1/s
 (|λ| up to 3·10⁵ 1/s), so the two computations of one eigenvalue differ by more than eps·|λ|.
-Measured on 100-point lines at 40, 120 and 250 km/h (the set calibrated by rank, issue 11): at
+Measured on 100-point lines at 40, 120 and 250 km/h (the set calibrated by rank): at
 most 2.6·10⁻⁸ / 1.9·10⁻⁸ / 1.5·10⁻⁸ relative to max(|λ|, 1 1/s), at the ill-conditioned
 near-twin eigenvalues (the ID1/ID2 twins near 3·10⁵ 1/s, closer on this set than on the previous
 one, which gave at most 6.5·10⁻⁹), largest real part within 3.4·10⁻⁹ 1/s.  EIG_RTOL = 8·10⁻⁸

@@ -125,7 +125,7 @@ def test_bad_tables_raise_parameter_error_naming_the_problem(table, how, message
 
 
 def test_a_set_from_before_the_yaw_damper_height_says_how_to_update_it(table):
-    """Sets written before issue 11 lack yaw_damper_height: the error names it and how to
+    """Sets written before the calibration by rank lack yaw_damper_height: the error names it and how to
     reproduce the earlier model (the dampers then sat at the secondary spring height)."""
     del table["yaw_damper_height"]
     with pytest.raises(ParameterError, match=r"missing parameter\(s\) yaw_damper_height;.*"

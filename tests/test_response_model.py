@@ -4,7 +4,7 @@ The reference is built only from the EXPORTED system (``bogie export`` arrays: M
 motor_torque, C_q, C_v) and eq. 23 written out again here: the state is augmented by its own
 generator of M_C (``[1, e^(−σt) sin(ω(t−Δt)), e^(−σt) cos(ω(t−Δt))]``) and stepped with
 ``Φ = expm(F/fs)`` one sample at a time (an exact discretization, no accumulation trick), and in
-the slow tests by scipy's Radau at tight tolerance.  Acceptance (issue 3): every output within
+the slow tests by scipy's Radau at tight tolerance.  Acceptance: every output within
 1e-5 of its peak |Δy|.
 """
 
@@ -23,7 +23,7 @@ from model.analysis.response import ResponseError, ShortCircuit, short_circuit_r
 from model.analysis.stability import stability_limit
 from model.mechanics.operating_point import OperatingPoint
 
-TOLERANCE = 1e-5  # of each output's peak |Δy| (issue 3)
+TOLERANCE = 1e-5  # of each output's peak |Δy| (the acceptance tolerance)
 
 
 @pytest.fixture(scope="module")

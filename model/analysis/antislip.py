@@ -1,4 +1,4 @@
-"""Required reaction time of the anti-slip protection (issue 10): how late may it act?
+"""Required reaction time of the anti-slip protection: how late may it act?
 
     from model.analysis.antislip import required_reaction_time
     r = required_reaction_time(model, op)          # default limit M_ad, delays 0 … 0.5 s

@@ -503,7 +503,7 @@ def character_cost(parameters: Parameters, threshold: float = math.inf) -> float
         math.log(e.driving_shaft.imag / (2 * np.pi) / DRIVING_SHAFT_HZ) / FREQUENCY_SCALE)
 
 
-# --- stages C–F: the ranking (issue 11) --------------------------------------------------------
+# --- stages C–F: the ranking (Table 1 by rank) --------------------------------------------------------
 # Stage B2 leaves the ten characters near their frequencies but not at their ranks: modes of other
 # characters (the frame's roll and yaw, the motors' pitch and opposite longitudinal motion) sit
 # among them below 12.6 Hz.  Stages C–F move those out and put the ten in Table 1's order, each a

@@ -14,7 +14,7 @@ the same continuation.  Against a full eigen-analysis at every point of 100-poin
 120 and 250 km/h: all eigenvalues within 6.5·10⁻⁹ relative, the counts identical
 (``scripts/bench_study.py --check-lines``, tests/test_continuation.py).
 
-The first method of issue 13, :func:`reduced_s0_line` (method "reduced", the default: it is
+The reduced method, :func:`reduced_s0_line` (method "reduced", the default: it is
 cheaper, see BENCHMARKS.md), reuses one Galerkin-reduced model (:class:`model.analysis.locus._Reduced`)
 per line and costs one dense eigen-analysis with vectors (the *anchor*: the last creepage), two
 without (the first creepage and the grid creepage of the most negative b11, the steepest falling
@@ -32,7 +32,7 @@ shifts σ are −1 1/s (the low-frequency part), the top eigenvalue of each dens
 anchor's selected modes (relative gap ≤ ``TWIN_GAP``: the ID1/ID2 twins, which the creep splits;
 without these shifts one twin of the ≈ 37 Hz pair had no Ritz value between the checked points
 and three test lines came out with 2 flutter pairs too few).  Measured: 59–66 columns instead
-of 69–71 for the exact eigenvectors at both ends (BENCHMARKS.md, "Issue 13, tenth session").
+of 69–71 for the exact eigenvectors at both ends (BENCHMARKS.md, "Parameter studies on Dask").
 The dense eigenvalues at the first creepage and at the b11 minimum check the basis: every
 eigenvalue there that the selection would take must have a Ritz value within
 10⁻⁴·max(|λ|, 1 1/s); if one has none, the basis falls back to the exact eigenvectors at both
@@ -503,7 +503,7 @@ def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
     default: :func:`reduced_s0_line`, ``max_frequency_hz`` and ``rtol`` apply) or "dense"
     (:func:`dense_line`).  The default stays "reduced" because it is cheaper: measured on the
     shared machine, a map point cost 0.35 of an eigenvalues-only analysis with "reduced" and
-    1.26 with "continuation" (BENCHMARKS.md, issue 13); in the tenth session 0.18–0.19 with
+    1.26 with "continuation" (BENCHMARKS.md); in the tenth session 0.18–0.19 with
     "reduced" and 20–26 ms a point (≈ 0.8) with "continuation"."""
     if method == "reduced":
         return reduced_s0_line(model, s0_values, v, N0, b_M, max_frequency_hz, rtol,
@@ -540,7 +540,7 @@ def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
 def reduced_s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
                     max_frequency_hz: float = 10.0, rtol: float = 1e-6,
                     s0_limit_xtol: float = 1e-6) -> LineResult:
-    """The Galerkin-reduced line (issue 13's first method, ``s0_line``'s default): largest
+    """The Galerkin-reduced line (``s0_line``'s default method): largest
     real part, flutter pairs and divergent reals at every creepage of ``s0_values``
     (increasing) at speed ``v`` [m/s], wheel force ``N0`` [N], motor slope ``b_M``
     [N m s/rad]; and s0* inside the line's range on the same evaluation (secant steps in a
