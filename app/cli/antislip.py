@@ -167,17 +167,14 @@ def write_result(result, path: Path) -> None:
     write_series(path, result.t, result.M_C, series(result), result.steady, summary_data(result))
 
 
-def cmd_nonlinear_response(args: argparse.Namespace, excitation, names, out: Path | None) -> None:
-    """The ``--creep nonlinear|tangent`` branch of ``bogie response``."""
+def nonlinear_history(args: argparse.Namespace, excitation, names):
+    """The ``--creep nonlinear|tangent`` history of ``bogie response`` and ``bogie spectrum``."""
     from model.analysis.nonlinear import nonlinear_response
 
     anti_slip = anti_slip_from(args) if args.anti_slip == "on" else None
     model, op, _ = load_model(args)
-    result = nonlinear_response(model, op, excitation, args.t_end, args.fs, creep=args.creep,
-                                anti_slip=anti_slip, outputs=names, strength=args.strength)
-    from app.cli.response import finish  # (response_cli imports this module)
-
-    finish(args, result, out, write_result, summary_data, summary_table)
+    return nonlinear_response(model, op, excitation, args.t_end, args.fs, creep=args.creep,
+                              anti_slip=anti_slip, outputs=names, strength=args.strength)
 
 
 # --- bogie antislip ------------------------------------------------------------------------------

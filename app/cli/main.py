@@ -366,6 +366,10 @@ from app.cli.report import register as _register_report  # noqa: E402
 
 EXTRA_COMMANDS.append(_register_report)
 
+from app.cli.loads import register as _register_loads  # noqa: E402 - envelope, spectrum
+
+EXTRA_COMMANDS.append(_register_loads)
+
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from app.cli.antislip import add_creep_arguments, check_creep_arguments, cmd_nonlinear_response
+from app.cli.antislip import add_creep_arguments, check_creep_arguments, nonlinear_history
 from app.cli.main import UsageError, add_operating_point, emit, load_model, number
 
 MIN_SAMPLES_PER_PERIOD = 2.5  # fs must exceed 2.5 × the highest excited frequency
@@ -27,6 +27,13 @@ MIN_SAMPLES_PER_PERIOD = 2.5  # fs must exceed 2.5 × the highest excited freque
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("response", help="short-circuit time response of the drive loads")
+    add_response_options(p)
+    p.add_argument("--out", default=None, help="write .npz, .csv or .json")
+    p.set_defaults(func=cmd_response)
+
+
+def add_response_options(p: argparse.ArgumentParser) -> None:
+    """Every option of ``bogie response`` but ``--out`` (shared with ``bogie spectrum``)."""
     add_operating_point(p)
     p.add_argument("--m0", type=number("--m0 (amplitude, N m)", 0, 1e8, low_open=False,
                                        allowed="must be in [0, 1e8] N m"),
@@ -40,6 +47,13 @@ def register(subparsers) -> None:
     p.add_argument("--phase", type=number("--phase (Δt, s)", -10, 10, low_open=False,
                                           high_open=False, allowed="must be in [-10, 10] s"),
                    default=None, help="time shift Δt [s] (default: continuous motor torque)")
+    add_time_options(p)
+    add_creep_arguments(p)  # issue 10: --creep, --anti-slip …
+
+
+def add_time_options(p: argparse.ArgumentParser) -> None:
+    """``--t-end``, ``--fs``, ``--outputs`` and ``--method`` (``bogie response``, ``bogie
+    spectrum``, ``bogie envelope``)."""
     p.add_argument("--t-end", type=number("--t-end (horizon, s)", 0, 60, high_open=False,
                                           allowed="must be in (0, 60] s"),
                    default=2.0, help="horizon [s] (default %(default)s)")
@@ -50,12 +64,28 @@ def register(subparsers) -> None:
                    help="comma-separated output or DOF names (default: all loads)")
     p.add_argument("--method", choices=("auto", "modal", "expm"), default="auto",
                    help="evaluation of the closed form (default %(default)s)")
-    p.add_argument("--out", default=None, help="write .npz, .csv or .json")
-    add_creep_arguments(p)  # issue 10: --creep, --anti-slip …
-    p.set_defaults(func=cmd_response)
 
 
-def _check_out(path: str | None) -> Path | None:
+def check_sampling(args: argparse.Namespace, frequency_hz: float,
+                   what: str = "the excitation at f") -> None:
+    """Refuse ``--fs`` below 2.5 × ``frequency_hz`` and more than 2·10⁶ samples."""
+    if args.fs < MIN_SAMPLES_PER_PERIOD * frequency_hz:
+        raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve {what} = "
+                         f"{frequency_hz:.4g} Hz: must be at least "
+                         f"{MIN_SAMPLES_PER_PERIOD * frequency_hz:.4g} Hz")
+    if args.t_end * args.fs > 2_000_000:
+        raise UsageError(f"--t-end × --fs = {args.t_end * args.fs:.0f} samples is too many: at "
+                         "most 2000000")
+
+
+def output_names(args: argparse.Namespace) -> list[str] | None:
+    """The names of ``--outputs`` (None: all loads)."""
+    if args.outputs is None:
+        return None
+    return [s.strip() for s in args.outputs.split(",") if s.strip()]
+
+
+def check_out(path: str | None) -> Path | None:
     if path is None:
         return None
     out = Path(path)
@@ -68,9 +98,24 @@ def _check_out(path: str | None) -> Path | None:
 
 
 def cmd_response(args: argparse.Namespace) -> None:
+    out = check_out(args.out)
+    result = history_from_args(args)
+    if args.creep != "linear":
+        from app.cli.antislip import summary_data as nonlinear_summary
+        from app.cli.antislip import summary_table as nonlinear_table
+        from app.cli.antislip import write_result as write_nonlinear
+
+        finish(args, result, out, write_nonlinear, nonlinear_summary, nonlinear_table)
+        return
+    finish(args, result, out, write_result, summary_data, summary_table)
+
+
+def history_from_args(args: argparse.Namespace):
+    """The response the options of ``bogie response`` describe: a
+    :class:`model.analysis.response.ResponseResult` (``--creep linear``) or a
+    :class:`model.analysis.nonlinear.NonlinearResult`; bad options raise :class:`UsageError`."""
     from model.analysis.response import ShortCircuit, short_circuit_response
 
-    out = _check_out(args.out)
     check_creep_arguments(args)
     defaults = ShortCircuit()
     excitation = ShortCircuit(
@@ -78,26 +123,16 @@ def cmd_response(args: argparse.Namespace) -> None:
         f=defaults.f if args.f is None else args.f,
         D=defaults.D if args.decay is None else args.decay,
         dt=args.phase)
-    if args.fs < MIN_SAMPLES_PER_PERIOD * excitation.f:
-        raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the excitation at "
-                         f"f = {excitation.f:g} Hz: must be at least "
-                         f"{MIN_SAMPLES_PER_PERIOD * excitation.f:g} Hz")
-    if args.t_end * args.fs > 2_000_000:
-        raise UsageError(f"--t-end × --fs = {args.t_end * args.fs:.0f} samples is too many: at "
-                         "most 2000000")
-    names = None if args.outputs is None else [s.strip() for s in args.outputs.split(",")
-                                                if s.strip()]
+    check_sampling(args, excitation.f)
+    names = output_names(args)
     if args.creep != "linear":
-        cmd_nonlinear_response(args, excitation, names, out)
-        return
+        return nonlinear_history(args, excitation, names)
     model, op, _ = load_model(args)
     result = short_circuit_response(model, op, excitation, args.t_end, args.fs, names,
                                     method=args.method)
-    if result.highest_excited_hz and args.fs < MIN_SAMPLES_PER_PERIOD * result.highest_excited_hz:
-        raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the highest excited "
-                         f"frequency {result.highest_excited_hz:.4g} Hz: must be at least "
-                         f"{MIN_SAMPLES_PER_PERIOD * result.highest_excited_hz:.4g} Hz")
-    finish(args, result, out, write_result, summary_data, summary_table)
+    if result.highest_excited_hz:
+        check_sampling(args, result.highest_excited_hz, "the highest excited frequency")
+    return result
 
 
 def finish(args: argparse.Namespace, result, out: Path | None, write, summarize, table) -> None:

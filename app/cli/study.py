@@ -80,11 +80,11 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="X.zarr", help="Zarr store to write")
     p.add_argument("--resume", action="store_true",
                    help="continue the study in --out (same parameters and arguments only)")
-    _engine_options(p)
+    add_engine_options(p)
     p.add_argument("--json", action="store_true", help="a JSON summary on stdout")
 
 
-def _engine_options(p: argparse.ArgumentParser) -> None:
+def add_engine_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                    help="attach to a running Dask scheduler (default: $DASK_SCHEDULER_ADDRESS, "
                         "else a local cluster)")
@@ -127,7 +127,7 @@ def register(subparsers) -> None:
     u.add_argument("--out", required=True, metavar="U.json", help="JSON result to write")
     u.add_argument("--chunk-size", type=positive_int("--chunk-size"), default=4,
                    help="model runs per task (default %(default)s)")
-    _engine_options(u)
+    add_engine_options(u)
     from app.cli.sensitivity import add_uncertainty_options
 
     add_uncertainty_options(u)
@@ -206,7 +206,7 @@ class ProgressBar:
         self.stream.flush()
 
 
-def _start_engine(args: argparse.Namespace):
+def start_engine(args: argparse.Namespace):
     """(engine or None, map_unordered, where) for --serial / --scheduler / a local cluster."""
     from model.studies.engine import EngineUnavailable, StudyEngine, serial_map_unordered
 
@@ -239,7 +239,7 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
     options = uncertainty_options(args)
     parameters = load_parameters(args.params)
     bar, start = ProgressBar("study uncertainty", unit="model runs"), time.monotonic()
-    engine, mapper, where = _start_engine(args)
+    engine, mapper, where = start_engine(args)
     try:
         print(f"study uncertainty: n = {n} on {where}", file=sys.stderr)
         result = run_uncertainty(parameters, n, seed=args.seed, map_fn=in_order(mapper), **options,
@@ -279,7 +279,7 @@ def _run(args: argparse.Namespace, study, parameters) -> None:
         prepare_store(args.out, study, parameters, resume=True)  # refuses another study's store
     engine = None
     try:
-        engine, mapper, where = _start_engine(args)
+        engine, mapper, where = start_engine(args)
         print(f"study {study.kind}: {len(study.chunks())} chunks on {where}", file=sys.stderr)
         run = run_into_store(study, parameters, args.out, mapper, resume=args.resume,
                              progress=progress)

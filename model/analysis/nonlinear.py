@@ -66,10 +66,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from model.analysis.eigen import bogie_system
+from model.analysis.load_peaks import LIMITED, LimitCrossing, history_peaks_and_crossings
 from model.analysis.response import (
-    LIMITED,
     MAX_POINTS,
-    LimitCrossing,
     ResponseError,
     ShortCircuit,
     time_grid_points,
@@ -205,6 +204,7 @@ class NonlinearResult:
     peaks: dict[str, float]  # name -> signed total of largest magnitude [units]
     peak_times: dict[str, float]  # name -> its time [s]
     perturbation_peaks: dict[str, float]  # name -> signed Δy of largest magnitude [units]
+    perturbation_peak_times: dict[str, float]  # name -> its time [s]
     limit_crossings: list[LimitCrossing]  # totals beyond the limits, by time
     limits: dict[str, float]  # "M_ad", "M_ad/p" [N m], "mu_max N0" [N], "strength" if given
     operating_point: OperatingPoint
@@ -454,12 +454,6 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     creepage = {rim: op.s0 + z_hist[:, i] / op.v for i, rim in enumerate(rims)}
     slip = {rim: creepage[rim] * op.v for rim in rims}
     utilisation = {rim: creep_total[:, i] / mu_max for i, rim in enumerate(rims)}
-    peaks, peak_times, pert_peaks = {}, {}, {}
-    for name, y in outputs_total.items():
-        kk = int(np.argmax(np.abs(y)))
-        peaks[name], peak_times[name] = float(y[kk]), float(t[kk])
-        d = y - steady[name]
-        pert_peaks[name] = float(d[int(np.argmax(np.abs(d)))])
     M_ad = adhesion_moment(p, op.v, op.N0)
     limits = {"M_ad": M_ad, "M_ad/p": M_ad / p["gear_ratio"], "mu_max N0": float(mu_max) * op.N0}
     checks = list(LIMITED)
@@ -468,21 +462,14 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
         limits["strength/p"] = float(strength) / p["gear_ratio"]
         checks += [("disc_clutch.torque", "strength"), ("claw_clutch.torque", "strength"),
                    ("driving_shaft.torque", "strength/p")]
-    crossings = []
-    for name, y in outputs_total.items():
-        for suffix, limit_name in checks:
-            if name.endswith(suffix):
-                over = np.flatnonzero(np.abs(y) > limits[limit_name] * (1 + 1e-12))
-                if len(over):
-                    kk = int(over[0])
-                    crossings.append(LimitCrossing(name, limit_name, limits[limit_name],
-                                                   float(t[kk]), float(y[kk])))
-    crossings.sort(key=lambda c: c.time)
+    found = history_peaks_and_crossings(t, outputs_total, steady, limits, checks)
     detection = float(det_state[0]) if det_state[0] >= 0 else None
     return NonlinearResult(
         t=t, outputs=outputs_total, units=units, steady=steady, M_C=M_C, motor_torques=motor,
-        creepage=creepage, slip_velocity=slip, utilisation=utilisation, peaks=peaks,
-        peak_times=peak_times, perturbation_peaks=pert_peaks, limit_crossings=crossings,
+        creepage=creepage, slip_velocity=slip, utilisation=utilisation, peaks=found.peaks,
+        peak_times=found.peak_times, perturbation_peaks=found.perturbation_peaks,
+        perturbation_peak_times=found.perturbation_peak_times,
+        limit_crossings=found.limit_crossings,
         limits=limits, operating_point=op, excitation=excitation, creep_model=creep,
         anti_slip=protection, detection_time=detection,
         action_time=None if detection is None else detection + delay, motor_torque=step,

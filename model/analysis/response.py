@@ -58,6 +58,7 @@ import scipy.linalg as sla
 
 from model.analysis.eigen import bogie_system
 from model.analysis.linear_system import LinearSystem
+from model.analysis.load_peaks import LIMITED, LimitCrossing, history_peaks_and_crossings  # noqa: F401 (re-export)
 from model.mechanics.assembly import BogieModel
 from model.mechanics.operating_point import (
     OperatingPoint,
@@ -315,17 +316,6 @@ def solve_linear(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu:
 
 # --- the bogie -----------------------------------------------------------------------------------
 
-@dataclass(frozen=True)
-class LimitCrossing:
-    """A total load that passed a physical limit."""
-
-    output: str  # output name
-    limit_name: str  # e.g. "M_ad"
-    limit: float  # limit magnitude [unit of the output]
-    time: float  # first time |total| > limit [s]
-    value: float  # total value at that time [unit of the output]
-
-
 @dataclass
 class ResponseResult:
     """Short-circuit time histories (plain data; see the module docstring)."""
@@ -416,11 +406,6 @@ def dominant_frequencies(y: np.ndarray, fs: float, count: int = 4,
     return result
 
 
-LIMITED = (("disc_clutch.torque", "M_ad"), ("claw_clutch.torque", "M_ad"),
-           ("wheelset.adhesion_moment", "M_ad"), ("driving_shaft.torque", "M_ad/p"),
-           ("creep_force", "mu_max N0"))
-
-
 def time_grid_points(t_end, fs, error: type[ResponseError] = ResponseError) -> int:
     """Samples of the grid t = k/fs, k = 0 … round(t_end fs) (t_end [s], fs [Hz]); a bad value
     raises ``error`` with a one-line message."""
@@ -438,17 +423,12 @@ def time_grid_points(t_end, fs, error: type[ResponseError] = ResponseError) -> i
     return n_points
 
 
-def short_circuit_response(model: BogieModel, op: OperatingPoint,
-                           excitation: ShortCircuit | None = None, t_end: float = 2.0,
-                           fs: float = 10_000.0, outputs: list[str] | None = None,
-                           method: str = "auto") -> ResponseResult:
-    """Time histories of the loads after the short circuit of ID1's motor (see module docstring).
-
-    ``t_end`` [s] horizon (0 < t_end ≤ 60), ``fs`` [Hz] output sampling rate (the grid is
-    ``t = k/fs``, k = 0 … round(t_end fs)); ``outputs`` names (default: all loads of both drives).
-    """
-    excitation = ShortCircuit() if excitation is None else excitation
-    n_points = time_grid_points(t_end, fs)
+def output_rows(model: BogieModel, op: OperatingPoint, outputs: list[str] | None = None
+                ) -> tuple[list[str], np.ndarray, dict[str, str], dict[str, float]]:
+    """(names, C, units, steady) of the requested outputs: ``C`` (p x 2n) maps the state
+    ``[Δq; Δq̇]`` to the perturbations, ``steady[name]`` is the pre-fault value [unit] (outputs of
+    :func:`model.mechanics.outputs.output_matrices`, default all of them, or DOF names); an unknown name
+    raises :class:`ResponseError`."""
     matrices = output_matrices(model, op)
     names = list(matrices.names) if outputs is None else list(outputs)
     if not names:
@@ -473,7 +453,21 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
             raise ResponseError(f"unknown output '{name}': use an output name "
                                 f"({', '.join(matrices.names[:3])}, …) or a DOF name "
                                 "(e.g. ID1.rotor.ry)")
-    C = np.array(rows)
+    return names, np.array(rows), units, steady
+
+
+def short_circuit_response(model: BogieModel, op: OperatingPoint,
+                           excitation: ShortCircuit | None = None, t_end: float = 2.0,
+                           fs: float = 10_000.0, outputs: list[str] | None = None,
+                           method: str = "auto") -> ResponseResult:
+    """Time histories of the loads after the short circuit of ID1's motor (see module docstring).
+
+    ``t_end`` [s] horizon (0 < t_end ≤ 60), ``fs`` [Hz] output sampling rate (the grid is
+    ``t = k/fs``, k = 0 … round(t_end fs)); ``outputs`` names (default: all loads of both drives).
+    """
+    excitation = ShortCircuit() if excitation is None else excitation
+    n_points = time_grid_points(t_end, fs)
+    names, C, units, steady = output_rows(model, op, outputs)
     step = motor_torque(model.parameters, op)
     u0, a, mu = excitation.terms(step)
     dt = 1.0 / fs
@@ -484,32 +478,18 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
     t = np.arange(valid) * dt
     yT = np.ascontiguousarray(y.T)  # p x valid
     totals = {name: yT[j] + steady[name] for j, name in enumerate(names)}
-    peaks, peak_times, pert_peaks, pert_times = {}, {}, {}, {}
     freqs = dict(zip(names, dominant_frequencies(y, fs), strict=True))
-    for j, name in enumerate(names):
-        k = int(np.argmax(np.abs(totals[name])))
-        peaks[name], peak_times[name] = float(totals[name][k]), float(t[k])
-        kp = int(np.argmax(np.abs(yT[j])))
-        pert_peaks[name], pert_times[name] = float(yT[j, kp]), float(t[kp])
     M_ad = adhesion_moment(model.parameters, op.v, op.N0)
     _, mu_max = creep_law(model.parameters, op.N0).maximum(op.v)
     limits = {"M_ad": M_ad, "M_ad/p": M_ad / model.parameters["gear_ratio"],
               "mu_max N0": float(mu_max) * op.N0}
-    crossings = []
-    for name in names:
-        for suffix, limit_name in LIMITED:
-            if name.endswith(suffix):
-                over = np.flatnonzero(np.abs(totals[name]) > limits[limit_name])
-                if len(over):
-                    k = int(over[0])
-                    crossings.append(LimitCrossing(name, limit_name, limits[limit_name],
-                                                   float(t[k]), float(totals[name][k])))
-    crossings.sort(key=lambda c: c.time)
+    found = history_peaks_and_crossings(t, totals, steady, limits)
     return ResponseResult(
         t=t, outputs=totals, units=units, steady=steady, M_C=excitation.torque(t, step),
-        peaks=peaks, peak_times=peak_times, perturbation_peaks=pert_peaks,
-        perturbation_peak_times=pert_times,
-        dominant_frequencies=freqs, limit_crossings=crossings, limits=limits,
+        peaks=found.peaks, peak_times=found.peak_times,
+        perturbation_peaks=found.perturbation_peaks,
+        perturbation_peak_times=found.perturbation_peak_times,
+        dominant_frequencies=freqs, limit_crossings=found.limit_crossings, limits=limits,
         operating_point=op, excitation=excitation, phase_shift=excitation.shift(step),
         motor_torque=step, method=used, error_estimate=estimate,
         truncated_at=None if valid == n_points else float(t[-1]),

@@ -13,6 +13,9 @@ Layout of a map store (``MapStudy``)::
 
 A limit store (``LimitStudy``) holds ``s0_limit`` and ``evaluations`` over (v, N0, b_M).
 Coordinates: ``s0`` [-], ``v`` [m/s] (and ``v_kmh``), ``N0`` [N], ``b_M`` [N m s/rad].
+Another study describes its own layout (:class:`StoreLayout`: dimensions, coordinates, variables
+and the marker dimensions a chunk key indexes) with a ``store_layout()`` method, e.g. the design-
+load envelope (:meth:`model.studies.envelope.EnvelopeStudy.store_layout`, docs/design-loads.md).
 
 Each finished chunk is written into its own Zarr chunks (one file per variable, written
 atomically by Zarr's local store: temporary file, then rename), and *then* its ``chunk_done``
@@ -94,38 +97,67 @@ def _attributes(study, parameters: Parameters) -> dict:
             "parameters_source": parameters.source, "code_version": code_version()}
 
 
-def _coordinates(study) -> dict:
-    import xarray as xr
+@dataclass(frozen=True)
+class StoreLayout:
+    """What a study's store holds (plain data; the map and limit studies' layout is built here,
+    other studies describe their own with a ``store_layout()`` method).  Every variable is
+    chunked by one element along the marker dimensions (a chunk key indexes them) and whole
+    along the others; ``chunk_done`` spans the marker dimensions."""
 
+    sizes: dict[str, int]  # dimension -> length
+    coords: dict[str, tuple[tuple[str, ...], np.ndarray, dict]]  # name -> (dims, values, attrs)
+    # name -> (dims, dtype, fill value, attrs)
+    variables: dict[str, tuple[tuple[str, ...], object, object, dict]]
+    marker_dims: tuple[str, ...]  # dimensions indexed by a chunk key
+
+    def region(self, name: str, key: tuple[int, ...]) -> tuple:
+        """The index of chunk ``key`` in variable ``name`` (an int per marker dimension, a whole
+        slice along the others)."""
+        dims = self.variables[name][0]
+        return tuple(key[self.marker_dims.index(d)] if d in self.marker_dims else slice(None)
+                     for d in dims)
+
+
+def store_layout(study) -> StoreLayout:
+    """The layout of ``study``'s store (its own ``store_layout()`` if it has one)."""
+    own = getattr(study, "store_layout", None)
+    if own is not None:
+        return own()
+    point_dims = ("v", "N0", "b_M")
     coords = {"v": ("v", np.array(study.v)), "N0": ("N0", np.array(study.N0)),
               "b_M": ("b_M", np.array(study.b_M)), "v_kmh": ("v", np.array(study.v) / KMH)}
     if study.kind == "map":
         coords["s0"] = ("s0", np.array(study.s0))
-    return {name: xr.Variable(dims, data, {"units": UNITS[name]}) for name, (dims, data)
-            in coords.items()}
+    coords = {name: ((dims,), data, {"units": UNITS[name]}) for name, (dims, data)
+              in coords.items()}
+    sizes = {name: len(coords[name][1]) for name in (*point_dims, "s0") if name in coords}
+    variables = {name: (point_dims, dtype, fill, {"units": UNITS[name],
+                                                   "description": DESCRIPTIONS[name]})
+                 for name, (dtype, fill) in POINT_VARIABLES[study.kind].items()}
+    if study.kind == "map":
+        for name, (dtype, fill) in LINE_VARIABLES.items():
+            variables[name] = (("s0", *point_dims), dtype, fill,
+                               {"units": UNITS[name], "description": DESCRIPTIONS[name]})
+    return StoreLayout(sizes, coords, variables, point_dims)
 
 
 def create_store(path: str | Path, study, parameters: Parameters) -> None:
     """A new store for ``study`` at ``path`` (replaces what is there) with every chunk unfinished."""
     import xarray as xr
 
-    point_dims = ("v", "N0", "b_M")
-    shape = tuple(len(getattr(study, d)) for d in point_dims)
-    variables = {}
-    encoding = {}
-    specs = dict(POINT_VARIABLES[study.kind])
-    specs["chunk_done"] = (np.int8, 0)
-    for name, (dtype, fill) in specs.items():
-        variables[name] = xr.Variable(point_dims, np.full(shape, fill, dtype=dtype),
-                                      {"units": UNITS[name], "description": DESCRIPTIONS[name]})
-        encoding[name] = {"chunks": (1, 1, 1), "fill_value": fill}
-    if study.kind == "map":
-        for name, (dtype, fill) in LINE_VARIABLES.items():
-            variables[name] = xr.Variable(("s0", *point_dims),
-                                          np.full((len(study.s0), *shape), fill, dtype=dtype),
-                                          {"units": UNITS[name], "description": DESCRIPTIONS[name]})
-            encoding[name] = {"chunks": (len(study.s0), 1, 1, 1), "fill_value": fill}
-    dataset = xr.Dataset(variables, coords=_coordinates(study), attrs=_attributes(study, parameters))
+    layout = store_layout(study)
+    variables, encoding = {}, {}
+    specs = dict(layout.variables)
+    specs["chunk_done"] = (layout.marker_dims, np.int8, 0,
+                           {"units": UNITS["chunk_done"], "description": DESCRIPTIONS["chunk_done"]})
+    for name, (dims, dtype, fill, attrs) in specs.items():
+        shape = tuple(layout.sizes[d] for d in dims)
+        variables[name] = xr.Variable(dims, np.full(shape, fill, dtype=dtype), attrs)
+        encoding[name] = {"chunks": tuple(1 if d in layout.marker_dims else layout.sizes[d]
+                                          for d in dims), "fill_value": fill}
+    coords = {name: xr.Variable(dims, data, attrs)
+              for name, (dims, data, attrs) in layout.coords.items()}
+    dataset = xr.Dataset(variables, coords=coords, attrs=_attributes(study, parameters))
     dataset.to_zarr(str(path), mode="w", consolidated=False, zarr_format=3, encoding=encoding)
 
 
@@ -167,16 +199,26 @@ class StoreWriter:
         import zarr
 
         self.group = zarr.open_group(str(path), mode="r+")
-        self.study = study
+        self.layout = store_layout(study)
 
-    def write(self, key: tuple[int, int, int], result: dict) -> None:
-        i, j, k = key
-        if self.study.kind == "map":
-            for name in LINE_VARIABLES:
-                self.group[name][:, i, j, k] = np.asarray(result[name])
-        for name in POINT_VARIABLES[self.study.kind]:
-            self.group[name][i, j, k] = result[name]
-        self.group["chunk_done"][i, j, k] = 1
+    def write(self, key: tuple[int, ...], result: dict) -> None:
+        for name in self.layout.variables:
+            self.group[name][self.layout.region(name, key)] = np.asarray(result[name])
+        self.group["chunk_done"][tuple(key)] = 1
+
+
+class MemoryWriter:
+    """The same as :class:`StoreWriter` into numpy arrays (``arrays``: name -> array over the
+    variable's dimensions, its fill value where no chunk was written)."""
+
+    def __init__(self, study):
+        self.layout = layout = store_layout(study)
+        self.arrays = {name: np.full(tuple(layout.sizes[d] for d in dims), fill, dtype=dtype)
+                       for name, (dims, dtype, fill, _) in layout.variables.items()}
+
+    def write(self, key: tuple[int, ...], result: dict) -> None:
+        for name, array in self.arrays.items():
+            array[self.layout.region(name, key)] = np.asarray(result[name])
 
 
 def open_study(path: str | Path):
@@ -242,3 +284,22 @@ def run_into_store(study, parameters: Parameters, path: str | Path, map_unordere
         if progress is not None:
             progress(skipped + computed, total, time.monotonic() - start)
     return StudyRun(total, skipped, computed, time.monotonic() - start)
+
+
+def run_in_memory(study, parameters: Parameters, map_unordered,
+                  progress: Callable[[int, int, float], None] | None = None) -> dict:
+    """Every chunk of ``study`` computed as :func:`run_into_store` does, into numpy arrays
+    (:class:`MemoryWriter`) instead of a store: name -> array."""
+    from model.studies.maps import chunk_function
+
+    todo = study.chunks()
+    writer = MemoryWriter(study)
+    start = time.monotonic()
+    if progress is not None:
+        progress(0, len(todo), 0.0)
+    for done, (index, result) in enumerate(map_unordered(chunk_function(study, parameters), todo),
+                                           start=1):
+        writer.write(todo[index], result)
+        if progress is not None:
+            progress(done, len(todo), time.monotonic() - start)
+    return writer.arrays

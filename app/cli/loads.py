@@ -1,0 +1,381 @@
+"""``bogie envelope`` and ``bogie spectrum``: design loads from the command line.
+
+    bogie envelope [--s0 LIST] [--v LIST] [--n0 LIST] [--bm LIST] [--rail calibrated,dry,wet]
+                   [--m0 LIST] [--f LIST] [--decay LIST] [--phase LIST|all]
+                   [--creep linear|nonlinear|tangent] [--anti-slip off,on] [--anti-slip-delay LIST]
+                   [--t-end T --fs FS --outputs a,b --method M] [--params FILE]
+                   [--out X.zarr [--resume]] [--scheduler tcp://HOST:PORT | --workers N | --serial]
+                   [--json]
+    bogie spectrum … the options of ``bogie response`` … [--slopes 3,5] [--out F.npz|.csv|.json]
+
+A LIST is ``A,B,C`` or ``A:B:N`` (N values from A to B), increasing; speeds in km/h.  Without
+``--phase`` the fault instants are the two continuity roots per period (physics first); a
+``--phase`` grid [s] or ``all`` (closed form over every Δt, linear creep) is the explicitly
+conservative case.  The envelope runs on the study engine (a local Dask cluster by default, as
+``bogie study``); ``--out`` keeps the peaks per scenario in a resumable Zarr store.  Bad input:
+one line on stderr, exit status 2; Ctrl-C: exit status 130.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from app.cli.antislip import add_anti_slip_arguments
+from app.cli.main import UsageError
+from app.cli.response import (
+    add_response_options,
+    add_time_options,
+    check_out,
+    check_sampling,
+    history_from_args,
+    output_names,
+)
+from app.cli.study import (
+    EXIT_INTERRUPTED,
+    ProgressBar,
+    add_engine_options,
+    parse_values,
+    start_engine,
+)
+
+AXIS_LABELS = {"rail": "rail", "s0": "s0", "v": "v [km/h]", "N0": "N0 [N]", "b_M": "b_M",
+               "M0": "M0 [N m]", "f": "f [Hz]", "D": "D", "anti_slip": "anti-slip",
+               "anti_slip_delay": "delay [s]"}
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("envelope", help="design loads: max and min of every output over "
+                              "a grid of short-circuit scenarios, and where they occur")
+    p.add_argument("--s0", default="0.005", metavar="LIST", help="creepages s0 [-] (default "
+                   "%(default)s)")
+    p.add_argument("--v", default="120", metavar="LIST", help="speeds [km/h] (default "
+                   "%(default)s)")
+    p.add_argument("--n0", default=None, metavar="LIST",
+                   help="wheel forces N0 [N] (default: the parameter set's)")
+    p.add_argument("--bm", default=None, metavar="LIST",
+                   help="motor slopes b_M [N m s/rad] (default: the parameter set's)")
+    p.add_argument("--rail", default="calibrated", metavar="LIST",
+                   help="creep laws: calibrated (the set's own), dry, wet (Polach's presets); "
+                        "default %(default)s")
+    p.add_argument("--m0", default="50000", metavar="LIST",
+                   help="amplitudes M0 of the oscillating part [N m] (default %(default)s)")
+    p.add_argument("--f", default="90", metavar="LIST",
+                   help="frequencies f of the oscillating part [Hz] (default %(default)s)")
+    p.add_argument("--decay", default="0.04", metavar="LIST",
+                   help="decays D [-] (default %(default)s)")
+    p.add_argument("--phase", default=None, metavar="LIST|all",
+                   help="fault instants Δt [s], or 'all' (every Δt in closed form; linear creep) "
+                        "(default: the two continuity roots per period)")
+    p.add_argument("--creep", choices=("linear", "nonlinear", "tangent"), default="linear",
+                   help="longitudinal creep forces (default %(default)s)")
+    p.add_argument("--anti-slip", default="off", metavar="off|on|off,on",
+                   help="anti-slip protection of ID2 (nonlinear creep; default %(default)s)")
+    p.add_argument("--anti-slip-delay", default=None, metavar="LIST",
+                   help="reaction delays of the protection [s] (default 0.1)")
+    add_anti_slip_arguments(p, with_delay=False)
+    add_time_options(p)
+    p.add_argument("--params", default=None, metavar="FILE",
+                   help="parameter file (TOML; default: the calibrated set)")
+    p.add_argument("--out", default=None, metavar="X.zarr",
+                   help="Zarr store of the peaks of every scenario (xarray dataset)")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the envelope in --out (same parameters and arguments only)")
+    add_engine_options(p)
+    p.add_argument("--json", action="store_true", help="machine-readable JSON output")
+    p.set_defaults(func=cmd_envelope)
+
+    s = subparsers.add_parser("spectrum", help="load spectrum of a short-circuit history: "
+                              "rainflow cycles, load collective, damage-equivalent ranges")
+    add_response_options(s)
+    s.add_argument("--slopes", default="3,5", metavar="LIST",
+                   help="Wöhler slopes m of the equivalent ranges (default %(default)s)")
+    s.add_argument("--out", default=None, help="write .npz, .csv or .json")
+    s.set_defaults(func=cmd_spectrum)
+
+
+# --- bogie envelope ----------------------------------------------------------------------------------
+
+def _names(text: str, label: str) -> list[str]:
+    names = [x.strip() for x in text.split(",")]
+    if not text.strip() or not all(names):
+        raise UsageError(f"{label} must be a comma-separated list of names, got '{text}'")
+    return names
+
+
+def study_from_args(args: argparse.Namespace):
+    """(:class:`model.studies.envelope.EnvelopeStudy`, parameters) from the options."""
+    from model.mechanics.operating_point import KMH, OperatingPoint
+    from model.mechanics.parameters import load_parameters
+    from model.studies.envelope import EnvelopeStudy, rail_parameters, resolve_outputs
+
+    parameters = load_parameters(args.params)
+    s0 = parse_values(args.s0, "--s0", 1e-9, 1 - 1e-9, "-", increasing=True)
+    v = [x * KMH for x in parse_values(args.v, "--v", 1, 500, "km/h", increasing=True)]
+    n0 = (parse_values(args.n0, "--n0", 1e3, 1e6, "N", increasing=True)
+          if args.n0 is not None else [parameters["wheel_force"]])
+    bm = (parse_values(args.bm, "--bm", 0, 1e9, "N m s/rad", increasing=True)
+          if args.bm is not None else [parameters["motor_slope"]])
+    m0 = parse_values(args.m0, "--m0", 0, 1e8, "N m", increasing=True)
+    f = parse_values(args.f, "--f", 1e-3, 1e5, "Hz", increasing=True)
+    decay = parse_values(args.decay, "--decay", 0, 10, "-", increasing=True)
+    rails = _names(args.rail, "--rail")
+    if args.phase is None:
+        fault, phase = "roots", ()
+    elif args.phase.strip() == "all":
+        fault, phase = "all", ()
+    else:
+        fault, phase = "grid", parse_values(args.phase, "--phase", -10, 10, "s", increasing=True)
+    if fault == "all" and args.creep != "linear":
+        raise UsageError("--phase all needs --creep linear (the closed form over every fault "
+                         "instant is a superposition); give a --phase grid with nonlinear creep")
+    anti_slip = _names(args.anti_slip, "--anti-slip")
+    delays = (parse_values(args.anti_slip_delay, "--anti-slip-delay", 0, 60, "s", increasing=True)
+              if args.anti_slip_delay is not None else [])
+    if args.creep != "linear" and args.method != "auto":
+        raise UsageError("--method applies to --creep linear only")
+    check_sampling(args, max(f))
+    from model.studies.maps import cached_model
+
+    model = cached_model(rail_parameters(parameters, rails[0]))
+    first = OperatingPoint(s0[0], v[0], n0[0], bm[0])
+    outputs, units = resolve_outputs(model, first, output_names(args), args.creep)
+    study = EnvelopeStudy(
+        s0=s0, v=v, N0=n0, b_M=bm, outputs=outputs, units=units, rail=tuple(rails), M0=m0, f=f,
+        D=decay, fault=fault, phase=tuple(phase), creep=args.creep, anti_slip=tuple(anti_slip),
+        anti_slip_delay=tuple(delays), anti_slip_threshold=args.anti_slip_threshold,
+        anti_slip_rate=args.anti_slip_rate, anti_slip_floor=args.anti_slip_floor,
+        t_end=args.t_end, fs=args.fs, method=args.method)
+    return study, parameters
+
+
+def _check_first_point(study, parameters, args) -> None:
+    """Refuse a sampling rate that cannot resolve the modes the first scenario excites (as
+    ``bogie response`` does; the other scenarios are checked after the run)."""
+    from model.analysis.fault_instant import phase_families
+    from model.mechanics.operating_point import OperatingPoint
+    from model.studies.envelope import rail_parameters
+    from model.studies.maps import cached_model
+
+    if study.creep != "linear":
+        return
+    model = cached_model(rail_parameters(parameters, study.rail[0]))
+    op = OperatingPoint(study.s0[0], study.v[0], study.N0[0], study.b_M[0])
+    family = phase_families(model, op, [(max(study.f), study.D[0])], study.t_end, study.fs,
+                            list(study.outputs), study.method)[0]
+    if family.highest_excited_hz:
+        check_sampling(args, family.highest_excited_hz, "the highest excited frequency")
+
+
+def cmd_envelope(args: argparse.Namespace) -> None:
+    from model.studies.envelope import envelope
+    from model.studies.store import (
+        finished_chunks,
+        open_study,
+        prepare_store,
+        run_in_memory,
+        run_into_store,
+        store_layout,
+    )
+
+    study, parameters = study_from_args(args)
+    out = None if args.out is None else Path(args.out)
+    if out is None and args.resume:
+        raise UsageError("--resume needs --out (the store to continue)")
+    if out is not None and not args.resume:
+        if out.exists():
+            raise UsageError(f"'{out}' exists: continue it with --resume, or remove it")
+        if not out.parent.is_dir():
+            raise UsageError(f"directory '{out.parent}' does not exist")
+    elif out is not None:
+        prepare_store(out, study, parameters, resume=True)  # refuses another study's store
+    _check_first_point(study, parameters, args)
+    progress = ProgressBar("envelope")
+    engine = None
+    try:
+        engine, mapper, where = start_engine(args)
+        print(f"envelope: {study.scenarios} scenario(s) in {len(study.chunks())} chunk(s) on "
+              f"{where}; fault instants: {study.fault}", file=sys.stderr)
+        if out is None:
+            arrays = run_in_memory(study, parameters, mapper, progress)
+            run = None
+        else:
+            run = run_into_store(study, parameters, out, mapper, resume=args.resume,
+                                 progress=progress)
+            dataset = open_study(out)
+            arrays = {name: dataset[name].values for name in store_layout(study).variables}
+    except KeyboardInterrupt:
+        where_to = ""
+        if out is not None:
+            where_to = (f"; {len(finished_chunks(out))} of {len(study.chunks())} chunks finished "
+                        f"in {out}; continue with --resume")
+        print(f"\nenvelope: interrupted{where_to}", file=sys.stderr)
+        raise SystemExit(EXIT_INTERRUPTED) from None
+    finally:
+        if engine is not None:
+            engine.close()
+    result = envelope(study, arrays)
+    data = result.as_dict()
+    data.update({"t_end": study.t_end, "fs": study.fs})
+    if out is not None:
+        data.update({"out": str(out), "computed_chunks": run.computed,
+                     "skipped_chunks": run.skipped})
+    if result.highest_excited_hz and study.fs < 2.5 * result.highest_excited_hz:
+        print(f"envelope: warning: some scenarios excite {result.highest_excited_hz:.4g} Hz, "
+              f"more than --fs / 2.5 = {study.fs / 2.5:.4g} Hz resolves", file=sys.stderr)
+    if args.json:
+        print(json.dumps(data, indent=1, allow_nan=False))
+    else:
+        print(envelope_table(study, result, out))
+
+
+def envelope_table(study, result, out: Path | None) -> str:
+    """The envelope as text: per output the max and min and the scenario of each (the axes with
+    more than one value, the fault instant Δt and the time)."""
+    from model.studies.envelope import FAULT_DESCRIPTIONS
+
+    varying = [d for d, n in study.sizes.items() if n > 1 and d in AXIS_LABELS]
+    keys = {"rail": "rail", "s0": "s0", "v": "v_kmh", "N0": "n0", "b_M": "bm", "M0": "m0",
+            "f": "f", "D": "decay", "anti_slip": "anti_slip", "anti_slip_delay":
+            "anti_slip_delay_s"}
+
+    def where(at: dict) -> str:
+        values = [(AXIS_LABELS[d], at[keys[d]]) for d in varying if at[keys[d]] is not None]
+        parts = [f"{label} {value}" if isinstance(value, str) else f"{label} {value:g}"
+                 for label, value in values]
+        parts += [f"Δt {at['phase_s'] * 1e3:.4g} ms", f"t {at['time_s']:.4f} s"]
+        return ", ".join(parts)
+
+    lines = [f"envelope over {result.scenarios} scenario(s), creep {result.creep}, "
+             f"t = 0…{study.t_end:g} s at {study.fs:g} Hz; values are totals "
+             "(pre-fault + perturbation)",
+             f"fault instants: {FAULT_DESCRIPTIONS[result.fault_instants]}"]
+    if result.truncated:
+        lines.append(f"{result.truncated} scenario(s) grew beyond 1e250 and were cut (linear "
+                     "growth): their peaks end there")
+    lines += ["", f"{'output':<30} {'unit':<4}     {'value':>12}  scenario"]
+    for o in result.outputs:
+        lines.append(f"{o.name:<30} {o.unit:<4} max {o.max:>12.5g}  {where(o.max_at)}")
+        lines.append(f"{'':<30} {'':<4} min {o.min:>12.5g}  {where(o.min_at)}")
+    if out is not None:
+        lines.append(f"\nwrote {out} (peaks per scenario; xarray.open_zarr(..., "
+                     "consolidated=False))")
+    return "\n".join(lines)
+
+
+# --- bogie spectrum -----------------------------------------------------------------------------------
+
+def _slopes(text: str) -> list[float]:
+    from model.analysis.load_spectrum import SpectrumError, check_slope
+
+    values = []
+    for part in text.split(","):
+        try:
+            values.append(check_slope(float(part)))
+        except ValueError as error:
+            reason = str(error) if isinstance(error, SpectrumError) else f"'{part.strip()}' is " \
+                "not a number"
+            raise UsageError(f"--slopes: {reason}") from None
+    if len(set(values)) != len(values):
+        raise UsageError(f"--slopes: a slope is repeated in '{text}'")
+    return values
+
+
+def _fault_instant(result) -> dict:
+    excitation = result.excitation
+    shift = excitation.shift(result.motor_torque)
+    how = ("continuity root: sin(ωΔt) = M(s0, v)/M0" if excitation.dt is None
+           else "given by --phase")
+    return {"dt": shift, "treatment": how}
+
+
+def spectrum_data(result, spectra, creep: str) -> dict:
+    from model.analysis.load_spectrum import N_REF
+
+    return {
+        "history": {"creep": creep, "operating_point": result.operating_point.as_dict(),
+                    "excitation": {"M0": result.excitation.M0, "f": result.excitation.f,
+                                   "D": result.excitation.D},
+                    "fault_instant": _fault_instant(result), "t_end": float(result.t[-1]),
+                    "samples": len(result.t)},
+        "counting": "rainflow, ASTM E1049-85 (rainflow package), residue as half cycles",
+        "n_ref": N_REF,
+        "outputs": [{"name": s.name, "unit": s.unit, "cycles": s.cycles.tolist(),
+                     "equivalent_range": {f"{m:g}": value
+                                          for m, value in s.equivalent_range.items()},
+                     "total_cycles": s.total_cycles, "largest_range": s.largest_range,
+                     "exceedance": {"range": s.exceedance_range.tolist(),
+                                    "cycles": s.exceedance_count.tolist()}}
+                    for s in spectra],
+    }
+
+
+def spectrum_table(result, spectra, creep: str) -> str:
+    slopes = list(spectra[0].equivalent_range) if spectra else []
+    op, fault = result.operating_point, _fault_instant(result)
+    lines = [f"load spectrum of the short circuit at s0 = {op.s0:g}, v = {op.v_kmh:g} km/h, creep "
+             f"{creep}, Δt = {fault['dt']:.4g} s ({fault['treatment']}), {len(result.t)} samples "
+             f"to {result.t[-1]:g} s",
+             "rainflow cycles (ASTM E1049-85, residue as half cycles); ΔM_eq = "
+             "(Σ n ΔM^m / 1e7)^(1/m)", "",
+             f"{'output':<30} {'unit':<4} {'cycles':>9} {'largest range':>14}"
+             + "".join(f" {'ΔM_eq m=' + format(m, 'g'):>13}" for m in slopes)]
+    for s in spectra:
+        lines.append(f"{s.name:<30} {s.unit:<4} {s.total_cycles:>9g} {s.largest_range:>14.5g}"
+                     + "".join(f" {s.equivalent_range[m]:>13.5g}" for m in slopes))
+    return "\n".join(lines)
+
+
+def write_spectra(path: Path, spectra, data: dict) -> None:
+    """``.json``: ``data``; ``.npz``: per output ``<name>.cycles`` (k x 3: range, mean, count),
+    ``<name>.exceedance_range``, ``<name>.exceedance_count``, and ``names``, ``units``,
+    ``slopes``, ``equivalent_range`` (outputs x slopes), ``n_ref``; ``.csv``: one row per cycle
+    (output, unit, range, mean, count)."""
+    if path.suffix == ".json":
+        path.write_text(json.dumps(data, allow_nan=False))
+        return
+    slopes = list(spectra[0].equivalent_range) if spectra else []
+    if path.suffix == ".npz":
+        arrays = {"names": np.array([s.name for s in spectra], dtype=str),
+                  "units": np.array([s.unit for s in spectra], dtype=str),
+                  "slopes": np.array(slopes),
+                  "equivalent_range": np.array([[s.equivalent_range[m] for m in slopes]
+                                                for s in spectra]).reshape(len(spectra), -1),
+                  "n_ref": np.array(data["n_ref"])}
+        for s in spectra:
+            arrays[f"{s.name}.cycles"] = s.cycles
+            arrays[f"{s.name}.exceedance_range"] = s.exceedance_range
+            arrays[f"{s.name}.exceedance_count"] = s.exceedance_count
+        np.savez(path, **arrays)
+        return
+    with path.open("w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["output", "unit", "range", "mean", "count"])
+        for s in spectra:
+            for rng, mean, count in s.cycles:
+                writer.writerow([s.name, s.unit, repr(float(rng)), repr(float(mean)),
+                                 repr(float(count))])
+
+
+def cmd_spectrum(args: argparse.Namespace) -> None:
+    from model.analysis.load_spectrum import history_spectra
+
+    slopes = _slopes(args.slopes)
+    out = check_out(args.out)
+    result = history_from_args(args)
+    spectra = history_spectra(result, slopes)
+    data = spectrum_data(result, spectra, args.creep)
+    if out is not None:
+        write_spectra(out, spectra, data)
+    if args.json:
+        summary = dict(data)
+        if out is not None:
+            summary["out"] = str(out)
+        print(json.dumps(summary, indent=1, allow_nan=False))
+    else:
+        print(spectrum_table(result, spectra, args.creep) + (f"\nwrote {out}" if out else ""))
