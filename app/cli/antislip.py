@@ -20,73 +20,16 @@ from pathlib import Path
 
 import numpy as np
 
-from app.cli.main import UsageError, add_operating_point, emit, load_model, number, parse_range
-
-ANTI_SLIP_OPTIONS = ("anti_slip_delay", "anti_slip_threshold", "anti_slip_rate", "anti_slip_floor")
-
-
-def add_anti_slip_arguments(p: argparse.ArgumentParser, with_delay: bool = True) -> None:
-    """The protection's options (defaults: :class:`model.analysis.nonlinear.AntiSlip`)."""
-    if with_delay:
-        p.add_argument("--anti-slip-delay", type=number(
-            "--anti-slip-delay (s)", 0, 60, low_open=False, high_open=False,
-            allowed="must be in [0, 60] s"), default=None,
-            help="reaction delay after detection [s] (default 0.1)")
-    p.add_argument("--anti-slip-threshold", type=number(
-        "--anti-slip-threshold (m/s)", 0, 100, high_open=False,
-        allowed="must be > 0 and at most 100 m/s"), default=None,
-        help="change of ID2's wheelset slip velocity that trips the protection [m/s] "
-             "(default 0.3)")
-    p.add_argument("--anti-slip-rate", type=number(
-        "--anti-slip-rate (1/s)", 0, 1e6, high_open=False,
-        allowed="must be > 0 and at most 1e6 1/s"), default=None,
-        help="torque reduction rate [fraction of M(s0, v) per s] (default 10)")
-    p.add_argument("--anti-slip-floor", type=number(
-        "--anti-slip-floor", 0, 1, low_open=False, allowed="must be in [0, 1)"), default=None,
-        help="torque kept after the reduction [fraction of M(s0, v)] (default 0)")
-
-
-def add_creep_arguments(p: argparse.ArgumentParser) -> None:
-    """``--creep`` and the anti-slip options of ``bogie response``."""
-    p.add_argument("--creep", choices=("linear", "nonlinear", "tangent"), default="linear",
-                   help="longitudinal creep forces: linear (closed form, default), nonlinear "
-                        "(Polach's law), tangent (the nonlinear solver with the law's tangent)")
-    p.add_argument("--anti-slip", choices=("off", "on"), default="off",
-                   help="anti-slip protection on ID2's motor torque (needs --creep nonlinear or "
-                        "tangent; default off)")
-    add_anti_slip_arguments(p)
-    p.add_argument("--strength", type=number("--strength (N m)", 0, 1e9,
-                                             allowed="must be in (0, 1e9) N m"), default=None,
-                   help="design strength [N m] of the disc and claw clutch (the driving shaft: "
-                        "strength/p); crossings are listed (needs --creep nonlinear or tangent)")
-
-
-def anti_slip_from(args: argparse.Namespace, delay: bool = True):
-    from model.analysis.nonlinear import AntiSlip
-
-    defaults = AntiSlip()
-    values = {name: getattr(args, name, None) for name in ANTI_SLIP_OPTIONS}
-    return AntiSlip(
-        delay=defaults.delay if not delay or values["anti_slip_delay"] is None
-        else values["anti_slip_delay"],
-        threshold=defaults.threshold if values["anti_slip_threshold"] is None
-        else values["anti_slip_threshold"],
-        rate=defaults.rate if values["anti_slip_rate"] is None else values["anti_slip_rate"],
-        floor=defaults.floor if values["anti_slip_floor"] is None else values["anti_slip_floor"])
-
-
-def check_creep_arguments(args: argparse.Namespace) -> None:
-    """Refuse combinations that would be silently ignored."""
-    given = [name for name in ANTI_SLIP_OPTIONS if getattr(args, name, None) is not None]
-    if args.anti_slip == "on" and args.creep == "linear":
-        raise UsageError("--anti-slip on needs --creep nonlinear or tangent (the closed form has "
-                         "no protection)")
-    if given and args.anti_slip == "off":
-        raise UsageError(f"--{given[0].replace('_', '-')} needs --anti-slip on")
-    if getattr(args, "strength", None) is not None and args.creep == "linear":
-        raise UsageError("--strength needs --creep nonlinear or tangent")
-    if args.creep != "linear" and getattr(args, "method", "auto") != "auto":
-        raise UsageError("--method applies to --creep linear only")
+from app.cli.options import (
+    UsageError,
+    add_anti_slip_arguments,
+    add_operating_point,
+    anti_slip_from,
+    load_model,
+    number,
+    parse_range,
+)
+from app.cli.output import emit, finish, limit_lines, write_series
 
 
 def series(result) -> dict[str, tuple[np.ndarray, str]]:
@@ -156,14 +99,10 @@ def summary_table(result) -> str:
     for name, y in result.motor_torques.items():
         lines.append(f"{name}: from {y[0]:.5g} to {y[-1]:.5g} N m (min {y.min():.5g}, max "
                      f"{y.max():.5g})")
-    from app.cli.response import limit_lines  # (response_cli imports this module)
-
     return "\n".join(lines + limit_lines(result))
 
 
 def write_result(result, path: Path) -> None:
-    from app.cli.response import write_series  # (response_cli imports this module)
-
     write_series(path, result.t, result.M_C, series(result), result.steady, summary_data(result))
 
 
@@ -175,8 +114,6 @@ def cmd_nonlinear_response(args: argparse.Namespace, excitation, names, out: Pat
     model, op, _ = load_model(args)
     result = nonlinear_response(model, op, excitation, args.t_end, args.fs, creep=args.creep,
                                 anti_slip=anti_slip, outputs=names, strength=args.strength)
-    from app.cli.response import finish  # (response_cli imports this module)
-
     finish(args, result, out, write_result, summary_data, summary_table)
 
 

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import argparse
 
-from app.cli.main import UsageError, add_operating_point, emit, number
+from app.cli.options import UsageError, add_operating_point, number
+from app.cli.output import emit
 
 
 def register(subparsers) -> None:

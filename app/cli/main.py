@@ -8,107 +8,24 @@ Bad input: one line on stderr saying what is wrong and what is allowed, exit sta
 from __future__ import annotations
 
 import argparse
-import json
-import math
 import sys
 from collections.abc import Callable
 
 import numpy as np
 
-from model.mechanics.parameters import ParameterError, load_parameters
-
-EXIT_BAD_INPUT = 2
-
-
-class UsageError(Exception):
-    """Bad input from the command line (reported in one line, exit status 2)."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # one line, no usage block
-        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
-
-
-def number(label: str, low: float = -math.inf, high: float = math.inf, low_open: bool = True,
-           high_open: bool = True, allowed: str = "") -> Callable[[str], float]:
-    """argparse type: a finite float within bounds, with a clear message otherwise."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{label} must be a number, got '{text}'") from None
-        ok_low = value > low if low_open else value >= low
-        ok_high = value < high if high_open else value <= high
-        if not math.isfinite(value) or not (ok_low and ok_high):
-            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: {allowed}")
-        return value
-
-    return parse
-
-
-def non_negative_int(label: str) -> Callable[[str], int]:
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{label} must be a whole number, got '{text}'") from None
-        if value < 0:
-            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: must be >= 0")
-        return value
-
-    return parse
-
-
-def positive_int(label: str) -> Callable[[str], int]:
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{label} must be a whole number, got '{text}'") from None
-        if value < 1:
-            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: must be >= 1")
-        return value
-
-    return parse
-
-
-def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.005) -> None:
-    parser.add_argument("--s0", type=number("--s0 (creepage)", 0, 1, allowed="must be in (0, 1)"),
-                        default=s0, help="longitudinal creepage s0 [-] (default %(default)s)")
-    parser.add_argument("--v", type=number("--v (speed, km/h)", 1, 500, False, False,
-                                           allowed="must be in [1, 500] km/h"),
-                        default=120.0, help="speed [km/h] (default %(default)s)")
-    parser.add_argument("--n0", type=number("--n0 (wheel force, N)", 1e3, 1e6, False, False,
-                                            allowed="must be in [1e3, 1e6] N"),
-                        default=None, help="static wheel force N0 [N] (default: parameter set)")
-    parser.add_argument("--bm", type=number("--bm (motor slope, N m s/rad)", 0, 1e9, False, False,
-                                            allowed="must be in [0, 1e9] N m s/rad"),
-                        default=None, help="motor slope b_M [N m s/rad] (default: parameter set)")
-    parser.add_argument("--params", default=None, metavar="FILE",
-                        help="parameter file (TOML; default: the calibrated set)")
-    parser.add_argument("--json", action="store_true", help="machine-readable JSON output")
-
-
-def load_model(args: argparse.Namespace):
-    """(model, operating point) from the common options."""
-    from model.mechanics.assembly import build_model
-    from model.mechanics.operating_point import OperatingPoint
-
-    parameters = load_parameters(args.params)
-    model = build_model(parameters)
-    n0 = parameters["wheel_force"] if args.n0 is None else args.n0
-    bm = parameters["motor_slope"] if args.bm is None else args.bm
-    op = OperatingPoint.from_kmh(args.s0, args.v, n0, bm) if args.s0 is not None else None
-    return model, op, (n0, bm)
-
-
-def emit(args: argparse.Namespace, data: dict, table: str) -> None:
-    if args.json:
-        print(json.dumps(data, indent=1, allow_nan=False))
-    else:
-        print(table)
-
+from app.cli.options import (
+    EXIT_BAD_INPUT,
+    BogieParser,
+    UsageError,
+    add_operating_point,
+    load_model,
+    non_negative_int,
+    number,
+    parse_range,
+    positive_int,
+)
+from app.cli.output import emit
+from model.mechanics.parameters import ParameterError
 
 # --- commands ------------------------------------------------------------------------------------
 
@@ -178,18 +95,6 @@ def cmd_modes(args: argparse.Namespace) -> None:
     emit(args, {"operating_point": op.as_dict(), "modes": rows}, "\n".join(lines))
 
 
-def parse_range(text: str, label: str, scale: float = 1.0) -> np.ndarray:
-    """'A:B:N' -> N values from A to B (times ``scale``)."""
-    parts = text.split(":")
-    try:
-        start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
-    except (ValueError, IndexError):
-        raise UsageError(f"{label} must be A:B:N (two numbers and a whole count), got '{text}'") from None
-    if len(parts) != 3 or count < 2 or count > 5000 or not (math.isfinite(start) and math.isfinite(stop)):
-        raise UsageError(f"{label} must be A:B:N with finite A, B and 2 <= N <= 5000, got '{text}'")
-    return np.linspace(start, stop, count) * scale
-
-
 def cmd_locus(args: argparse.Namespace) -> None:
     from model.analysis.locus import root_locus
     from model.mechanics.operating_point import KMH
@@ -255,9 +160,9 @@ def cmd_serve(args: argparse.Namespace) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="bogie", description="Locomotive bogie drive dynamics: eigenvalues, "
+    parser = BogieParser(prog="bogie", description="Locomotive bogie drive dynamics: eigenvalues, "
                      "stability and traction-motor short-circuit response.")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=BogieParser)
 
     p = sub.add_parser("eigen", help="eigenvalues and stability at an operating point")
     add_operating_point(p)

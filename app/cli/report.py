@@ -15,7 +15,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from app.cli.main import UsageError, add_operating_point, number
+from app.cli.options import UsageError, add_operating_point, number
 
 
 def register(subparsers) -> None:

@@ -12,15 +12,19 @@ Bad input: one line on stderr, exit status 2.
 from __future__ import annotations
 
 import argparse
-import csv
-import json
 import math
 from pathlib import Path
 
-import numpy as np
-
-from app.cli.antislip import add_creep_arguments, check_creep_arguments, cmd_nonlinear_response
-from app.cli.main import UsageError, add_operating_point, emit, load_model, number
+from app.cli.antislip import cmd_nonlinear_response
+from app.cli.options import (
+    UsageError,
+    add_creep_arguments,
+    add_operating_point,
+    check_creep_arguments,
+    load_model,
+    number,
+)
+from app.cli.output import check_history_file, finish, limit_lines, write_series
 
 MIN_SAMPLES_PER_PERIOD = 2.5  # fs must exceed 2.5 × the highest excited frequency
 
@@ -55,22 +59,10 @@ def register(subparsers) -> None:
     p.set_defaults(func=cmd_response)
 
 
-def _check_out(path: str | None) -> Path | None:
-    if path is None:
-        return None
-    out = Path(path)
-    if out.suffix not in (".npz", ".csv", ".json"):
-        raise UsageError(f"unknown file extension '{out.suffix or out.name}': use .npz, .csv or "
-                         ".json")
-    if not out.parent.exists():
-        raise UsageError(f"directory '{out.parent}' does not exist")
-    return out
-
-
 def cmd_response(args: argparse.Namespace) -> None:
     from model.analysis.response import ShortCircuit, short_circuit_response
 
-    out = _check_out(args.out)
+    out = check_history_file(args.out)
     check_creep_arguments(args)
     defaults = ShortCircuit()
     excitation = ShortCircuit(
@@ -98,17 +90,6 @@ def cmd_response(args: argparse.Namespace) -> None:
                          f"frequency {result.highest_excited_hz:.4g} Hz: must be at least "
                          f"{MIN_SAMPLES_PER_PERIOD * result.highest_excited_hz:.4g} Hz")
     finish(args, result, out, write_result, summary_data, summary_table)
-
-
-def finish(args: argparse.Namespace, result, out: Path | None, write, summarize, table) -> None:
-    """The tail of a response command: ``write(result, out)`` if asked, then the summary
-    (``summarize(result)``, JSON) or the table (``table(result)``, text)."""
-    if out is not None:
-        write(result, out)
-    summary = summarize(result)
-    if out is not None:
-        summary["out"] = str(out)
-    emit(args, summary, table(result) + (f"\nwrote {out}" if out else ""))
 
 
 def summary_data(result) -> dict:
@@ -153,47 +134,7 @@ def summary_table(result) -> str:
     return "\n".join(lines + limit_lines(result))
 
 
-def limit_lines(result) -> list[str]:
-    """The limits and their first crossings of a (linear or nonlinear) response, as text lines."""
-    lines = ["", "limits: " + ", ".join(f"{k} = {v:.5g}" for k, v in result.limits.items())]
-    if not result.limit_crossings:
-        return [*lines, "no limit crossed"]
-    lines.append("limit crossings (|total| > limit), first time:")
-    for c in result.limit_crossings:
-        lines.append(f"  {c.time:8.4f} s  {c.output} = {c.value:.5g} beyond {c.limit_name} = "
-                     f"{c.limit:.5g}")
-    return lines
-
-
 def write_result(result, path: Path) -> None:
     write_series(path, result.t, result.M_C,
                  {name: (result.outputs[name], result.units[name]) for name in result.outputs},
                  result.steady, summary_data(result))
-
-
-def write_series(path: Path, t: np.ndarray, M_C: np.ndarray,
-                 series: dict[str, tuple[np.ndarray, str]], steady: dict[str, float],
-                 summary: dict) -> None:
-    """Time series (name -> (values, unit)) at times ``t`` [s] with the short-circuit torque
-    ``M_C`` [N m] as ``.npz`` (arrays, names, units, steady values; NaN where a series has
-    none), ``.csv`` (one column per series, units in the header) or ``.json`` (``summary``
-    plus the series)."""
-    names = list(series)
-    if path.suffix == ".npz":
-        arrays = {"t": t, "M_C": M_C, **{n: series[n][0] for n in names},
-                  "names": np.array(names, dtype=str),
-                  "units": np.array([series[n][1] for n in names], dtype=str),
-                  "steady": np.array([steady.get(n, np.nan) for n in names])}
-        np.savez(path, **arrays)
-    elif path.suffix == ".csv":
-        with path.open("w", newline="") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(["t [s]", "M_C [N m]"] + [f"{n} [{series[n][1]}]" for n in names])
-            table = np.column_stack([t, M_C] + [series[n][0] for n in names])
-            writer.writerows([[repr(float(x)) for x in row] for row in table])
-    else:
-        data = dict(summary)
-        data["t"] = t.tolist()
-        data["M_C"] = M_C.tolist()
-        data["series"] = {n: series[n][0].tolist() for n in names}
-        path.write_text(json.dumps(data, allow_nan=False))

@@ -18,7 +18,6 @@ stderr, exit status 2.  Interrupted: exit status 130.
 from __future__ import annotations
 
 import argparse
-import itertools
 import json
 import math
 import sys
@@ -26,46 +25,9 @@ import time
 
 import numpy as np
 
-from app.cli.main import UsageError, number, positive_int
+from app.cli.options import UsageError, add_uncertainty_options, number, parse_values, positive_int, uncertainty_options
 
 EXIT_INTERRUPTED = 130
-
-
-def parse_values(text: str, label: str, low: float, high: float, unit: str,
-                 increasing: bool = False) -> list[float]:
-    """'A:B:N' (N values from A to B) or 'x1,x2,…' -> values within [low, high]."""
-    text = text.strip()
-    if ":" in text:
-        parts = text.split(":")
-        try:
-            if len(parts) != 3:
-                raise ValueError
-            start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
-        except ValueError:
-            raise UsageError(f"{label} must be A:B:N (two numbers and a whole count) or a "
-                             f"comma-separated list, got '{text}'") from None
-        if count < 1:
-            raise UsageError(f"{label} = '{text}': N = {count} is not allowed, must be >= 1")
-        if count > 1 and not start < stop:
-            raise UsageError(f"{label} = '{text}' is an empty range: A must be below B")
-        values = [start] if count == 1 else list(np.linspace(start, stop, count))
-    else:
-        try:
-            values = [float(x) for x in text.split(",") if x.strip()]
-        except ValueError:
-            raise UsageError(f"{label} must be numbers separated by commas or A:B:N, "
-                             f"got '{text}'") from None
-        if not values:
-            raise UsageError(f"{label} is empty")
-    for value in values:
-        if not (math.isfinite(value) and low <= value <= high):
-            raise UsageError(f"{label}: {value:g} is not allowed, must be in [{low:g}, {high:g}] "
-                             f"{unit}")
-    if increasing and any(b <= a for a, b in itertools.pairwise(values)):
-        raise UsageError(f"{label} must increase")
-    if len(values) > 100_000:
-        raise UsageError(f"{label}: {len(values)} values, at most 100000 allowed")
-    return [float(v) for v in values]
 
 
 def _common(p: argparse.ArgumentParser) -> None:
@@ -128,8 +90,6 @@ def register(subparsers) -> None:
     u.add_argument("--chunk-size", type=positive_int("--chunk-size"), default=4,
                    help="model runs per task (default %(default)s)")
     _engine_options(u)
-    from app.cli.sensitivity import add_uncertainty_options
-
     add_uncertainty_options(u)
     u.add_argument("--json", action="store_true", help="the result as JSON on stdout")
     u.set_defaults(func=cmd_uncertainty)
@@ -234,8 +194,6 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
     out = Path(args.out)
     if not out.parent.is_dir():
         raise UsageError(f"directory '{out.parent}' does not exist")
-    from app.cli.sensitivity import uncertainty_options
-
     options = uncertainty_options(args)
     parameters = load_parameters(args.params)
     bar, start = ProgressBar("study uncertainty", unit="model runs"), time.monotonic()
