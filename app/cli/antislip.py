@@ -1,22 +1,18 @@
-"""``bogie response --creep …`` and ``bogie antislip``: the nonlinear response and the required
-reaction time of the anti-slip protection from the command line (issue 10).
+"""``bogie antislip``: the required reaction time of the anti-slip protection (nonlinear creep)
+and the curve peak(delay) from the command line.
 
-    bogie response … --creep linear|nonlinear|tangent [--anti-slip off|on --anti-slip-delay S
-                   --anti-slip-threshold M_S --anti-slip-rate PER_S --anti-slip-floor F]
     bogie antislip --s0 0.014 --v 120 [--n0 --bm --params] [--limit N_m] [--delays A:B:N]
                    [--drives ID2|both] [--anti-slip-threshold … --anti-slip-rate … ] [--json]
 
-``--creep linear`` (default) is the closed form of :mod:`model.analysis.response`; ``nonlinear`` and
-``tangent`` run :func:`model.analysis.nonlinear.nonlinear_response`.  Files as ``bogie response`` writes
-them, with the same output names (totals), plus per wheel ``<rim>.creepage`` [-],
-``<rim>.slip_velocity`` [m/s], ``<rim>.utilisation`` [-] and the motor torques
-``ID1.motor.torque``, ``ID2.motor.torque`` [N m].  Bad input: one line, exit status 2.
+Each delay of the grid is one run of :func:`model.analysis.nonlinear.nonlinear_response`
+(:func:`model.analysis.antislip.required_reaction_time`); progress goes to stderr unless
+``--json``.  The nonlinear response itself is ``bogie response --creep nonlinear``
+(:mod:`app.cli.response`).  Bad input: one line on stderr, exit status 2.
 """
 
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
@@ -29,95 +25,8 @@ from app.cli.options import (
     number,
     parse_range,
 )
-from app.cli.output import emit, finish, limit_lines, write_series
+from app.cli.output import emit
 
-
-def series(result) -> dict[str, tuple[np.ndarray, str]]:
-    """Every time series of a nonlinear result: name -> (values, unit)."""
-    out = {name: (y, result.units[name]) for name, y in result.outputs.items()}
-    for rim in result.creepage:
-        out[f"{rim}.creepage"] = (result.creepage[rim], "-")
-        out[f"{rim}.slip_velocity"] = (result.slip_velocity[rim], "m/s")
-        out[f"{rim}.utilisation"] = (result.utilisation[rim], "-")
-    for name, y in result.motor_torques.items():
-        out[name] = (y, "N m")
-    return out
-
-
-def summary_data(result) -> dict:
-    a = result.anti_slip
-    return {
-        "operating_point": result.operating_point.as_dict(),
-        "excitation": {"M0": result.excitation.M0, "f": result.excitation.f,
-                       "D": result.excitation.D},
-        "creep": result.creep_model, "motor_torque": result.motor_torque,
-        "mu_max": result.mu_max, "limits": result.limits,
-        "anti_slip": None if a is None else {"delay_s": a.delay, "threshold_m_s": a.threshold,
-                                             "rate_per_s": a.rate, "floor": a.floor},
-        "detection_time": result.detection_time, "action_time": result.action_time,
-        "newton_iterations_per_step": result.newton_iterations,
-        "outputs": {name: {"unit": result.units[name], "steady": result.steady[name],
-                           "peak": result.peaks[name], "peak_time": result.peak_times[name],
-                           "perturbation_peak": result.perturbation_peaks[name]}
-                    for name in result.outputs},
-        "wheels": {rim: {"creepage_min": float(result.creepage[rim].min()),
-                         "creepage_max": float(result.creepage[rim].max()),
-                         "slip_velocity_max": float(np.abs(result.slip_velocity[rim]).max()),
-                         "utilisation_max": float(np.abs(result.utilisation[rim]).max())}
-                   for rim in result.creepage},
-        "limit_crossings": [{"output": c.output, "limit": c.limit_name, "limit_value": c.limit,
-                             "time": c.time, "value": c.value} for c in result.limit_crossings],
-    }
-
-
-def summary_table(result) -> str:
-    op, a = result.operating_point, result.anti_slip
-    protection = "anti-slip off" if a is None else (
-        f"anti-slip on: threshold {a.threshold:g} m/s, delay {a.delay:g} s, rate {a.rate:g} 1/s, "
-        f"floor {a.floor:g}; " + ("never detected" if result.detection_time is None else
-                                  f"detected at {result.detection_time:.4f} s, acts at "
-                                  f"{result.action_time:.4f} s"))
-    lines = [f"short circuit of ID1's motor at s0 = {op.s0:g}, v = {op.v_kmh:g} km/h, "
-             f"N0 = {op.N0:g} N, creep {result.creep_model}: M(s0, v) = "
-             f"{result.motor_torque:.6g} N m, μ_max = {result.mu_max:.4g}",
-             protection,
-             f"{len(result.t)} points to t = {result.t[-1]:g} s; values are totals "
-             f"(pre-fault + perturbation); {result.newton_iterations:.2f} Newton iterations/step",
-             "", f"{'output':<30} {'unit':<4} {'steady':>11} {'peak':>11} {'at [s]':>8} "
-             f"{'Δpeak':>11}"]
-    for name in result.outputs:
-        lines.append(f"{name:<30} {result.units[name]:<4} {result.steady[name]:>11.4g} "
-                     f"{result.peaks[name]:>11.4g} {result.peak_times[name]:>8.4f} "
-                     f"{result.perturbation_peaks[name]:>11.4g}")
-    lines += ["", f"{'wheel':<12} {'creepage min':>12} {'max':>10} {'|slip v| max [m/s]':>19} "
-              f"{'|μ|/μ_max max':>14}"]
-    for rim in result.creepage:
-        lines.append(f"{rim:<12} {result.creepage[rim].min():>12.5f} "
-                     f"{result.creepage[rim].max():>10.5f} "
-                     f"{np.abs(result.slip_velocity[rim]).max():>19.4g} "
-                     f"{np.abs(result.utilisation[rim]).max():>14.4f}")
-    for name, y in result.motor_torques.items():
-        lines.append(f"{name}: from {y[0]:.5g} to {y[-1]:.5g} N m (min {y.min():.5g}, max "
-                     f"{y.max():.5g})")
-    return "\n".join(lines + limit_lines(result))
-
-
-def write_result(result, path: Path) -> None:
-    write_series(path, result.t, result.M_C, series(result), result.steady, summary_data(result))
-
-
-def cmd_nonlinear_response(args: argparse.Namespace, excitation, names, out: Path | None) -> None:
-    """The ``--creep nonlinear|tangent`` branch of ``bogie response``."""
-    from model.analysis.nonlinear import nonlinear_response
-
-    anti_slip = anti_slip_from(args) if args.anti_slip == "on" else None
-    model, op, _ = load_model(args)
-    result = nonlinear_response(model, op, excitation, args.t_end, args.fs, creep=args.creep,
-                                anti_slip=anti_slip, outputs=names, strength=args.strength)
-    finish(args, result, out, write_result, summary_data, summary_table)
-
-
-# --- bogie antislip ------------------------------------------------------------------------------
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("antislip", help="required reaction time of the anti-slip "

@@ -2,11 +2,19 @@
 
     bogie response --s0 0.005 --v 120 [--n0 N --bm B] [--m0 M0 --f F --decay D --phase DT]
                    --t-end T --fs FS [--out FILE.npz|.csv|.json] [--outputs a,b,…]
+                   [--creep linear|nonlinear|tangent [--anti-slip off|on --anti-slip-delay S
+                   --anti-slip-threshold M_S --anti-slip-rate PER_S --anti-slip-floor F]
+                   [--strength N_m]]
+
+``--creep linear`` (default) is the closed form of :mod:`model.analysis.response`; ``nonlinear``
+and ``tangent`` run :func:`model.analysis.nonlinear.nonlinear_response`.
 
 Without ``--out``: a table of peaks (totals), their times and dominant frequencies, and the
 limit crossings.  Files: ``.npz`` (array ``t`` [s], one array per output name (totals), ``M_C``,
 plus ``units``/``steady``), ``.csv`` (a column per output, the unit in the header), ``.json``.
-Bad input: one line on stderr, exit status 2.
+The nonlinear runs write the same output names plus per wheel ``<rim>.creepage`` [-],
+``<rim>.slip_velocity`` [m/s], ``<rim>.utilisation`` [-] and the motor torques
+``ID1.motor.torque``, ``ID2.motor.torque`` [N m].  Bad input: one line on stderr, exit status 2.
 """
 
 from __future__ import annotations
@@ -15,11 +23,13 @@ import argparse
 import math
 from pathlib import Path
 
-from app.cli.antislip import cmd_nonlinear_response
+import numpy as np
+
 from app.cli.options import (
     UsageError,
     add_creep_arguments,
     add_operating_point,
+    anti_slip_from,
     check_creep_arguments,
     load_model,
     number,
@@ -80,7 +90,7 @@ def cmd_response(args: argparse.Namespace) -> None:
     names = None if args.outputs is None else [s.strip() for s in args.outputs.split(",")
                                                 if s.strip()]
     if args.creep != "linear":
-        cmd_nonlinear_response(args, excitation, names, out)
+        run_nonlinear(args, excitation, names, out)
         return
     model, op, _ = load_model(args)
     result = short_circuit_response(model, op, excitation, args.t_end, args.fs, names,
@@ -89,10 +99,10 @@ def cmd_response(args: argparse.Namespace) -> None:
         raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the highest excited "
                          f"frequency {result.highest_excited_hz:.4g} Hz: must be at least "
                          f"{MIN_SAMPLES_PER_PERIOD * result.highest_excited_hz:.4g} Hz")
-    finish(args, result, out, write_result, summary_data, summary_table)
+    finish(args, result, out, write_linear, linear_summary, linear_table)
 
 
-def summary_data(result) -> dict:
+def linear_summary(result) -> dict:
     op = result.operating_point
     return {
         "operating_point": op.as_dict(),
@@ -113,7 +123,7 @@ def summary_data(result) -> dict:
     }
 
 
-def summary_table(result) -> str:
+def linear_table(result) -> str:
     op, e = result.operating_point, result.excitation
     lines = [f"short circuit of ID1's motor at s0 = {op.s0:g}, v = {op.v_kmh:g} km/h, "
              f"N0 = {op.N0:g} N: M(s0, v) = {result.motor_torque:.6g} N m, M0 = {e.M0:g} N m, "
@@ -134,7 +144,95 @@ def summary_table(result) -> str:
     return "\n".join(lines + limit_lines(result))
 
 
-def write_result(result, path: Path) -> None:
+def write_linear(result, path: Path) -> None:
     write_series(path, result.t, result.M_C,
                  {name: (result.outputs[name], result.units[name]) for name in result.outputs},
-                 result.steady, summary_data(result))
+                 result.steady, linear_summary(result))
+
+
+# --- --creep nonlinear | tangent: the step-by-step solution with creep forces, anti-slip --------
+
+def nonlinear_series(result) -> dict[str, tuple[np.ndarray, str]]:
+    """Every time series of a nonlinear result: name -> (values, unit)."""
+    out = {name: (y, result.units[name]) for name, y in result.outputs.items()}
+    for rim in result.creepage:
+        out[f"{rim}.creepage"] = (result.creepage[rim], "-")
+        out[f"{rim}.slip_velocity"] = (result.slip_velocity[rim], "m/s")
+        out[f"{rim}.utilisation"] = (result.utilisation[rim], "-")
+    for name, y in result.motor_torques.items():
+        out[name] = (y, "N m")
+    return out
+
+
+def nonlinear_summary(result) -> dict:
+    a = result.anti_slip
+    return {
+        "operating_point": result.operating_point.as_dict(),
+        "excitation": {"M0": result.excitation.M0, "f": result.excitation.f,
+                       "D": result.excitation.D},
+        "creep": result.creep_model, "motor_torque": result.motor_torque,
+        "mu_max": result.mu_max, "limits": result.limits,
+        "anti_slip": None if a is None else {"delay_s": a.delay, "threshold_m_s": a.threshold,
+                                             "rate_per_s": a.rate, "floor": a.floor},
+        "detection_time": result.detection_time, "action_time": result.action_time,
+        "newton_iterations_per_step": result.newton_iterations,
+        "outputs": {name: {"unit": result.units[name], "steady": result.steady[name],
+                           "peak": result.peaks[name], "peak_time": result.peak_times[name],
+                           "perturbation_peak": result.perturbation_peaks[name]}
+                    for name in result.outputs},
+        "wheels": {rim: {"creepage_min": float(result.creepage[rim].min()),
+                         "creepage_max": float(result.creepage[rim].max()),
+                         "slip_velocity_max": float(np.abs(result.slip_velocity[rim]).max()),
+                         "utilisation_max": float(np.abs(result.utilisation[rim]).max())}
+                   for rim in result.creepage},
+        "limit_crossings": [{"output": c.output, "limit": c.limit_name, "limit_value": c.limit,
+                             "time": c.time, "value": c.value} for c in result.limit_crossings],
+    }
+
+
+def nonlinear_table(result) -> str:
+    op, a = result.operating_point, result.anti_slip
+    protection = "anti-slip off" if a is None else (
+        f"anti-slip on: threshold {a.threshold:g} m/s, delay {a.delay:g} s, rate {a.rate:g} 1/s, "
+        f"floor {a.floor:g}; " + ("never detected" if result.detection_time is None else
+                                  f"detected at {result.detection_time:.4f} s, acts at "
+                                  f"{result.action_time:.4f} s"))
+    lines = [f"short circuit of ID1's motor at s0 = {op.s0:g}, v = {op.v_kmh:g} km/h, "
+             f"N0 = {op.N0:g} N, creep {result.creep_model}: M(s0, v) = "
+             f"{result.motor_torque:.6g} N m, μ_max = {result.mu_max:.4g}",
+             protection,
+             f"{len(result.t)} points to t = {result.t[-1]:g} s; values are totals "
+             f"(pre-fault + perturbation); {result.newton_iterations:.2f} Newton iterations/step",
+             "", f"{'output':<30} {'unit':<4} {'steady':>11} {'peak':>11} {'at [s]':>8} "
+             f"{'Δpeak':>11}"]
+    for name in result.outputs:
+        lines.append(f"{name:<30} {result.units[name]:<4} {result.steady[name]:>11.4g} "
+                     f"{result.peaks[name]:>11.4g} {result.peak_times[name]:>8.4f} "
+                     f"{result.perturbation_peaks[name]:>11.4g}")
+    lines += ["", f"{'wheel':<12} {'creepage min':>12} {'max':>10} {'|slip v| max [m/s]':>19} "
+              f"{'|μ|/μ_max max':>14}"]
+    for rim in result.creepage:
+        lines.append(f"{rim:<12} {result.creepage[rim].min():>12.5f} "
+                     f"{result.creepage[rim].max():>10.5f} "
+                     f"{np.abs(result.slip_velocity[rim]).max():>19.4g} "
+                     f"{np.abs(result.utilisation[rim]).max():>14.4f}")
+    for name, y in result.motor_torques.items():
+        lines.append(f"{name}: from {y[0]:.5g} to {y[-1]:.5g} N m (min {y.min():.5g}, max "
+                     f"{y.max():.5g})")
+    return "\n".join(lines + limit_lines(result))
+
+
+def write_nonlinear(result, path: Path) -> None:
+    write_series(path, result.t, result.M_C, nonlinear_series(result), result.steady,
+                 nonlinear_summary(result))
+
+
+def run_nonlinear(args: argparse.Namespace, excitation, names, out: Path | None) -> None:
+    """The ``--creep nonlinear|tangent`` branch of ``bogie response``."""
+    from model.analysis.nonlinear import nonlinear_response
+
+    anti_slip = anti_slip_from(args) if args.anti_slip == "on" else None
+    model, op, _ = load_model(args)
+    result = nonlinear_response(model, op, excitation, args.t_end, args.fs, creep=args.creep,
+                                anti_slip=anti_slip, outputs=names, strength=args.strength)
+    finish(args, result, out, write_nonlinear, nonlinear_summary, nonlinear_table)
