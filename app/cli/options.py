@@ -1,11 +1,14 @@
 """Argument helpers every command group of ``bogie`` shares, so that no command imports another.
 
 The parser whose errors are one line with exit status 2; argparse types for numbers with
-bounds; the operating point (``--s0 --v --n0 --bm --params --json``) and the model it builds;
-ranges ``A:B:N`` and value lists ``x1,x2,…``; the nonlinear creep and anti-slip options of
-``bogie response`` and ``bogie antislip``; the uncertainty options of ``bogie uncertainty`` and
-``bogie study uncertainty``.  A check that fails raises :class:`UsageError`, which
-:func:`app.cli.main.main` prints as one line on stderr with exit status 2.
+bounds (:func:`bounded` takes the allowed interval as it is printed, ``"(0, 60]"``, so the check
+and its message cannot drift apart); the operating point (``--s0 --v --n0 --bm --params
+--json``) and the model it builds; ranges ``A:B:N`` and value lists ``x1,x2,…``; the time grid
+(``--t-end --fs``) and the short circuit (``--m0 --f --decay --phase``) of the commands that
+compute a response; the nonlinear creep and anti-slip options of ``bogie response`` and
+``bogie antislip``; the uncertainty options of ``bogie uncertainty`` and ``bogie study
+uncertainty``.  A check that fails raises :class:`UsageError`, which :func:`app.cli.main.main`
+prints as one line on stderr with exit status 2.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from __future__ import annotations
 import argparse
 import itertools
 import math
+import re
 from collections.abc import Callable
 
 import numpy as np
@@ -53,6 +57,24 @@ def number(label: str, low: float = -math.inf, high: float = math.inf, low_open:
     return parse
 
 
+_INTERVAL = re.compile(r"^([\[(])(\S+), (\S+)([\])])$")
+
+
+def bounded(label: str, interval: str, unit: str = "") -> Callable[[str], float]:
+    """argparse type: a finite float in ``interval``, written as it is printed (``"(0, 60]"``:
+    0 excluded, 60 included; ``"[1, 500]"``; ``"(0, 1e7)"``) followed by ``unit``.  A value
+    outside: ``<label> = <text> is not allowed: must be in <interval> <unit>``."""
+    match = _INTERVAL.match(interval)
+    try:
+        opening, low, high, closing = match.groups()
+        ends = float(low), float(high)
+    except (AttributeError, ValueError):
+        raise ValueError(f"interval {interval!r} is not written as '(a, b]' or the like") from None
+    allowed = f"must be in {interval}" + (f" {unit}" if unit else "")
+    return number(label, *ends, low_open=opening == "(", high_open=closing == ")",
+                  allowed=allowed)
+
+
 def non_negative_int(label: str) -> Callable[[str], int]:
     def parse(text: str) -> int:
         try:
@@ -82,16 +104,15 @@ def positive_int(label: str) -> Callable[[str], int]:
 # --- the operating point -------------------------------------------------------------------------
 
 def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.005) -> None:
-    parser.add_argument("--s0", type=number("--s0 (creepage)", 0, 1, allowed="must be in (0, 1)"),
+    """``--s0 --v --n0 --bm --params --json`` (``s0``: the default creepage; None: not given)."""
+    parser.add_argument("--s0", type=bounded("--s0 (creepage)", "(0, 1)"),
                         default=s0, help="longitudinal creepage s0 [-] (default %(default)s)")
-    parser.add_argument("--v", type=number("--v (speed, km/h)", 1, 500, False, False,
-                                           allowed="must be in [1, 500] km/h"),
+    parser.add_argument("--v", type=bounded("--v (speed, km/h)", "[1, 500]", "km/h"),
                         default=120.0, help="speed [km/h] (default %(default)s)")
-    parser.add_argument("--n0", type=number("--n0 (wheel force, N)", 1e3, 1e6, False, False,
-                                            allowed="must be in [1e3, 1e6] N"),
+    parser.add_argument("--n0", type=bounded("--n0 (wheel force, N)", "[1e3, 1e6]", "N"),
                         default=None, help="static wheel force N0 [N] (default: parameter set)")
-    parser.add_argument("--bm", type=number("--bm (motor slope, N m s/rad)", 0, 1e9, False, False,
-                                            allowed="must be in [0, 1e9] N m s/rad"),
+    parser.add_argument("--bm", type=bounded("--bm (motor slope, N m s/rad)", "[0, 1e9]",
+                                             "N m s/rad"),
                         default=None, help="motor slope b_M [N m s/rad] (default: parameter set)")
     parser.add_argument("--params", default=None, metavar="FILE",
                         help="parameter file (TOML; default: the calibrated set)")
@@ -99,7 +120,8 @@ def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.00
 
 
 def load_model(args: argparse.Namespace):
-    """(model, operating point) from the common options."""
+    """(model, operating point or None without ``--s0``, (N0 [N], b_M [N m s/rad])) from the
+    operating point options; N0 and b_M default to the parameter set's."""
     from model.mechanics.assembly import build_model
     from model.mechanics.operating_point import OperatingPoint
 
@@ -162,30 +184,99 @@ def parse_values(text: str, label: str, low: float, high: float, unit: str,
     return [float(v) for v in values]
 
 
+# --- the time grid of a response ----------------------------------------------------------------
+
+T_END = "(0, 60]"  # [s]: the horizons model.analysis.response accepts (MAX_T_END)
+FS = "(0, 1e7)"  # [Hz]
+MAX_SAMPLES = 2_000_000  # t_end × fs: the longest history model.analysis.response computes
+
+
+def add_time_grid(p: argparse.ArgumentParser, t_end_help: str, fs_help: str | None = None, *,
+                  t_end: str = T_END, fs: str = FS) -> None:
+    """``--t-end`` [s] (default 2) and, with ``fs_help``, ``--fs`` [Hz] (default 10 000).
+    ``t_end_help``/``fs_help`` say what the values mean for the command ("horizon of each run");
+    ``t_end``/``fs`` are the allowed intervals, narrower where a command needs it (give the
+    reason at the call).  With ``--fs``, call :func:`check_samples` before computing."""
+    p.add_argument("--t-end", type=bounded("--t-end (horizon, s)", t_end, "s"), default=2.0,
+                   help=f"{t_end_help} [s] (default %(default)s)")
+    if fs_help is not None:
+        p.add_argument("--fs", type=bounded("--fs (sampling rate, Hz)", fs, "Hz"),
+                       default=10_000.0, help=f"{fs_help} [Hz] (default %(default)s)")
+
+
+def check_samples(args: argparse.Namespace) -> None:
+    """Refuse a grid ``--t-end × --fs`` longer than :data:`MAX_SAMPLES` before any work."""
+    if args.t_end * args.fs > MAX_SAMPLES:
+        raise UsageError(f"--t-end × --fs = {args.t_end * args.fs:.0f} samples is too many: at "
+                         f"most {MAX_SAMPLES}")
+
+
+# --- the short circuit ---------------------------------------------------------------------------
+
+M0 = "[0, 1e8]"  # [N m]: the amplitudes model.analysis.response.ShortCircuit accepts
+FREQUENCY = "(0, 1e5)"  # [Hz]
+DECAY = "[0, 10]"  # [-]
+PHASE = "[-10, 10]"  # [s]
+
+
+def add_short_circuit(p: argparse.ArgumentParser, *, m0: str = M0, f: str = FREQUENCY,
+                      decay: str = DECAY, phase: str | None = PHASE) -> None:
+    """``--m0`` [N m], ``--f`` [Hz], ``--decay`` [-] and (unless ``phase`` is None) ``--phase``
+    [s] of the short-circuit torque, defaults those of
+    :class:`model.analysis.response.ShortCircuit` (``--phase``: none, the motor torque is
+    continuous).  The arguments are the allowed intervals, narrower where a command needs it
+    (give the reason at the call).  :func:`short_circuit_from` builds the excitation."""
+    from model.analysis.response import ShortCircuit
+
+    defaults = ShortCircuit()
+    p.add_argument("--m0", type=bounded("--m0 (amplitude, N m)", m0, "N m"), default=defaults.M0,
+                   help="short-circuit amplitude M0 (oscillating part) [N m] "
+                        "(default %(default)s)")
+    p.add_argument("--f", type=bounded("--f (frequency, Hz)", f, "Hz"), default=defaults.f,
+                   help="short-circuit frequency f (oscillating part) [Hz] (default %(default)s)")
+    p.add_argument("--decay", type=bounded("--decay (D)", decay), default=defaults.D,
+                   help="short-circuit decay D: envelope e^(-D 2π f t) [-] (default %(default)s)")
+    if phase is not None:
+        p.add_argument("--phase", type=bounded("--phase (Δt, s)", phase, "s"), default=None,
+                       help="time shift Δt [s] (default: continuous motor torque)")
+
+
+def short_circuit_from(args: argparse.Namespace):
+    """The :class:`model.analysis.response.ShortCircuit` of the options of
+    :func:`add_short_circuit`."""
+    from model.analysis.response import ShortCircuit
+
+    return ShortCircuit(M0=args.m0, f=args.f, D=args.decay, dt=getattr(args, "phase", None))
+
+
 # --- nonlinear creep and the anti-slip protection ------------------------------------------------
 
 ANTI_SLIP_OPTIONS = ("anti_slip_delay", "anti_slip_threshold", "anti_slip_rate", "anti_slip_floor")
 
 
 def add_anti_slip_arguments(p: argparse.ArgumentParser, with_delay: bool = True) -> None:
-    """The protection's options (defaults: :class:`model.analysis.nonlinear.AntiSlip`)."""
+    """The protection's options, defaults those of :class:`model.analysis.nonlinear.AntiSlip`
+    (None in the namespace: :func:`anti_slip_from` fills them in, :func:`check_creep_arguments`
+    sees which were given)."""
+    from model.analysis.nonlinear import AntiSlip
+
+    defaults = AntiSlip()
     if with_delay:
-        p.add_argument("--anti-slip-delay", type=number(
-            "--anti-slip-delay (s)", 0, 60, low_open=False, high_open=False,
-            allowed="must be in [0, 60] s"), default=None,
-            help="reaction delay after detection [s] (default 0.1)")
+        p.add_argument("--anti-slip-delay", type=bounded("--anti-slip-delay (s)", "[0, 60]", "s"),
+                       default=None,
+                       help=f"reaction delay after detection [s] (default {defaults.delay:g})")
     p.add_argument("--anti-slip-threshold", type=number(
         "--anti-slip-threshold (m/s)", 0, 100, high_open=False,
         allowed="must be > 0 and at most 100 m/s"), default=None,
         help="change of ID2's wheelset slip velocity that trips the protection [m/s] "
-             "(default 0.3)")
+             f"(default {defaults.threshold:g})")
     p.add_argument("--anti-slip-rate", type=number(
         "--anti-slip-rate (1/s)", 0, 1e6, high_open=False,
         allowed="must be > 0 and at most 1e6 1/s"), default=None,
-        help="torque reduction rate [fraction of M(s0, v) per s] (default 10)")
-    p.add_argument("--anti-slip-floor", type=number(
-        "--anti-slip-floor", 0, 1, low_open=False, allowed="must be in [0, 1)"), default=None,
-        help="torque kept after the reduction [fraction of M(s0, v)] (default 0)")
+        help=f"torque reduction rate [fraction of M(s0, v) per s] (default {defaults.rate:g})")
+    p.add_argument("--anti-slip-floor", type=bounded("--anti-slip-floor", "[0, 1)"), default=None,
+                   help="torque kept after the reduction [fraction of M(s0, v)] "
+                        f"(default {defaults.floor:g})")
 
 
 def add_creep_arguments(p: argparse.ArgumentParser) -> None:
@@ -197,13 +288,14 @@ def add_creep_arguments(p: argparse.ArgumentParser) -> None:
                    help="anti-slip protection on ID2's motor torque (needs --creep nonlinear or "
                         "tangent; default off)")
     add_anti_slip_arguments(p)
-    p.add_argument("--strength", type=number("--strength (N m)", 0, 1e9,
-                                             allowed="must be in (0, 1e9) N m"), default=None,
+    p.add_argument("--strength", type=bounded("--strength (N m)", "(0, 1e9)", "N m"), default=None,
                    help="design strength [N m] of the disc and claw clutch (the driving shaft: "
                         "strength/p); crossings are listed (needs --creep nonlinear or tangent)")
 
 
 def anti_slip_from(args: argparse.Namespace, delay: bool = True):
+    """The :class:`model.analysis.nonlinear.AntiSlip` of the options (its defaults where not
+    given; ``delay=False``: the default delay, for ``bogie antislip``, which varies it)."""
     from model.analysis.nonlinear import AntiSlip
 
     defaults = AntiSlip()

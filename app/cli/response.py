@@ -29,10 +29,13 @@ from app.cli.options import (
     UsageError,
     add_creep_arguments,
     add_operating_point,
+    add_short_circuit,
+    add_time_grid,
     anti_slip_from,
     check_creep_arguments,
+    check_samples,
     load_model,
-    number,
+    short_circuit_from,
 )
 from app.cli.output import check_history_file, finish, limit_lines, write_series
 
@@ -42,51 +45,28 @@ MIN_SAMPLES_PER_PERIOD = 2.5  # fs must exceed 2.5 × the highest excited freque
 def register(subparsers) -> None:
     p = subparsers.add_parser("response", help="short-circuit time response of the drive loads")
     add_operating_point(p)
-    p.add_argument("--m0", type=number("--m0 (amplitude, N m)", 0, 1e8, low_open=False,
-                                       allowed="must be in [0, 1e8] N m"),
-                   default=None, help="amplitude M0 of the oscillating part [N m] (default 50000)")
-    p.add_argument("--f", type=number("--f (frequency, Hz)", 0, 1e5,
-                                      allowed="must be in (0, 1e5) Hz"),
-                   default=None, help="frequency f of the oscillating part [Hz] (default 90)")
-    p.add_argument("--decay", type=number("--decay (D)", 0, 10, low_open=False,
-                                          allowed="must be in [0, 10]"),
-                   default=None, help="decay D: envelope e^(-D 2π f t) [-] (default 0.04)")
-    p.add_argument("--phase", type=number("--phase (Δt, s)", -10, 10, low_open=False,
-                                          high_open=False, allowed="must be in [-10, 10] s"),
-                   default=None, help="time shift Δt [s] (default: continuous motor torque)")
-    p.add_argument("--t-end", type=number("--t-end (horizon, s)", 0, 60, high_open=False,
-                                          allowed="must be in (0, 60] s"),
-                   default=2.0, help="horizon [s] (default %(default)s)")
-    p.add_argument("--fs", type=number("--fs (sampling rate, Hz)", 0, 1e7,
-                                       allowed="must be in (0, 1e7) Hz"),
-                   default=10_000.0, help="output sampling rate [Hz] (default %(default)s)")
+    add_short_circuit(p)
+    add_time_grid(p, "horizon", "output sampling rate")
     p.add_argument("--outputs", default=None,
                    help="comma-separated output or DOF names (default: all loads)")
     p.add_argument("--method", choices=("auto", "modal", "expm"), default="auto",
                    help="evaluation of the closed form (default %(default)s)")
     p.add_argument("--out", default=None, help="write .npz, .csv or .json")
-    add_creep_arguments(p)  # issue 10: --creep, --anti-slip …
+    add_creep_arguments(p)
     p.set_defaults(func=cmd_response)
 
 
 def cmd_response(args: argparse.Namespace) -> None:
-    from model.analysis.response import ShortCircuit, short_circuit_response
+    from model.analysis.response import short_circuit_response
 
     out = check_history_file(args.out)
     check_creep_arguments(args)
-    defaults = ShortCircuit()
-    excitation = ShortCircuit(
-        M0=defaults.M0 if args.m0 is None else args.m0,
-        f=defaults.f if args.f is None else args.f,
-        D=defaults.D if args.decay is None else args.decay,
-        dt=args.phase)
+    excitation = short_circuit_from(args)
     if args.fs < MIN_SAMPLES_PER_PERIOD * excitation.f:
         raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the excitation at "
                          f"f = {excitation.f:g} Hz: must be at least "
                          f"{MIN_SAMPLES_PER_PERIOD * excitation.f:g} Hz")
-    if args.t_end * args.fs > 2_000_000:
-        raise UsageError(f"--t-end × --fs = {args.t_end * args.fs:.0f} samples is too many: at "
-                         "most 2000000")
+    check_samples(args)
     names = None if args.outputs is None else [s.strip() for s in args.outputs.split(",")
                                                 if s.strip()]
     if args.creep != "linear":
