@@ -6,8 +6,8 @@
 
 Units as in ``bogie response``: ``--n0`` [N], ``--m0`` [N m], ``--phase`` [s].  ``--variant``:
 a design variant as ``name:value,…`` (SI) applied to the set, as in the dashboard's links.  The
-report itself is built by :mod:`app.report.page` (imported only by this command: ``model`` does not
-depend on the app otherwise).  Bad input: one line on stderr, exit status 2.
+report itself is built by :mod:`app.report.page` (imported when the command runs, so that the
+other commands do not load Bokeh).  Bad input: one line on stderr, exit status 2.
 """
 
 from __future__ import annotations
