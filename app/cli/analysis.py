@@ -17,7 +17,7 @@ import argparse
 
 import numpy as np
 
-from app.cli.options import UsageError, add_operating_point, load_model, number, parse_range, positive_int
+from app.cli.options import UsageError, add_operating_point, bounded, load_model, parse_range, positive_int
 from app.cli.output import emit
 
 
@@ -42,8 +42,7 @@ def register(subparsers) -> None:
     add_operating_point(p)
     p.add_argument("--s0-range", default=None, metavar="A:B:N", help="creepage sweep")
     p.add_argument("--v-range", default=None, metavar="A:B:N", help="speed sweep [km/h]")
-    p.add_argument("--max-frequency", type=number("--max-frequency (Hz)", 0.5, 500,
-                                                  allowed="must be in (0.5, 500) Hz"),
+    p.add_argument("--max-frequency", type=bounded("--max-frequency (Hz)", "(0.5, 500)", "Hz"),
                    default=20.0, help="track eigenvalues with |λ| < 2π f [Hz] (default %(default)s)")
     p.set_defaults(func=cmd_locus)
 

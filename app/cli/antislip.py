@@ -22,9 +22,9 @@ from app.cli.options import (
     add_operating_point,
     add_time_grid,
     anti_slip_from,
+    bounded,
     check_samples,
     load_model,
-    number,
     parse_range,
 )
 from app.cli.output import emit
@@ -34,8 +34,7 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("antislip", help="required reaction time of the anti-slip "
                               "protection (nonlinear creep) and the curve peak(delay)")
     add_operating_point(p, s0=0.014)
-    p.add_argument("--limit", type=number("--limit (N m)", 0, 1e9, allowed="must be in (0, 1e9) "
-                                          "N m"), default=None,
+    p.add_argument("--limit", type=bounded("--limit (N m)", "(0, 1e9)", "N m"), default=None,
                    help="wheel-side torque limit [N m] (default M_ad = 2 N0 r0 μ_max)")
     p.add_argument("--delays", default="0:0.5:26", metavar="A:B:N",
                    help="delays of the curve [s] (default %(default)s)")

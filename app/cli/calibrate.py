@@ -8,7 +8,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from app.cli.options import UsageError, number, positive_int
+from app.cli.options import UsageError, bounded, positive_int
 
 
 def register(subparsers) -> None:
@@ -18,8 +18,7 @@ def register(subparsers) -> None:
     p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=2400,
                    help="trial parameter sets of stages B1 and B2 (the characters, then Table 1 "
                         "by rank), each up to three eigen-analyses (default %(default)s)")
-    p.add_argument("--budget-scale", type=number("--budget-scale", 0.001, 10, high_open=False,
-                                                 allowed="must be in (0.001, 10]"),
+    p.add_argument("--budget-scale", type=bounded("--budget-scale", "(0.001, 10]"),
                    default=1.0, help="multiply the evaluation budgets of stages D-F (the ranking; "
                                      "default %(default)s; smaller for a quick check)")
     p.add_argument("--json", action="store_true", help="progress to stderr")

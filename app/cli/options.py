@@ -76,6 +76,8 @@ def bounded(label: str, interval: str, unit: str = "") -> Callable[[str], float]
 
 
 def non_negative_int(label: str) -> Callable[[str], int]:
+    """argparse type: a whole number >= 0, with a clear message otherwise."""
+
     def parse(text: str) -> int:
         try:
             value = int(text)
@@ -89,6 +91,8 @@ def non_negative_int(label: str) -> Callable[[str], int]:
 
 
 def positive_int(label: str) -> Callable[[str], int]:
+    """argparse type: a whole number >= 1, with a clear message otherwise."""
+
     def parse(text: str) -> int:
         try:
             value = int(text)

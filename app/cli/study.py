@@ -25,7 +25,14 @@ import time
 
 import numpy as np
 
-from app.cli.options import UsageError, add_uncertainty_options, number, parse_values, positive_int, uncertainty_options
+from app.cli.options import (
+    UsageError,
+    add_uncertainty_options,
+    bounded,
+    parse_values,
+    positive_int,
+    uncertainty_options,
+)
 
 EXIT_INTERRUPTED = 130
 
@@ -54,8 +61,7 @@ def _engine_options(p: argparse.ArgumentParser) -> None:
                    help="worker processes of the local cluster (default: one per core)")
     p.add_argument("--serial", action="store_true",
                    help="compute in this process, without Dask (the reference)")
-    p.add_argument("--connect-timeout", type=number("--connect-timeout (s)", 0, 600,
-                                                    allowed="must be in (0, 600) s"),
+    p.add_argument("--connect-timeout", type=bounded("--connect-timeout (s)", "(0, 600)", "s"),
                    default=10.0, help="seconds to reach the scheduler (default %(default)s)")
 
 
@@ -65,8 +71,7 @@ def register(subparsers) -> None:
     m = sub.add_parser("map", help="stability map over s0 × v (× N0 × b_M)")
     m.add_argument("--s0", required=True, metavar="A:B:N", help="creepages s0 [-], increasing")
     m.add_argument("--v", required=True, metavar="A:B:N", help="speeds [km/h]")
-    m.add_argument("--max-frequency", type=number("--max-frequency (Hz)", 0.5, 500,
-                                                  allowed="must be in (0.5, 500) Hz"),
+    m.add_argument("--max-frequency", type=bounded("--max-frequency (Hz)", "(0.5, 500)", "Hz"),
                    default=10.0, help="method reduced: reduction basis disc |λ| < 2π f [Hz] "
                    "(default %(default)s)")
     m.add_argument("--method", choices=("reduced", "continuation", "dense"),
