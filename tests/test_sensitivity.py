@@ -301,7 +301,7 @@ def test_uncertainty_bad_input(setup):
 def test_cli_bad_input(argv, message, capsys):
     try:
         status = main(argv)
-    except SystemExit as stop:  # argparse's own errors (one line, see app.cli.main._Parser)
+    except SystemExit as stop:  # argparse's own errors (one line, see app.cli.options.BogieParser)
         status = stop.code
     assert status == 2
     err = capsys.readouterr().err

@@ -1,8 +1,11 @@
 """The command line ``bogie`` (also ``python -m app``): a module per command group.
 
-:mod:`.main` builds the parser and runs a command; :mod:`.options` holds the argument helpers
-every group shares (numbers with bounds, the operating point, the time grid), so that no command
-module imports another.  Groups: :mod:`.main` (eigen, limit, modes, locus, calibrate, export,
-serve), :mod:`.response`, :mod:`.antislip`, :mod:`.sensitivity`, :mod:`.study`, :mod:`.compare`,
-:mod:`.report`.  Bad input: one line on stderr, exit status 2.
+:mod:`.main` builds the parser from the groups' ``register`` functions and runs a command.
+Groups: :mod:`.analysis` (eigen, limit, modes, locus, export), :mod:`.calibrate`, :mod:`.serve`,
+:mod:`.response`, :mod:`.antislip`, :mod:`.sensitivity` (sensitivity, uncertainty),
+:mod:`.study`, :mod:`.compare`, :mod:`.report`.  What several groups need lives below them:
+:mod:`.options` (the parser, numbers with bounds, the operating point, ranges, the time grid, the
+short circuit, the creep, anti-slip and uncertainty options) and :mod:`.output` (JSON or a table,
+time histories to files, limit lines).  No group imports another (an import-linter contract in
+pyproject.toml).  Bad input: one line on stderr, exit status 2.
 """

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import argparse
 
-from app.cli.main import UsageError, add_operating_point, emit, number
+from app.cli.options import UsageError, add_operating_point, add_short_circuit, add_time_grid, short_circuit_from
+from app.cli.output import emit
 
 
 def register(subparsers) -> None:
@@ -22,18 +23,9 @@ def register(subparsers) -> None:
     p.add_argument("base", metavar="BASE.toml", help="baseline parameter file")
     p.add_argument("variant", metavar="VARIANT.toml", help="variant parameter file")
     add_operating_point(p)
-    p.add_argument("--m0", type=number("--m0 (amplitude, N m)", 0, 1e8, low_open=False,
-                                       allowed="must be in [0, 1e8] N m"),
-                   default=50_000.0, help="short-circuit amplitude M0 [N m] (default %(default)s)")
-    p.add_argument("--f", type=number("--f (frequency, Hz)", 0, 1e4,
-                                      allowed="must be in (0, 1e4) Hz"),
-                   default=90.0, help="short-circuit frequency f [Hz] (default %(default)s)")
-    p.add_argument("--decay", type=number("--decay (D)", 0, 10, low_open=False,
-                                          allowed="must be in [0, 10]"),
-                   default=0.04, help="decay D [-] (default %(default)s)")
-    p.add_argument("--t-end", type=number("--t-end (horizon, s)", 0, 60, high_open=False,
-                                          allowed="must be in (0, 60] s"),
-                   default=2.0, help="horizon of the response [s] (default %(default)s)")
+    # the comparison samples its response at a fixed 10 kHz (no --fs): f stays below that rate
+    add_short_circuit(p, f="(0, 1e4)", phase=None)
+    add_time_grid(p, "horizon of the response")
     p.set_defaults(func=cmd_compare)
 
 
@@ -72,7 +64,6 @@ def comparison_table(data: dict) -> str:
 def cmd_compare(args: argparse.Namespace) -> None:
     import sys
 
-    from model.analysis.response import ShortCircuit
     from model.mechanics.parameters import load_parameters
     from model.studies.compare import compare_designs
 
@@ -82,7 +73,7 @@ def cmd_compare(args: argparse.Namespace) -> None:
         raise UsageError("--s0 is required")
     base, variant = load_parameters(args.base), load_parameters(args.variant)
     result = compare_designs(base, variant, args.s0, args.v, args.n0, args.bm,
-                             ShortCircuit(M0=args.m0, f=args.f, D=args.decay), args.t_end,
+                             short_circuit_from(args), args.t_end,
                              progress=lambda text: print(f"bogie compare: {text}",
                                                          file=sys.stderr, flush=True))
     data = result.as_dict()

@@ -26,23 +26,21 @@ from pathlib import Path
 
 import numpy as np
 
-from app.cli.antislip import add_anti_slip_arguments
-from app.cli.main import UsageError
-from app.cli.response import (
-    add_response_options,
-    add_time_options,
-    check_out,
-    check_sampling,
-    history_from_args,
-    output_names,
-)
-from app.cli.study import (
+from app.cli.options import (
     EXIT_INTERRUPTED,
-    ProgressBar,
+    UsageError,
+    add_anti_slip_arguments,
     add_engine_options,
+    add_history_options,
+    add_output_selection,
+    add_time_grid,
+    check_samples,
+    check_sampling,
+    output_names,
     parse_values,
-    start_engine,
 )
+from app.cli.output import check_history_file
+from app.cli.runs import ProgressBar, history_from_args, start_engine
 
 AXIS_LABELS = {"rail": "rail", "s0": "s0", "v": "v [km/h]", "N0": "N0 [N]", "b_M": "b_M",
                "M0": "M0 [N m]", "f": "f [Hz]", "D": "D", "anti_slip": "anti-slip",
@@ -79,7 +77,8 @@ def register(subparsers) -> None:
     p.add_argument("--anti-slip-delay", default=None, metavar="LIST",
                    help="reaction delays of the protection [s] (default 0.1)")
     add_anti_slip_arguments(p, with_delay=False)
-    add_time_options(p)
+    add_time_grid(p, "horizon", "output sampling rate")
+    add_output_selection(p)
     p.add_argument("--params", default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
     p.add_argument("--out", default=None, metavar="X.zarr",
@@ -92,7 +91,7 @@ def register(subparsers) -> None:
 
     s = subparsers.add_parser("spectrum", help="load spectrum of a short-circuit history: "
                               "rainflow cycles, load collective, damage-equivalent ranges")
-    add_response_options(s)
+    add_history_options(s)
     s.add_argument("--slopes", default="3,5", metavar="LIST",
                    help="Wöhler slopes m of the equivalent ranges (default %(default)s)")
     s.add_argument("--out", default=None, help="write .npz, .csv or .json")
@@ -139,7 +138,8 @@ def study_from_args(args: argparse.Namespace):
               if args.anti_slip_delay is not None else [])
     if args.creep != "linear" and args.method != "auto":
         raise UsageError("--method applies to --creep linear only")
-    check_sampling(args, max(f))
+    check_sampling(args, max(f), f"the excitation at f = {max(f):g} Hz")
+    check_samples(args)
     from model.studies.maps import cached_model
 
     model = cached_model(rail_parameters(parameters, rails[0]))
@@ -169,7 +169,8 @@ def _check_first_point(study, parameters, args) -> None:
     family = phase_families(model, op, [(max(study.f), study.D[0])], study.t_end, study.fs,
                             list(study.outputs), study.method)[0]
     if family.highest_excited_hz:
-        check_sampling(args, family.highest_excited_hz, "the highest excited frequency")
+        check_sampling(args, family.highest_excited_hz,
+                       f"the highest excited frequency {family.highest_excited_hz:.4g} Hz", ".4g")
 
 
 def cmd_envelope(args: argparse.Namespace) -> None:
@@ -366,7 +367,7 @@ def cmd_spectrum(args: argparse.Namespace) -> None:
     from model.analysis.load_spectrum import history_spectra
 
     slopes = _slopes(args.slopes)
-    out = check_out(args.out)
+    out = check_history_file(args.out)
     result = history_from_args(args)
     spectra = history_spectra(result, slopes)
     data = spectrum_data(result, spectra, args.creep)

@@ -6,8 +6,8 @@
 
 Units as in ``bogie response``: ``--n0`` [N], ``--m0`` [N m], ``--phase`` [s].  ``--variant``:
 a design variant as ``name:value,…`` (SI) applied to the set, as in the dashboard's links.  The
-report itself is built by :mod:`app.report.page` (imported only by this command: ``model`` does not
-depend on the app otherwise).  Bad input: one line on stderr, exit status 2.
+report itself is built by :mod:`app.report.page` (imported when the command runs, so that the
+other commands do not load Bokeh).  Bad input: one line on stderr, exit status 2.
 """
 
 from __future__ import annotations
@@ -15,27 +15,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from app.cli.main import UsageError, add_operating_point, number
+from app.cli.options import UsageError, add_operating_point, add_short_circuit, add_time_grid
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("report", help="self-contained HTML report of an operating point")
     add_operating_point(p)
-    p.add_argument("--m0", type=number("--m0 (amplitude, N m)", 0, 2e5, low_open=False,
-                                       high_open=False, allowed="must be in [0, 2e5] N m"),
-                   default=50_000.0, help="short-circuit amplitude M0 [N m] (default %(default)s)")
-    p.add_argument("--f", type=number("--f (frequency, Hz)", 10, 300, False, False,
-                                      allowed="must be in [10, 300] Hz"),
-                   default=90.0, help="short-circuit frequency f [Hz] (default %(default)s)")
-    p.add_argument("--decay", type=number("--decay (D)", 0, 0.3, False, False,
-                                          allowed="must be in [0, 0.3]"),
-                   default=0.04, help="decay D [-] (default %(default)s)")
-    p.add_argument("--phase", type=number("--phase (Δt, s)", -0.01, 0.01, False, False,
-                                          allowed="must be in [-0.01, 0.01] s"),
-                   default=None, help="time shift Δt [s] (default: continuous motor torque)")
-    p.add_argument("--t-end", type=number("--t-end (horizon, s)", 0.2, 5, False, False,
-                                          allowed="must be in [0.2, 5] s"),
-                   default=2.0, help="simulated time [s] (default %(default)s)")
+    # the report reproduces the dashboard: its sliders' ranges (app/dashboard/dashboard.py, there
+    # in kN m and ms) bound the short circuit and the simulated time
+    add_short_circuit(p, m0="[0, 2e5]", f="[10, 300]", decay="[0, 0.3]", phase="[-0.01, 0.01]")
+    add_time_grid(p, "simulated time", t_end="[0.2, 5]")
     p.add_argument("--rail", choices=("calibrated", "dry", "wet"), default="calibrated",
                    help="creep law (default: the set's own)")
     p.add_argument("--variant", default="", metavar="TEXT",

@@ -2,151 +2,62 @@
 
     bogie response --s0 0.005 --v 120 [--n0 N --bm B] [--m0 M0 --f F --decay D --phase DT]
                    --t-end T --fs FS [--out FILE.npz|.csv|.json] [--outputs a,b,…]
+                   [--creep linear|nonlinear|tangent [--anti-slip off|on --anti-slip-delay S
+                   --anti-slip-threshold M_S --anti-slip-rate PER_S --anti-slip-floor F]
+                   [--strength N_m]]
+
+``--creep linear`` (default) is the closed form of :mod:`model.analysis.response`; ``nonlinear``
+and ``tangent`` run :func:`model.analysis.nonlinear.nonlinear_response`.
 
 Without ``--out``: a table of peaks (totals), their times and dominant frequencies, and the
 limit crossings.  Files: ``.npz`` (array ``t`` [s], one array per output name (totals), ``M_C``,
 plus ``units``/``steady``), ``.csv`` (a column per output, the unit in the header), ``.json``.
-Bad input: one line on stderr, exit status 2.
+The nonlinear runs write the same output names plus per wheel ``<rim>.creepage`` [-],
+``<rim>.slip_velocity`` [m/s], ``<rim>.utilisation`` [-] and the motor torques
+``ID1.motor.torque``, ``ID2.motor.torque`` [N m].  Bad input: one line on stderr, exit status 2.
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
-import json
 import math
 from pathlib import Path
 
 import numpy as np
 
-from app.cli.antislip import add_creep_arguments, check_creep_arguments, nonlinear_history
-from app.cli.main import UsageError, add_operating_point, emit, load_model, number
-
-MIN_SAMPLES_PER_PERIOD = 2.5  # fs must exceed 2.5 × the highest excited frequency
+from app.cli.options import (
+    add_creep_arguments,
+    add_operating_point,
+    add_output_selection,
+    add_short_circuit,
+    add_time_grid,
+)
+from app.cli.output import check_history_file, finish, limit_lines, write_series
+from app.cli.runs import history_from_args
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("response", help="short-circuit time response of the drive loads")
-    add_response_options(p)
+    # add_history_options, with --out before the creep options (their order in --help)
+    add_operating_point(p)
+    add_short_circuit(p)
+    add_time_grid(p, "horizon", "output sampling rate")
+    add_output_selection(p)
     p.add_argument("--out", default=None, help="write .npz, .csv or .json")
+    add_creep_arguments(p)
     p.set_defaults(func=cmd_response)
 
 
-def add_response_options(p: argparse.ArgumentParser) -> None:
-    """Every option of ``bogie response`` but ``--out`` (shared with ``bogie spectrum``)."""
-    add_operating_point(p)
-    p.add_argument("--m0", type=number("--m0 (amplitude, N m)", 0, 1e8, low_open=False,
-                                       allowed="must be in [0, 1e8] N m"),
-                   default=None, help="amplitude M0 of the oscillating part [N m] (default 50000)")
-    p.add_argument("--f", type=number("--f (frequency, Hz)", 0, 1e5,
-                                      allowed="must be in (0, 1e5) Hz"),
-                   default=None, help="frequency f of the oscillating part [Hz] (default 90)")
-    p.add_argument("--decay", type=number("--decay (D)", 0, 10, low_open=False,
-                                          allowed="must be in [0, 10]"),
-                   default=None, help="decay D: envelope e^(-D 2π f t) [-] (default 0.04)")
-    p.add_argument("--phase", type=number("--phase (Δt, s)", -10, 10, low_open=False,
-                                          high_open=False, allowed="must be in [-10, 10] s"),
-                   default=None, help="time shift Δt [s] (default: continuous motor torque)")
-    add_time_options(p)
-    add_creep_arguments(p)  # issue 10: --creep, --anti-slip …
-
-
-def add_time_options(p: argparse.ArgumentParser) -> None:
-    """``--t-end``, ``--fs``, ``--outputs`` and ``--method`` (``bogie response``, ``bogie
-    spectrum``, ``bogie envelope``)."""
-    p.add_argument("--t-end", type=number("--t-end (horizon, s)", 0, 60, high_open=False,
-                                          allowed="must be in (0, 60] s"),
-                   default=2.0, help="horizon [s] (default %(default)s)")
-    p.add_argument("--fs", type=number("--fs (sampling rate, Hz)", 0, 1e7,
-                                       allowed="must be in (0, 1e7) Hz"),
-                   default=10_000.0, help="output sampling rate [Hz] (default %(default)s)")
-    p.add_argument("--outputs", default=None,
-                   help="comma-separated output or DOF names (default: all loads)")
-    p.add_argument("--method", choices=("auto", "modal", "expm"), default="auto",
-                   help="evaluation of the closed form (default %(default)s)")
-
-
-def check_sampling(args: argparse.Namespace, frequency_hz: float,
-                   what: str = "the excitation at f") -> None:
-    """Refuse ``--fs`` below 2.5 × ``frequency_hz`` and more than 2·10⁶ samples."""
-    if args.fs < MIN_SAMPLES_PER_PERIOD * frequency_hz:
-        raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve {what} = "
-                         f"{frequency_hz:.4g} Hz: must be at least "
-                         f"{MIN_SAMPLES_PER_PERIOD * frequency_hz:.4g} Hz")
-    if args.t_end * args.fs > 2_000_000:
-        raise UsageError(f"--t-end × --fs = {args.t_end * args.fs:.0f} samples is too many: at "
-                         "most 2000000")
-
-
-def output_names(args: argparse.Namespace) -> list[str] | None:
-    """The names of ``--outputs`` (None: all loads)."""
-    if args.outputs is None:
-        return None
-    return [s.strip() for s in args.outputs.split(",") if s.strip()]
-
-
-def check_out(path: str | None) -> Path | None:
-    if path is None:
-        return None
-    out = Path(path)
-    if out.suffix not in (".npz", ".csv", ".json"):
-        raise UsageError(f"unknown file extension '{out.suffix or out.name}': use .npz, .csv or "
-                         ".json")
-    if not out.parent.exists():
-        raise UsageError(f"directory '{out.parent}' does not exist")
-    return out
-
-
 def cmd_response(args: argparse.Namespace) -> None:
-    out = check_out(args.out)
+    out = check_history_file(args.out)
     result = history_from_args(args)
     if args.creep != "linear":
-        from app.cli.antislip import summary_data as nonlinear_summary
-        from app.cli.antislip import summary_table as nonlinear_table
-        from app.cli.antislip import write_result as write_nonlinear
-
         finish(args, result, out, write_nonlinear, nonlinear_summary, nonlinear_table)
         return
-    finish(args, result, out, write_result, summary_data, summary_table)
+    finish(args, result, out, write_linear, linear_summary, linear_table)
 
 
-def history_from_args(args: argparse.Namespace):
-    """The response the options of ``bogie response`` describe: a
-    :class:`model.analysis.response.ResponseResult` (``--creep linear``) or a
-    :class:`model.analysis.nonlinear.NonlinearResult`; bad options raise :class:`UsageError`."""
-    from model.analysis.response import ShortCircuit, short_circuit_response
-
-    check_creep_arguments(args)
-    defaults = ShortCircuit()
-    excitation = ShortCircuit(
-        M0=defaults.M0 if args.m0 is None else args.m0,
-        f=defaults.f if args.f is None else args.f,
-        D=defaults.D if args.decay is None else args.decay,
-        dt=args.phase)
-    check_sampling(args, excitation.f)
-    names = output_names(args)
-    if args.creep != "linear":
-        return nonlinear_history(args, excitation, names)
-    model, op, _ = load_model(args)
-    result = short_circuit_response(model, op, excitation, args.t_end, args.fs, names,
-                                    method=args.method)
-    if result.highest_excited_hz:
-        check_sampling(args, result.highest_excited_hz, "the highest excited frequency")
-    return result
-
-
-def finish(args: argparse.Namespace, result, out: Path | None, write, summarize, table) -> None:
-    """The tail of a response command: ``write(result, out)`` if asked, then the summary
-    (``summarize(result)``, JSON) or the table (``table(result)``, text)."""
-    if out is not None:
-        write(result, out)
-    summary = summarize(result)
-    if out is not None:
-        summary["out"] = str(out)
-    emit(args, summary, table(result) + (f"\nwrote {out}" if out else ""))
-
-
-def summary_data(result) -> dict:
+def linear_summary(result) -> dict:
     op = result.operating_point
     return {
         "operating_point": op.as_dict(),
@@ -167,7 +78,7 @@ def summary_data(result) -> dict:
     }
 
 
-def summary_table(result) -> str:
+def linear_table(result) -> str:
     op, e = result.operating_point, result.excitation
     lines = [f"short circuit of ID1's motor at s0 = {op.s0:g}, v = {op.v_kmh:g} km/h, "
              f"N0 = {op.N0:g} N: M(s0, v) = {result.motor_torque:.6g} N m, M0 = {e.M0:g} N m, "
@@ -188,47 +99,84 @@ def summary_table(result) -> str:
     return "\n".join(lines + limit_lines(result))
 
 
-def limit_lines(result) -> list[str]:
-    """The limits and their first crossings of a (linear or nonlinear) response, as text lines."""
-    lines = ["", "limits: " + ", ".join(f"{k} = {v:.5g}" for k, v in result.limits.items())]
-    if not result.limit_crossings:
-        return [*lines, "no limit crossed"]
-    lines.append("limit crossings (|total| > limit), first time:")
-    for c in result.limit_crossings:
-        lines.append(f"  {c.time:8.4f} s  {c.output} = {c.value:.5g} beyond {c.limit_name} = "
-                     f"{c.limit:.5g}")
-    return lines
-
-
-def write_result(result, path: Path) -> None:
+def write_linear(result, path: Path) -> None:
     write_series(path, result.t, result.M_C,
                  {name: (result.outputs[name], result.units[name]) for name in result.outputs},
-                 result.steady, summary_data(result))
+                 result.steady, linear_summary(result))
 
 
-def write_series(path: Path, t: np.ndarray, M_C: np.ndarray,
-                 series: dict[str, tuple[np.ndarray, str]], steady: dict[str, float],
-                 summary: dict) -> None:
-    """Time series (name -> (values, unit)) at times ``t`` [s] with the short-circuit torque
-    ``M_C`` [N m] as ``.npz`` (arrays, names, units, steady values; NaN where a series has
-    none), ``.csv`` (one column per series, units in the header) or ``.json`` (``summary``
-    plus the series)."""
-    names = list(series)
-    if path.suffix == ".npz":
-        arrays = {"t": t, "M_C": M_C, **{n: series[n][0] for n in names},
-                  "names": np.array(names, dtype=str),
-                  "units": np.array([series[n][1] for n in names], dtype=str),
-                  "steady": np.array([steady.get(n, np.nan) for n in names])}
-        np.savez(path, **arrays)
-    elif path.suffix == ".csv":
-        with path.open("w", newline="") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(["t [s]", "M_C [N m]"] + [f"{n} [{series[n][1]}]" for n in names])
-            table = np.column_stack([t, M_C] + [series[n][0] for n in names])
-            writer.writerows([[repr(float(x)) for x in row] for row in table])
-    else:
-        data = dict(summary)
-        data["t"] = t.tolist()
-        data["M_C"] = M_C.tolist()
-        data["series"] = {n: series[n][0].tolist() for n in names}
-        path.write_text(json.dumps(data, allow_nan=False))
+# --- --creep nonlinear | tangent: the step-by-step solution with creep forces, anti-slip --------
+
+def nonlinear_series(result) -> dict[str, tuple[np.ndarray, str]]:
+    """Every time series of a nonlinear result: name -> (values, unit)."""
+    out = {name: (y, result.units[name]) for name, y in result.outputs.items()}
+    for rim in result.creepage:
+        out[f"{rim}.creepage"] = (result.creepage[rim], "-")
+        out[f"{rim}.slip_velocity"] = (result.slip_velocity[rim], "m/s")
+        out[f"{rim}.utilisation"] = (result.utilisation[rim], "-")
+    for name, y in result.motor_torques.items():
+        out[name] = (y, "N m")
+    return out
+
+
+def nonlinear_summary(result) -> dict:
+    a = result.anti_slip
+    return {
+        "operating_point": result.operating_point.as_dict(),
+        "excitation": {"M0": result.excitation.M0, "f": result.excitation.f,
+                       "D": result.excitation.D},
+        "creep": result.creep_model, "motor_torque": result.motor_torque,
+        "mu_max": result.mu_max, "limits": result.limits,
+        "anti_slip": None if a is None else {"delay_s": a.delay, "threshold_m_s": a.threshold,
+                                             "rate_per_s": a.rate, "floor": a.floor},
+        "detection_time": result.detection_time, "action_time": result.action_time,
+        "newton_iterations_per_step": result.newton_iterations,
+        "outputs": {name: {"unit": result.units[name], "steady": result.steady[name],
+                           "peak": result.peaks[name], "peak_time": result.peak_times[name],
+                           "perturbation_peak": result.perturbation_peaks[name]}
+                    for name in result.outputs},
+        "wheels": {rim: {"creepage_min": float(result.creepage[rim].min()),
+                         "creepage_max": float(result.creepage[rim].max()),
+                         "slip_velocity_max": float(np.abs(result.slip_velocity[rim]).max()),
+                         "utilisation_max": float(np.abs(result.utilisation[rim]).max())}
+                   for rim in result.creepage},
+        "limit_crossings": [{"output": c.output, "limit": c.limit_name, "limit_value": c.limit,
+                             "time": c.time, "value": c.value} for c in result.limit_crossings],
+    }
+
+
+def nonlinear_table(result) -> str:
+    op, a = result.operating_point, result.anti_slip
+    protection = "anti-slip off" if a is None else (
+        f"anti-slip on: threshold {a.threshold:g} m/s, delay {a.delay:g} s, rate {a.rate:g} 1/s, "
+        f"floor {a.floor:g}; " + ("never detected" if result.detection_time is None else
+                                  f"detected at {result.detection_time:.4f} s, acts at "
+                                  f"{result.action_time:.4f} s"))
+    lines = [f"short circuit of ID1's motor at s0 = {op.s0:g}, v = {op.v_kmh:g} km/h, "
+             f"N0 = {op.N0:g} N, creep {result.creep_model}: M(s0, v) = "
+             f"{result.motor_torque:.6g} N m, μ_max = {result.mu_max:.4g}",
+             protection,
+             f"{len(result.t)} points to t = {result.t[-1]:g} s; values are totals "
+             f"(pre-fault + perturbation); {result.newton_iterations:.2f} Newton iterations/step",
+             "", f"{'output':<30} {'unit':<4} {'steady':>11} {'peak':>11} {'at [s]':>8} "
+             f"{'Δpeak':>11}"]
+    for name in result.outputs:
+        lines.append(f"{name:<30} {result.units[name]:<4} {result.steady[name]:>11.4g} "
+                     f"{result.peaks[name]:>11.4g} {result.peak_times[name]:>8.4f} "
+                     f"{result.perturbation_peaks[name]:>11.4g}")
+    lines += ["", f"{'wheel':<12} {'creepage min':>12} {'max':>10} {'|slip v| max [m/s]':>19} "
+              f"{'|μ|/μ_max max':>14}"]
+    for rim in result.creepage:
+        lines.append(f"{rim:<12} {result.creepage[rim].min():>12.5f} "
+                     f"{result.creepage[rim].max():>10.5f} "
+                     f"{np.abs(result.slip_velocity[rim]).max():>19.4g} "
+                     f"{np.abs(result.utilisation[rim]).max():>14.4f}")
+    for name, y in result.motor_torques.items():
+        lines.append(f"{name}: from {y[0]:.5g} to {y[-1]:.5g} N m (min {y.min():.5g}, max "
+                     f"{y.max():.5g})")
+    return "\n".join(lines + limit_lines(result))
+
+
+def write_nonlinear(result, path: Path) -> None:
+    write_series(path, result.t, result.M_C, nonlinear_series(result), result.steady,
+                 nonlinear_summary(result))

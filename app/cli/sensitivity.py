@@ -21,7 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from app.cli.main import UsageError, add_operating_point, emit, load_model
+from app.cli.options import UsageError, add_operating_point, add_uncertainty_options, load_model, uncertainty_options
+from app.cli.output import emit
 
 
 def _finite(values) -> list:
@@ -48,36 +49,6 @@ def register(subparsers) -> None:
     p.add_argument("--json", action="store_true", help="machine-readable JSON output")
     p.add_argument("--out", default=None, metavar="FILE", help="also write the JSON result here")
     p.set_defaults(func=cmd_uncertainty)
-
-
-def add_uncertainty_options(p: argparse.ArgumentParser) -> None:
-    """--posterior, --no-indices, --speeds (shared with ``bogie study uncertainty``)."""
-    p.add_argument("--posterior", action="store_true",
-                   help="sample the linearized posterior given the calibration's targets "
-                        "(model/studies/posterior.py; n runs, distributions only) instead of the prior "
-                        "ranges")
-    p.add_argument("--no-indices", action="store_true",
-                   help="prior: distributions only from n QMC samples (n runs, no Sobol indices)")
-    p.add_argument("--speeds", default=None, metavar="LIST",
-                   help="speeds of s0* [km/h]: x1,x2,… or A:B:N (default 120,200); several "
-                        "speeds give the s0*(v) band the dashboard's Studies view draws")
-
-
-def uncertainty_options(args: argparse.Namespace) -> dict:
-    """Keyword arguments of :func:`model.studies.uncertainty.run_uncertainty` from the shared options
-    (raises UsageError)."""
-    from app.cli.study import parse_values
-    from model.studies.uncertainty import V_SPEEDS_KMH
-
-    if args.posterior and args.no_indices:
-        raise UsageError("--posterior and --no-indices exclude each other (the posterior never "
-                         "has Sobol indices)")
-    speeds = (parse_values(args.speeds, "--speeds", 1, 500, "km/h", increasing=True)
-              if args.speeds is not None else list(V_SPEEDS_KMH))
-    if len(speeds) > 50:
-        raise UsageError(f"--speeds: {len(speeds)} speeds, at most 50 allowed")
-    return {"method": "posterior" if args.posterior else "prior",
-            "indices": not (args.posterior or args.no_indices), "speeds_kmh": speeds}
 
 
 def cmd_sensitivity(args: argparse.Namespace) -> None:

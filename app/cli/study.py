@@ -18,54 +18,23 @@ stderr, exit status 2.  Interrupted: exit status 130.
 from __future__ import annotations
 
 import argparse
-import itertools
 import json
-import math
 import sys
 import time
 
 import numpy as np
 
-from app.cli.main import UsageError, number, positive_int
-
-EXIT_INTERRUPTED = 130
-
-
-def parse_values(text: str, label: str, low: float, high: float, unit: str,
-                 increasing: bool = False) -> list[float]:
-    """'A:B:N' (N values from A to B) or 'x1,x2,…' -> values within [low, high]."""
-    text = text.strip()
-    if ":" in text:
-        parts = text.split(":")
-        try:
-            if len(parts) != 3:
-                raise ValueError
-            start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
-        except ValueError:
-            raise UsageError(f"{label} must be A:B:N (two numbers and a whole count) or a "
-                             f"comma-separated list, got '{text}'") from None
-        if count < 1:
-            raise UsageError(f"{label} = '{text}': N = {count} is not allowed, must be >= 1")
-        if count > 1 and not start < stop:
-            raise UsageError(f"{label} = '{text}' is an empty range: A must be below B")
-        values = [start] if count == 1 else list(np.linspace(start, stop, count))
-    else:
-        try:
-            values = [float(x) for x in text.split(",") if x.strip()]
-        except ValueError:
-            raise UsageError(f"{label} must be numbers separated by commas or A:B:N, "
-                             f"got '{text}'") from None
-        if not values:
-            raise UsageError(f"{label} is empty")
-    for value in values:
-        if not (math.isfinite(value) and low <= value <= high):
-            raise UsageError(f"{label}: {value:g} is not allowed, must be in [{low:g}, {high:g}] "
-                             f"{unit}")
-    if increasing and any(b <= a for a, b in itertools.pairwise(values)):
-        raise UsageError(f"{label} must increase")
-    if len(values) > 100_000:
-        raise UsageError(f"{label}: {len(values)} values, at most 100000 allowed")
-    return [float(v) for v in values]
+from app.cli.options import (
+    EXIT_INTERRUPTED,
+    UsageError,
+    add_engine_options,
+    add_uncertainty_options,
+    bounded,
+    parse_values,
+    positive_int,
+    uncertainty_options,
+)
+from app.cli.runs import ProgressBar, start_engine
 
 
 def _common(p: argparse.ArgumentParser) -> None:
@@ -84,27 +53,13 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="a JSON summary on stdout")
 
 
-def add_engine_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
-                   help="attach to a running Dask scheduler (default: $DASK_SCHEDULER_ADDRESS, "
-                        "else a local cluster)")
-    p.add_argument("--workers", type=positive_int("--workers"), default=None,
-                   help="worker processes of the local cluster (default: one per core)")
-    p.add_argument("--serial", action="store_true",
-                   help="compute in this process, without Dask (the reference)")
-    p.add_argument("--connect-timeout", type=number("--connect-timeout (s)", 0, 600,
-                                                    allowed="must be in (0, 600) s"),
-                   default=10.0, help="seconds to reach the scheduler (default %(default)s)")
-
-
 def register(subparsers) -> None:
     p = subparsers.add_parser("study", help="parameter studies on Dask: stability map, s0*(v)")
     sub = p.add_subparsers(dest="study_command", required=True)
     m = sub.add_parser("map", help="stability map over s0 × v (× N0 × b_M)")
     m.add_argument("--s0", required=True, metavar="A:B:N", help="creepages s0 [-], increasing")
     m.add_argument("--v", required=True, metavar="A:B:N", help="speeds [km/h]")
-    m.add_argument("--max-frequency", type=number("--max-frequency (Hz)", 0.5, 500,
-                                                  allowed="must be in (0.5, 500) Hz"),
+    m.add_argument("--max-frequency", type=bounded("--max-frequency (Hz)", "(0.5, 500)", "Hz"),
                    default=10.0, help="method reduced: reduction basis disc |λ| < 2π f [Hz] "
                    "(default %(default)s)")
     m.add_argument("--method", choices=("reduced", "continuation", "dense"),
@@ -128,8 +83,6 @@ def register(subparsers) -> None:
     u.add_argument("--chunk-size", type=positive_int("--chunk-size"), default=4,
                    help="model runs per task (default %(default)s)")
     add_engine_options(u)
-    from app.cli.sensitivity import add_uncertainty_options
-
     add_uncertainty_options(u)
     u.add_argument("--json", action="store_true", help="the result as JSON on stdout")
     u.set_defaults(func=cmd_uncertainty)
@@ -174,52 +127,6 @@ def cmd_limit(args: argparse.Namespace) -> None:
     _run(args, LimitStudy(v, n0, bm), parameters)
 
 
-class ProgressBar:
-    """``[#####-----] 5/10 chunks, 12 s elapsed, ~12 s left`` on stderr (redrawn in place on a
-    terminal; otherwise a line at most every 2 s and at the end)."""
-
-    def __init__(self, label: str, stream=None, width: int = 30, unit: str = "chunks"):
-        self.label, self.stream, self.width, self.unit = label, stream or sys.stderr, width, unit
-        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
-        self.first: tuple[int, float] | None = None
-        self.last_print = -math.inf
-
-    def __call__(self, finished: int, total: int, elapsed: float) -> None:
-        if self.first is None:
-            self.first = (finished, elapsed)
-        done_here = finished - self.first[0]
-        if done_here > 0 and finished < total:
-            left = f", ~{(elapsed - self.first[1]) / done_here * (total - finished):.0f} s left"
-        else:
-            left = ""
-        filled = int(self.width * finished / max(total, 1))
-        text = (f"{self.label}: [{'#' * filled}{'-' * (self.width - filled)}] {finished}/{total} "
-                f"{self.unit}, {elapsed:.0f} s elapsed{left}")
-        now = time.monotonic()
-        if self.tty:
-            self.stream.write("\r" + text.ljust(100) + ("\n" if finished == total else ""))
-        elif finished == total or now - self.last_print >= 2.0:
-            self.stream.write(text + "\n")
-        else:
-            return
-        self.last_print = now
-        self.stream.flush()
-
-
-def start_engine(args: argparse.Namespace):
-    """(engine or None, map_unordered, where) for --serial / --scheduler / a local cluster."""
-    from model.studies.engine import EngineUnavailable, StudyEngine, serial_map_unordered
-
-    if args.serial:
-        return None, serial_map_unordered, "this process (serial)"
-    engine = StudyEngine(args.scheduler, args.workers, args.connect_timeout)
-    try:
-        engine.start()
-    except EngineUnavailable as error:
-        raise UsageError(str(error)) from None
-    return engine, engine.map_unordered, engine.description
-
-
 def cmd_uncertainty(args: argparse.Namespace) -> None:
     from pathlib import Path
 
@@ -234,8 +141,6 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
     out = Path(args.out)
     if not out.parent.is_dir():
         raise UsageError(f"directory '{out.parent}' does not exist")
-    from app.cli.sensitivity import uncertainty_options
-
     options = uncertainty_options(args)
     parameters = load_parameters(args.params)
     bar, start = ProgressBar("study uncertainty", unit="model runs"), time.monotonic()

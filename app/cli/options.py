@@ -1,0 +1,417 @@
+"""Argument helpers every command group of ``bogie`` shares, so that no command imports another.
+
+The parser whose errors are one line with exit status 2; argparse types for numbers with
+bounds (:func:`bounded` takes the allowed interval as it is printed, ``"(0, 60]"``, so the check
+and its message cannot drift apart); the operating point (``--s0 --v --n0 --bm --params
+--json``) and the model it builds; ranges ``A:B:N`` and value lists ``x1,x2,…``; the time grid
+(``--t-end --fs``) and the short circuit (``--m0 --f --decay --phase``) of the commands that
+compute a response; the nonlinear creep and anti-slip options of ``bogie response`` and
+``bogie antislip``; the uncertainty options of ``bogie uncertainty`` and ``bogie study
+uncertainty``.  A check that fails raises :class:`UsageError`, which :func:`app.cli.main.main`
+prints as one line on stderr with exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import math
+import re
+from collections.abc import Callable
+
+import numpy as np
+
+from model.mechanics.parameters import load_parameters
+
+EXIT_BAD_INPUT = 2
+
+
+class UsageError(Exception):
+    """Bad input from the command line (reported in one line, exit status 2)."""
+
+
+class BogieParser(argparse.ArgumentParser):
+    """argparse with the error contract of ``bogie``: one line on stderr, exit status 2."""
+
+    def error(self, message: str) -> None:  # one line, no usage block
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
+# --- numbers -------------------------------------------------------------------------------------
+
+def number(label: str, low: float = -math.inf, high: float = math.inf, low_open: bool = True,
+           high_open: bool = True, allowed: str = "") -> Callable[[str], float]:
+    """argparse type: a finite float within bounds, with a clear message otherwise."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{label} must be a number, got '{text}'") from None
+        ok_low = value > low if low_open else value >= low
+        ok_high = value < high if high_open else value <= high
+        if not math.isfinite(value) or not (ok_low and ok_high):
+            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: {allowed}")
+        return value
+
+    return parse
+
+
+_INTERVAL = re.compile(r"^([\[(])(\S+), (\S+)([\])])$")
+
+
+def bounded(label: str, interval: str, unit: str = "") -> Callable[[str], float]:
+    """argparse type: a finite float in ``interval``, written as it is printed (``"(0, 60]"``:
+    0 excluded, 60 included; ``"[1, 500]"``; ``"(0, 1e7)"``) followed by ``unit``.  A value
+    outside: ``<label> = <text> is not allowed: must be in <interval> <unit>``."""
+    match = _INTERVAL.match(interval)
+    try:
+        opening, low, high, closing = match.groups()
+        ends = float(low), float(high)
+    except (AttributeError, ValueError):
+        raise ValueError(f"interval {interval!r} is not written as '(a, b]' or the like") from None
+    allowed = f"must be in {interval}" + (f" {unit}" if unit else "")
+    return number(label, *ends, low_open=opening == "(", high_open=closing == ")",
+                  allowed=allowed)
+
+
+def non_negative_int(label: str) -> Callable[[str], int]:
+    """argparse type: a whole number >= 0, with a clear message otherwise."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{label} must be a whole number, got '{text}'") from None
+        if value < 0:
+            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: must be >= 0")
+        return value
+
+    return parse
+
+
+def positive_int(label: str) -> Callable[[str], int]:
+    """argparse type: a whole number >= 1, with a clear message otherwise."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{label} must be a whole number, got '{text}'") from None
+        if value < 1:
+            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: must be >= 1")
+        return value
+
+    return parse
+
+
+# --- the operating point -------------------------------------------------------------------------
+
+def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.005) -> None:
+    """``--s0 --v --n0 --bm --params --json`` (``s0``: the default creepage; None: not given)."""
+    parser.add_argument("--s0", type=bounded("--s0 (creepage)", "(0, 1)"),
+                        default=s0, help="longitudinal creepage s0 [-] (default %(default)s)")
+    parser.add_argument("--v", type=bounded("--v (speed, km/h)", "[1, 500]", "km/h"),
+                        default=120.0, help="speed [km/h] (default %(default)s)")
+    parser.add_argument("--n0", type=bounded("--n0 (wheel force, N)", "[1e3, 1e6]", "N"),
+                        default=None, help="static wheel force N0 [N] (default: parameter set)")
+    parser.add_argument("--bm", type=bounded("--bm (motor slope, N m s/rad)", "[0, 1e9]",
+                                             "N m s/rad"),
+                        default=None, help="motor slope b_M [N m s/rad] (default: parameter set)")
+    parser.add_argument("--params", default=None, metavar="FILE",
+                        help="parameter file (TOML; default: the calibrated set)")
+    parser.add_argument("--json", action="store_true", help="machine-readable JSON output")
+
+
+def load_model(args: argparse.Namespace):
+    """(model, operating point or None without ``--s0``, (N0 [N], b_M [N m s/rad])) from the
+    operating point options; N0 and b_M default to the parameter set's."""
+    from model.mechanics.assembly import build_model
+    from model.mechanics.operating_point import OperatingPoint
+
+    parameters = load_parameters(args.params)
+    model = build_model(parameters)
+    n0 = parameters["wheel_force"] if args.n0 is None else args.n0
+    bm = parameters["motor_slope"] if args.bm is None else args.bm
+    op = OperatingPoint.from_kmh(args.s0, args.v, n0, bm) if args.s0 is not None else None
+    return model, op, (n0, bm)
+
+
+# --- ranges and value lists ----------------------------------------------------------------------
+
+def parse_range(text: str, label: str, scale: float = 1.0) -> np.ndarray:
+    """'A:B:N' -> N values from A to B (times ``scale``)."""
+    parts = text.split(":")
+    try:
+        start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
+    except (ValueError, IndexError):
+        raise UsageError(f"{label} must be A:B:N (two numbers and a whole count), got '{text}'") from None
+    if len(parts) != 3 or count < 2 or count > 5000 or not (math.isfinite(start) and math.isfinite(stop)):
+        raise UsageError(f"{label} must be A:B:N with finite A, B and 2 <= N <= 5000, got '{text}'")
+    return np.linspace(start, stop, count) * scale
+
+
+def parse_values(text: str, label: str, low: float, high: float, unit: str,
+                 increasing: bool = False) -> list[float]:
+    """'A:B:N' (N values from A to B) or 'x1,x2,…' -> values within [low, high]."""
+    text = text.strip()
+    if ":" in text:
+        parts = text.split(":")
+        try:
+            if len(parts) != 3:
+                raise ValueError
+            start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
+        except ValueError:
+            raise UsageError(f"{label} must be A:B:N (two numbers and a whole count) or a "
+                             f"comma-separated list, got '{text}'") from None
+        if count < 1:
+            raise UsageError(f"{label} = '{text}': N = {count} is not allowed, must be >= 1")
+        if count > 1 and not start < stop:
+            raise UsageError(f"{label} = '{text}' is an empty range: A must be below B")
+        values = [start] if count == 1 else list(np.linspace(start, stop, count))
+    else:
+        try:
+            values = [float(x) for x in text.split(",") if x.strip()]
+        except ValueError:
+            raise UsageError(f"{label} must be numbers separated by commas or A:B:N, "
+                             f"got '{text}'") from None
+        if not values:
+            raise UsageError(f"{label} is empty")
+    for value in values:
+        if not (math.isfinite(value) and low <= value <= high):
+            raise UsageError(f"{label}: {value:g} is not allowed, must be in [{low:g}, {high:g}] "
+                             f"{unit}")
+    if increasing and any(b <= a for a, b in itertools.pairwise(values)):
+        raise UsageError(f"{label} must increase")
+    if len(values) > 100_000:
+        raise UsageError(f"{label}: {len(values)} values, at most 100000 allowed")
+    return [float(v) for v in values]
+
+
+# --- the time grid of a response ----------------------------------------------------------------
+
+T_END = "(0, 60]"  # [s]: the horizons model.analysis.response accepts (MAX_T_END)
+FS = "(0, 1e7)"  # [Hz]
+MAX_SAMPLES = 2_000_000  # t_end × fs: the longest history model.analysis.response computes
+
+
+def add_time_grid(p: argparse.ArgumentParser, t_end_help: str, fs_help: str | None = None, *,
+                  t_end: str = T_END, fs: str = FS) -> None:
+    """``--t-end`` [s] (default 2) and, with ``fs_help``, ``--fs`` [Hz] (default 10 000).
+    ``t_end_help``/``fs_help`` say what the values mean for the command ("horizon of each run");
+    ``t_end``/``fs`` are the allowed intervals, narrower where a command needs it (give the
+    reason at the call).  With ``--fs``, call :func:`check_samples` before computing."""
+    p.add_argument("--t-end", type=bounded("--t-end (horizon, s)", t_end, "s"), default=2.0,
+                   help=f"{t_end_help} [s] (default %(default)s)")
+    if fs_help is not None:
+        p.add_argument("--fs", type=bounded("--fs (sampling rate, Hz)", fs, "Hz"),
+                       default=10_000.0, help=f"{fs_help} [Hz] (default %(default)s)")
+
+
+def check_samples(args: argparse.Namespace) -> None:
+    """Refuse a grid ``--t-end × --fs`` longer than :data:`MAX_SAMPLES` before any work."""
+    if args.t_end * args.fs > MAX_SAMPLES:
+        raise UsageError(f"--t-end × --fs = {args.t_end * args.fs:.0f} samples is too many: at "
+                         f"most {MAX_SAMPLES}")
+
+
+# --- the short circuit ---------------------------------------------------------------------------
+
+M0 = "[0, 1e8]"  # [N m]: the amplitudes model.analysis.response.ShortCircuit accepts
+FREQUENCY = "(0, 1e5)"  # [Hz]
+DECAY = "[0, 10]"  # [-]
+PHASE = "[-10, 10]"  # [s]
+
+
+def add_short_circuit(p: argparse.ArgumentParser, *, m0: str = M0, f: str = FREQUENCY,
+                      decay: str = DECAY, phase: str | None = PHASE) -> None:
+    """``--m0`` [N m], ``--f`` [Hz], ``--decay`` [-] and (unless ``phase`` is None) ``--phase``
+    [s] of the short-circuit torque, defaults those of
+    :class:`model.analysis.response.ShortCircuit` (``--phase``: none, the motor torque is
+    continuous).  The arguments are the allowed intervals, narrower where a command needs it
+    (give the reason at the call).  :func:`short_circuit_from` builds the excitation."""
+    from model.analysis.response import ShortCircuit
+
+    defaults = ShortCircuit()
+    p.add_argument("--m0", type=bounded("--m0 (amplitude, N m)", m0, "N m"), default=defaults.M0,
+                   help="short-circuit amplitude M0 (oscillating part) [N m] "
+                        "(default %(default)s)")
+    p.add_argument("--f", type=bounded("--f (frequency, Hz)", f, "Hz"), default=defaults.f,
+                   help="short-circuit frequency f (oscillating part) [Hz] (default %(default)s)")
+    p.add_argument("--decay", type=bounded("--decay (D)", decay), default=defaults.D,
+                   help="short-circuit decay D: envelope e^(-D 2π f t) [-] (default %(default)s)")
+    if phase is not None:
+        p.add_argument("--phase", type=bounded("--phase (Δt, s)", phase, "s"), default=None,
+                       help="time shift Δt [s] (default: continuous motor torque)")
+
+
+def short_circuit_from(args: argparse.Namespace):
+    """The :class:`model.analysis.response.ShortCircuit` of the options of
+    :func:`add_short_circuit`."""
+    from model.analysis.response import ShortCircuit
+
+    return ShortCircuit(M0=args.m0, f=args.f, D=args.decay, dt=getattr(args, "phase", None))
+
+
+# --- nonlinear creep and the anti-slip protection ------------------------------------------------
+
+ANTI_SLIP_OPTIONS = ("anti_slip_delay", "anti_slip_threshold", "anti_slip_rate", "anti_slip_floor")
+
+
+def add_anti_slip_arguments(p: argparse.ArgumentParser, with_delay: bool = True) -> None:
+    """The protection's options, defaults those of :class:`model.analysis.nonlinear.AntiSlip`
+    (None in the namespace: :func:`anti_slip_from` fills them in, :func:`check_creep_arguments`
+    sees which were given)."""
+    from model.analysis.nonlinear import AntiSlip
+
+    defaults = AntiSlip()
+    if with_delay:
+        p.add_argument("--anti-slip-delay", type=bounded("--anti-slip-delay (s)", "[0, 60]", "s"),
+                       default=None,
+                       help=f"reaction delay after detection [s] (default {defaults.delay:g})")
+    p.add_argument("--anti-slip-threshold", type=number(
+        "--anti-slip-threshold (m/s)", 0, 100, high_open=False,
+        allowed="must be > 0 and at most 100 m/s"), default=None,
+        help="change of ID2's wheelset slip velocity that trips the protection [m/s] "
+             f"(default {defaults.threshold:g})")
+    p.add_argument("--anti-slip-rate", type=number(
+        "--anti-slip-rate (1/s)", 0, 1e6, high_open=False,
+        allowed="must be > 0 and at most 1e6 1/s"), default=None,
+        help=f"torque reduction rate [fraction of M(s0, v) per s] (default {defaults.rate:g})")
+    p.add_argument("--anti-slip-floor", type=bounded("--anti-slip-floor", "[0, 1)"), default=None,
+                   help="torque kept after the reduction [fraction of M(s0, v)] "
+                        f"(default {defaults.floor:g})")
+
+
+def add_creep_arguments(p: argparse.ArgumentParser) -> None:
+    """``--creep`` and the anti-slip options of ``bogie response``."""
+    p.add_argument("--creep", choices=("linear", "nonlinear", "tangent"), default="linear",
+                   help="longitudinal creep forces: linear (closed form, default), nonlinear "
+                        "(Polach's law), tangent (the nonlinear solver with the law's tangent)")
+    p.add_argument("--anti-slip", choices=("off", "on"), default="off",
+                   help="anti-slip protection on ID2's motor torque (needs --creep nonlinear or "
+                        "tangent; default off)")
+    add_anti_slip_arguments(p)
+    p.add_argument("--strength", type=bounded("--strength (N m)", "(0, 1e9)", "N m"), default=None,
+                   help="design strength [N m] of the disc and claw clutch (the driving shaft: "
+                        "strength/p); crossings are listed (needs --creep nonlinear or tangent)")
+
+
+def anti_slip_from(args: argparse.Namespace, delay: bool = True):
+    """The :class:`model.analysis.nonlinear.AntiSlip` of the options (its defaults where not
+    given; ``delay=False``: the default delay, for ``bogie antislip``, which varies it)."""
+    from model.analysis.nonlinear import AntiSlip
+
+    defaults = AntiSlip()
+    values = {name: getattr(args, name, None) for name in ANTI_SLIP_OPTIONS}
+    return AntiSlip(
+        delay=defaults.delay if not delay or values["anti_slip_delay"] is None
+        else values["anti_slip_delay"],
+        threshold=defaults.threshold if values["anti_slip_threshold"] is None
+        else values["anti_slip_threshold"],
+        rate=defaults.rate if values["anti_slip_rate"] is None else values["anti_slip_rate"],
+        floor=defaults.floor if values["anti_slip_floor"] is None else values["anti_slip_floor"])
+
+
+def check_creep_arguments(args: argparse.Namespace) -> None:
+    """Refuse combinations that would be silently ignored."""
+    given = [name for name in ANTI_SLIP_OPTIONS if getattr(args, name, None) is not None]
+    if args.anti_slip == "on" and args.creep == "linear":
+        raise UsageError("--anti-slip on needs --creep nonlinear or tangent (the closed form has "
+                         "no protection)")
+    if given and args.anti_slip == "off":
+        raise UsageError(f"--{given[0].replace('_', '-')} needs --anti-slip on")
+    if getattr(args, "strength", None) is not None and args.creep == "linear":
+        raise UsageError("--strength needs --creep nonlinear or tangent")
+    if args.creep != "linear" and getattr(args, "method", "auto") != "auto":
+        raise UsageError("--method applies to --creep linear only")
+
+
+# --- the uncertainty study -----------------------------------------------------------------------
+
+def add_uncertainty_options(p: argparse.ArgumentParser) -> None:
+    """--posterior, --no-indices, --speeds (shared with ``bogie study uncertainty``)."""
+    p.add_argument("--posterior", action="store_true",
+                   help="sample the linearized posterior given the calibration's targets "
+                        "(model/studies/posterior.py; n runs, distributions only) instead of the prior "
+                        "ranges")
+    p.add_argument("--no-indices", action="store_true",
+                   help="prior: distributions only from n QMC samples (n runs, no Sobol indices)")
+    p.add_argument("--speeds", default=None, metavar="LIST",
+                   help="speeds of s0* [km/h]: x1,x2,… or A:B:N (default 120,200); several "
+                        "speeds give the s0*(v) band the dashboard's Studies view draws")
+
+
+def uncertainty_options(args: argparse.Namespace) -> dict:
+    """Keyword arguments of :func:`model.studies.uncertainty.run_uncertainty` from the shared options
+    (raises UsageError)."""
+    from model.studies.uncertainty import V_SPEEDS_KMH
+
+    if args.posterior and args.no_indices:
+        raise UsageError("--posterior and --no-indices exclude each other (the posterior never "
+                         "has Sobol indices)")
+    speeds = (parse_values(args.speeds, "--speeds", 1, 500, "km/h", increasing=True)
+              if args.speeds is not None else list(V_SPEEDS_KMH))
+    if len(speeds) > 50:
+        raise UsageError(f"--speeds: {len(speeds)} speeds, at most 50 allowed")
+    return {"method": "posterior" if args.posterior else "prior",
+            "indices": not (args.posterior or args.no_indices), "speeds_kmh": speeds}
+
+
+# --- what a history command reads (bogie response, bogie spectrum) --------------------------
+
+MIN_SAMPLES_PER_PERIOD = 2.5  # fs must exceed 2.5 × the highest excited frequency
+
+
+def add_history_options(p: argparse.ArgumentParser) -> None:
+    """Every option of ``bogie response`` but ``--out``: the operating point, the short circuit,
+    the time grid, ``--outputs``, ``--method`` and the creep model (shared with ``bogie
+    spectrum``)."""
+    add_operating_point(p)
+    add_short_circuit(p)
+    add_time_grid(p, "horizon", "output sampling rate")
+    add_output_selection(p)
+    add_creep_arguments(p)
+
+
+def add_output_selection(p: argparse.ArgumentParser) -> None:
+    """``--outputs`` and ``--method`` (the linear closed form's evaluation)."""
+    p.add_argument("--outputs", default=None,
+                   help="comma-separated output or DOF names (default: all loads)")
+    p.add_argument("--method", choices=("auto", "modal", "expm"), default="auto",
+                   help="evaluation of the closed form (default %(default)s)")
+
+
+def output_names(args: argparse.Namespace) -> list[str] | None:
+    """The names of ``--outputs`` (None: all loads)."""
+    if args.outputs is None:
+        return None
+    return [s.strip() for s in args.outputs.split(",") if s.strip()]
+
+
+def check_sampling(args: argparse.Namespace, frequency_hz: float, what: str,
+                   digits: str = "g") -> None:
+    """Refuse ``--fs`` below 2.5 × ``frequency_hz`` [Hz]; ``what`` names that frequency in the
+    message, ``digits`` formats the least allowed rate."""
+    least = MIN_SAMPLES_PER_PERIOD * frequency_hz
+    if args.fs < least:
+        raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve {what}: must be at least "
+                         f"{least:{digits}} Hz")
+
+
+# --- where a study runs (bogie study, bogie envelope) ------------------------------------------
+
+EXIT_INTERRUPTED = 130  # Ctrl-C: the store keeps the finished chunks (resume with --resume)
+
+
+def add_engine_options(p: argparse.ArgumentParser) -> None:
+    """``--scheduler``, ``--workers``, ``--serial``, ``--connect-timeout``."""
+    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                   help="attach to a running Dask scheduler (default: $DASK_SCHEDULER_ADDRESS, "
+                        "else a local cluster)")
+    p.add_argument("--workers", type=positive_int("--workers"), default=None,
+                   help="worker processes of the local cluster (default: one per core)")
+    p.add_argument("--serial", action="store_true",
+                   help="compute in this process, without Dask (the reference)")
+    p.add_argument("--connect-timeout", type=bounded("--connect-timeout (s)", "(0, 600)", "s"),
+                   default=10.0, help="seconds to reach the scheduler (default %(default)s)")
