@@ -34,6 +34,7 @@ from app.dashboard.modes_view import ModeClickThrough
 from app.dashboard.nonlinear_view import NonlinearView  # issue 10
 from app.dashboard.panel_fixes import skip_detached_markup_models
 from app.dashboard.sensitivity_view import SensitivityView  # issue 12: sensitivity tornado
+from app.dashboard.session import post, run_locked, session_query
 from app.dashboard.url_state import make_query, parse_query
 from app.dashboard.variant_view import VariantView
 from app.results import compute
@@ -45,6 +46,7 @@ from app.services.thread_pools import (
     FOLLOW_UP_POOL,
     SIDE_VIEW_POOL,
     LatestRequest,
+    ignore_outcome,
     limit_blas_threads,
 )
 from model import NoStabilityLimit, OperatingPointError, ParameterError
@@ -112,12 +114,6 @@ class State:
         return (self.params_path, self.rail, self.locus, fixed, self.N0, self.b_M)
 
 
-def _ignore_outcome(future) -> None:
-    """A computation whose result is no longer shown: retrieve its outcome when it ends (no
-    "exception was never retrieved" warning for a rejected, superseded parameter set)."""
-    future.add_done_callback(lambda f: f.cancelled() or f.exception())
-
-
 class BogieDashboard(pn.viewable.Viewer):
     """Stability and short-circuit load of the bogie at one operating point."""
 
@@ -145,7 +141,7 @@ class BogieDashboard(pn.viewable.Viewer):
         parameter values (they win over the query)."""
         limit_blas_threads()
         if query is None:
-            query = _session_query()
+            query = session_query()
         values, variant, self._query_tab, query_notices = parse_query(
             query, type(self).param, None, base=str(params_path or ""))
         params = {**values, **({"variant": variant} if variant else {}), **params}
@@ -373,6 +369,12 @@ class BogieDashboard(pn.viewable.Viewer):
     # --- state and computations --------------------------------------------------------------
 
     @property
+    def params_path(self) -> str:
+        """The bundled parameter file in use ("": the calibrated set); the variant, if any,
+        changes it (:attr:`set_key`)."""
+        return self._params_path
+
+    @property
     def set_key(self) -> str:
         """The parameter set in use for app.results.compute: the bundled file, or a variant of it."""
         return f"{self._params_path}|{self.variant}" if self.variant else self._params_path
@@ -429,6 +431,10 @@ class BogieDashboard(pn.viewable.Viewer):
         """Show a notice about input that was not used (the previous state is kept)."""
         self.input_notice.object = html.escape(text)
         self.input_notice.visible = True
+
+    def clear_warning(self) -> None:
+        """Hide the notice about unused input (the input it named has been corrected)."""
+        self.input_notice.visible = False
 
     def _share(self, *_events) -> None:
         """Keep the browser's address (served) equal to the settings: a link to share."""
@@ -527,28 +533,28 @@ class BogieDashboard(pn.viewable.Viewer):
                 try:
                     fast = await loop.run_in_executor(FIRST_ANSWER_POOL, self.compute_fast, state)
                 except MODEL_ERRORS as error:
-                    self._post(doc, self._reject, error)
+                    self.post(doc, self._reject, error)
                     if locus_future is not None:
-                        _ignore_outcome(locus_future)
+                        ignore_outcome(locus_future)
                     continue
                 # issue 10: the nonlinear history, if shown, starts once the linear first answer
                 # is computed, not beside it: its step loop is mostly Python and shared the GIL
                 # with the fast stage (linear result 304 ms beside it, median of 12 steps)
                 self.nonlinear.prefetch(state)
-                self._post(doc, self._apply_fast, state, fast)
+                self.post(doc, self._apply_fast, state, fast)
                 if self._dirty:
                     if locus_future is not None:
-                        _ignore_outcome(locus_future)  # it still fills the cache
+                        ignore_outcome(locus_future)  # it still fills the cache
                     continue
                 if locus_future is not None:
                     try:
                         locus = await locus_future
                     except MODEL_ERRORS as error:
-                        self._post(doc, self._reject, error)
+                        self.post(doc, self._reject, error)
                         continue
                     if self._dirty:
                         continue
-                    self._post(doc, self._apply_locus, state, locus)
+                    self.post(doc, self._apply_locus, state, locus)
                     dense = self._dense_requests.submit(self._dense_if_current, state)
                     dense.add_done_callback(partial(self._dense_done, doc, state))
                     # s0*(v) after the dense locus (which has a target: ≤ 2 s after a speed
@@ -559,10 +565,10 @@ class BogieDashboard(pn.viewable.Viewer):
                     self._start_limit(doc, state)
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")
-            self._post(doc, self._reject, error)
+            self.post(doc, self._reject, error)
         finally:
             self._busy = False
-            self._post(doc, self._done)
+            self.post(doc, self._done)
 
     def _start_limit(self, doc, state: State) -> None:
         """s0*(v) (≈ 0.7 s when not cached) is not waited for: a change arriving meanwhile
@@ -601,50 +607,22 @@ class BogieDashboard(pn.viewable.Viewer):
         error = future.exception()
         if error is not None:
             if isinstance(error, MODEL_ERRORS):
-                self._post(doc, self._reject, error)
+                self.post(doc, self._reject, error)
             else:
                 log.error("%s failed", what, exc_info=error)
             return
         if future.result() is not None:
-            self._post(doc, apply, state, future.result())
+            self.post(doc, apply, state, future.result())
 
     def run_locked(self, function, *args) -> None:
-        """Run ``function(*args)`` with the session's document lock: served, on the next tick
-        (a Panel widget callback may run without the lock; changing Bokeh models there raised
-        "_pending_writes should be non-None"); otherwise at once."""
-        doc = pn.state.curdoc
-        if doc is None or doc.session_context is None:
-            function(*args)
-        else:
-            self._post(doc, function, *args)
+        """Run ``function(*args)`` with the session's document lock: served, on the next tick;
+        otherwise at once (:func:`app.dashboard.session.run_locked`)."""
+        run_locked(function, *args)
 
-    def _post(self, doc, function, *args) -> None:
+    def post(self, doc, function, *args) -> None:
         """``function(*args)`` on the session's next tick, with its document lock; nothing if the
-        session has ended meanwhile (a closed browser tab: its document is destroyed, and
-        Bokeh raised AttributeError on scheduling into it)."""
-        if doc.session_context is None or getattr(doc.session_context, "destroyed", False):
-            return
-        try:
-            doc.add_next_tick_callback(partial(self._locked, doc, function, *args))
-        except (AttributeError, RuntimeError):
-            log.debug("session ended: result not shown")
-
-    @staticmethod
-    def _locked(doc, function, *args) -> None:
-        from panel.io.state import set_curdoc
-
-        # Bokeh's own hold: all changes of one result go to the browser in one go and are
-        # rendered once (Panel's ``hold`` bypasses the document lock and lost the changes of
-        # a session whose websocket was not connected yet)
-        with set_curdoc(doc):
-            held = doc.callbacks.hold_value is not None
-            if not held:
-                doc.hold("combine")
-            try:
-                function(*args)
-            finally:
-                if not held:
-                    doc.unhold()
+        session has ended meanwhile (:func:`app.dashboard.session.post`)."""
+        post(doc, function, *args)
 
     def _done(self) -> None:
         if not self._busy and self.busy.object:
@@ -780,10 +758,3 @@ class BogieDashboard(pn.viewable.Viewer):
                   f"b_M = {state.b_M} N m s/rad")
         return io.StringIO(dumps_parameters(p, header))
 
-
-def _session_query() -> dict:
-    """The URL query arguments of the served session being built ({} without a server)."""
-    doc = pn.state.curdoc
-    if doc is None or doc.session_context is None:
-        return {}
-    return dict(pn.state.session_args or {})

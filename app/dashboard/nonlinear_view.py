@@ -28,7 +28,7 @@ import panel as pn
 
 from app.results import compute
 from app.results.plots import SeriesSource
-from app.services.thread_pools import NONLINEAR_POOL, SEARCH_POOL, LatestRequest
+from app.services.thread_pools import NONLINEAR_POOL, SEARCH_POOL, LatestRequest, ignore_outcome
 from model.analysis.antislip import required_reaction_time
 from model.analysis.nonlinear import AntiSlip, NonlinearError, nonlinear_response
 from model.analysis.response import ShortCircuit
@@ -260,7 +260,7 @@ class NonlinearView:
         key = self._key(state)
         if key != self._shown_key:
             future = self._histories.submit(nonlinear_histories, *key)
-            future.add_done_callback(lambda f: f.cancelled() or f.exception())  # on_fast reports
+            ignore_outcome(future)  # on_fast shows its result or its error
 
     def on_fast(self, state) -> None:
         """Hook: the dashboard has shown the linear result for ``state``."""
@@ -352,11 +352,10 @@ class NonlinearView:
         if error is not None:
             if not isinstance(error, ValueError | np.linalg.LinAlgError):
                 log.error("nonlinear computation failed", exc_info=error)
-            doc.add_next_tick_callback(partial(self.dash._locked, doc, self._reject, error))
+            self.dash.post(doc, self._reject, error)
             return
         if future.result() is not None:
-            doc.add_next_tick_callback(partial(self.dash._locked, doc, apply, key,
-                                               future.result()))
+            self.dash.post(doc, apply, key, future.result())
 
     def _apply_histories(self, key, histories: NonlinearHistories) -> None:
         if self.creep.value != "nonlinear" or key != self._key():

@@ -32,7 +32,7 @@ from bokeh.palettes import RdBu10
 
 from app.dashboard.uncertainty_band import BandLayer, UncertaintyBand, band_mismatch, read_band
 from app.results import compute
-from app.results.plots import _figure
+from app.results.plots import new_figure
 from app.services.study_queue import FAILED, WAITING, StudyQueue, StudyTicket, study_queue, wait_until_ended
 from model.mechanics.operating_point import KMH
 
@@ -82,7 +82,7 @@ class StudyMapPlot:
     """Heat map of the largest real part over (v, s0) with s0*(v) on top."""
 
     def __init__(self):
-        self.figure = _figure("Stability map: largest real part [1/s]", "speed v [km/h]",
+        self.figure = new_figure("Stability map: largest real part [1/s]", "speed v [km/h]",
                               "creepage s0 [-]")
         self.figure.height = 380
         # an even number of colours on a range symmetric about 0: the blue/red boundary is
@@ -262,7 +262,7 @@ class StudiesView(pn.viewable.Viewer):
             return
         try:
             study = self.study()
-            parameters = compute.parameters(self.dashboard._params_path, self.dashboard.rail)
+            parameters = compute.parameters(self.dashboard.params_path, self.dashboard.rail)
             ticket = self.queue.submit(self.owner, study, parameters)
         except ValueError as error:  # StudyRefused is a ValueError
             self._reject(str(error.args[0] if error.args else error))
@@ -392,7 +392,7 @@ class StudiesView(pn.viewable.Viewer):
         d = self.dashboard
         # the set's hash with the result's creep law (a different rail is its own reason)
         rail = self.uncertainty.rail if self.uncertainty is not None else d.rail
-        parameters = compute.parameters(d._params_path, rail if rail in compute.RAIL_CONDITIONS
+        parameters = compute.parameters(d.params_path, rail if rail in compute.RAIL_CONDITIONS
                                         else d.rail)
         return parameter_hash(parameters), d.N0 * 1e3, d.b_M, d.rail, "the dashboard's set"
 
