@@ -1,6 +1,6 @@
-"""Dashboard part of issue 10: the creep-model switch, the anti-slip controls, the nonlinear
-histories overlaid on the linear ones, each wheel's creepage path on the creep plot, and the
-required reaction time of the protection in the status area for unstable points.
+"""The nonlinear creep model in the dashboard: the creep-model switch, the anti-slip controls,
+the nonlinear histories overlaid on the linear ones, each wheel's creepage path on the creep plot,
+and the required reaction time of the protection in the status area for unstable points.
 
 The linear closed form stays the fast first answer (the dashboard's fast stage); this view
 starts its own computations after it, on worker threads of its own when served, and shows
@@ -8,10 +8,10 @@ them when ready, if they still belong to what is on screen (a notice says "compu
 meantime; the page never waits).  Bad anti-slip input shows a notice and keeps the last valid
 values and results.
 
-Hooks in :mod:`app.dashboard.dashboard` (marked "issue 10"): ``NonlinearView(dashboard)`` in ``_build``
-(its ``controls``, ``notice`` and ``status`` placed in the layout) and ``on_fast(state)`` at the
-end of ``_apply_fast``.  Computations here take primitives only (``pn.cache`` keys) and return
-plain read-only data, like :mod:`app.results.compute`.
+The dashboard builds ``NonlinearView(dashboard)`` and places its ``controls``, ``notice`` and
+``status`` in its page; it calls ``prefetch(state)`` when the linear first answer is computed
+(served) and ``on_fast(state)`` when that answer is shown.  Computations here take primitives
+only (``pn.cache`` keys) and return plain read-only data, like :mod:`app.results.compute`.
 """
 
 from __future__ import annotations

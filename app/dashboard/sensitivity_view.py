@@ -1,5 +1,5 @@
 """Which parameter moves what, live: a tornado chart of normalized sensitivities at the
-dashboard's current operating point (issue 12; :mod:`model.analysis.sensitivity`).
+dashboard's current operating point (:mod:`model.analysis.sensitivity`).
 
 Targets (a radio group, CSS class ``ctl-sensitivity-target``):
 

@@ -99,7 +99,8 @@ class StudyMapPlot:
         self.figure.line("v", "s0", source=self.limit, line_color="black", line_width=2,
                          legend_label="s0*(v)")
         self.figure.scatter("v", "s0", source=self.limit, color="black", size=4)
-        self.band = BandLayer(self.figure, name="study-s0-band")  # issue 12: uncertainty band
+        # an uncertainty result's 5–95 % band of s0*(v), drawn when it matches the map
+        self.band = BandLayer(self.figure, name="study-s0-band")
         self.figure.legend.location = "top_right"
 
     def update(self, view: MapView) -> None:
@@ -360,7 +361,7 @@ class StudiesView(pn.viewable.Viewer):
         self.plot.update(view)
         self.check_band()
 
-    # --- the uncertainty band (issue 12) ---------------------------------------------------------
+    # --- the uncertainty band of s0*(v) --------------------------------------------------------
 
     def open_uncertainty(self, name) -> None:
         """Open an uncertainty result of the folder's list; a name not in the list or a bad file
