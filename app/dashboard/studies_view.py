@@ -83,7 +83,7 @@ class StudyMapPlot:
 
     def __init__(self):
         self.figure = new_figure("Stability map: largest real part [1/s]", "speed v [km/h]",
-                              "creepage s0 [-]")
+                                 "creepage s0 [-]")
         self.figure.height = 380
         # an even number of colours on a range symmetric about 0: the blue/red boundary is
         # exactly Re λ = 0 (stable blue, unstable red)

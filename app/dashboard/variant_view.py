@@ -153,7 +153,7 @@ class VariantView(pn.viewable.Viewer):
                                   stylesheets=[".changed {background: #fff3b0; "
                                                "font-weight: 700}"])
         self.limits_figure = new_figure("Stability limit s0*(v): baseline and variant",
-                                     "speed v [km/h]", "s0* [-]")
+                                        "speed v [km/h]", "s0* [-]")
         self.limits_figure.name = "variant-limits"
         self.limit_sources = {}
         for label, color, dash in (("baseline", "#555555", "solid"),

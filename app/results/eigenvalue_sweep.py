@@ -83,7 +83,7 @@ class Fig6Plot:
         shared_x = None
         for name, title, y_label in specs:
             fig = new_figure(title, "creepage s0 [-]", y_label,
-                          **({"x_range": shared_x} if shared_x else {}))
+                             **({"x_range": shared_x} if shared_x else {}))
             shared_x = shared_x or fig.x_range
             fig.name = name
             fig.height = 300

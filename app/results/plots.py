@@ -104,7 +104,7 @@ class RootLocusPlot:
 
     def __init__(self):
         self.figure = new_figure("Root locus", "Re λ [1/s]", "Im λ [Hz]",
-                              x_range=Range1d(-6.0, 2.5), y_range=Range1d(0.0, 14.0))
+                                 x_range=Range1d(-6.0, 2.5), y_range=Range1d(0.0, 14.0))
         self.figure.name = "root-locus"
         fig = self.figure
         fig.add_layout(BoxAnnotation(left=0.0, fill_color=UNSTABLE, fill_alpha=0.08,
@@ -188,7 +188,7 @@ class CreepPlot:
 
     def __init__(self):
         self.figure = new_figure("Creep characteristic μ(s) at the current speed", "creepage s [-]",
-                              "adhesion coefficient μ [-]")
+                                 "adhesion coefficient μ [-]")
         fig = self.figure
         self.curve = ColumnDataSource({"s": [], "mu": []})
         self.point = ColumnDataSource({"s": [], "mu": []})
@@ -236,7 +236,7 @@ class ResponsePlots:
         shared_x = None
         for drive in ("ID1", "ID2"):
             fig = new_figure(f"{drive}: torques", "t [s]", "torque [N m]",
-                          **({"x_range": shared_x} if shared_x else {}))
+                             **({"x_range": shared_x} if shared_x else {}))
             shared_x = shared_x or fig.x_range
             for quantity, color in zip(TORQUES, ("#1f77b4", "#d62728"), strict=True):
                 label = {"driving_shaft.torque": "driving shaft M_DS",
@@ -252,7 +252,7 @@ class ResponsePlots:
             fig.legend.label_text_font_size = "10px"
             self.torque[drive] = fig
         self.forces = new_figure("Disc clutch forces (ID1 —, ID2 - -)", "t [s]",
-                              "force [N]", x_range=shared_x)
+                                 "force [N]", x_range=shared_x)
         for quantity, color in zip(FORCES, Category10_10[2:5], strict=True):
             axis = quantity[-1]
             self.sources.line(self.forces, f"ID1.{quantity}", color=color,
@@ -262,7 +262,7 @@ class ResponsePlots:
         self.forces.legend.click_policy = "hide"
         self.forces.legend.label_text_font_size = "10px"
         self.excitation = new_figure("Short-circuit torque M_C(t) on ID1's rotor", "t [s]",
-                                  "M_C [N m]", x_range=shared_x)
+                                     "M_C [N m]", x_range=shared_x)
         self.sources.line(self.excitation, "M_C", color="black")
         self.ad_label = Label(x=60, y=5, x_units="screen", y_units="screen", text="",
                               text_font_size="10px")
@@ -316,7 +316,7 @@ class ModeShapePlot:
         self.views = {}
         for name, (a, b), label in (("side", (0, 2), "z [m]"), ("top", (0, 1), "y [m]")):
             fig = new_figure(f"{'Side' if name == 'side' else 'Top'} view", "x [m]", label,
-                          match_aspect=True)
+                             match_aspect=True)
             fig.height = 300
             base = ColumnDataSource(self._lines(np.zeros(3), a, b, {}))
             moved = ColumnDataSource(self._lines(np.zeros(3), a, b, {}))
