@@ -175,8 +175,6 @@ class StudiesView(pn.viewable.Viewer):
         self.uncertainty_button = pn.widgets.Button(label="Open result",
                                                     css_classes=["study-open-uncertainty"],
                                                     width=120)
-        self.uncertainty_button.on_click(
-            lambda _event: self.open_uncertainty(self.uncertainty_select.value))
         self.band_status = pn.pane.HTML("", css_classes=["study-band-status"],
                                         sizing_mode="stretch_width")
         self.band_notice = pn.pane.Alert("", alert_type="warning", visible=False,
@@ -187,9 +185,15 @@ class StudiesView(pn.viewable.Viewer):
         variant_figure = getattr(getattr(dashboard, "variant_view", None), "limits_figure", None)
         self.variant_band = (BandLayer(variant_figure, name="variant-s0-band")
                              if variant_figure is not None else None)
-        self.start_button.on_click(lambda _event: self.start())
-        self.stop_button.on_click(lambda _event: self.stop())
-        self.open_button.on_click(lambda _event: self.open(self.store_select.value))
+        # a button's callback may run without the session's document lock (Panel runs a click
+        # that arrives while a widget change is pending as a coroutine without it); the plots'
+        # Bokeh sources may only change with the lock: dashboard.run_locked
+        locked = dashboard.run_locked
+        self.start_button.on_click(lambda _event: locked(self.start))
+        self.stop_button.on_click(lambda _event: locked(self.stop))
+        self.open_button.on_click(lambda _event: locked(self.open, self.store_select.value))
+        self.uncertainty_button.on_click(
+            lambda _event: locked(self.open_uncertainty, self.uncertainty_select.value))
         self.refresh_button.on_click(lambda _event: self.refresh_lists())
         self.layout = pn.Column(
             self.notice,

@@ -133,10 +133,12 @@ class VariantView(pn.viewable.Viewer):
             cards.append(pn.Card(*widgets, title=group, collapsed=index > 0, width=310))
         apply = pn.widgets.Button(label="Apply variant", color="primary",
                                   css_classes=["var-apply"], width=150)
-        apply.on_click(lambda _event: self.apply_inputs())
+        # with the session's document lock: a new variant may clear the s0*(v) sources, and a
+        # button's callback may run without the lock (app/dashboard/studies_view.py says when)
+        apply.on_click(lambda _event: dashboard.run_locked(self.apply_inputs))
         reset = pn.widgets.Button(label="Back to the baseline", css_classes=["var-reset"],
                                   width=150)
-        reset.on_click(lambda _event: self.set_changes({}))
+        reset.on_click(lambda _event: dashboard.run_locked(self.set_changes, {}))
         self.upload = pn.widgets.FileInput(accept=".toml", css_classes=["var-upload"],
                                            multiple=False)
         self.upload.param.watch(self._on_upload, "value")
