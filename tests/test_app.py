@@ -66,14 +66,14 @@ def _verdict(dashboard) -> bool:
 @pytest.mark.slow
 def test_status_follows_the_model_and_the_published_cases_flip(dash):
     for s0 in (0.005, 0.014, 0.005):
-        dash._published_case(s0)
+        dash.show_published_case(s0)
         expected = "STABLE" if _verdict(dash) else "UNSTABLE"
         assert dash.s0 == s0
         assert dash.v == 120.0
         assert f">{expected}<" in dash.status.object
-    dash._published_case(0.005)
+    dash.show_published_case(0.005)
     stable_text = dash.status.object
-    dash._published_case(0.014)
+    dash.show_published_case(0.014)
     assert dash.status.object != stable_text, "the two published cases must differ in verdict"
 
 
@@ -155,7 +155,7 @@ def test_rail_condition_changes_the_creep_law(dash):
     calibrated = np.array(dash.creep_plot.curve.data["mu"])
     dash.rail = "wet"
     assert not np.array_equal(dash.creep_plot.curve.data["mu"], calibrated)
-    toml = tomllib.loads(dash._toml().read())
+    toml = tomllib.loads(dash.downloads.parameters_toml().read())
     from model.contact.creep import CREEP_PRESETS
 
     for name, value in CREEP_PRESETS["wet"].items():
@@ -166,16 +166,16 @@ def test_rail_condition_changes_the_creep_law(dash):
 
 @pytest.mark.slow
 def test_downloads(dash):
-    csv = dash._csv().read()
+    csv = dash.downloads.time_histories_csv().read()
     header, first = csv.splitlines()[:2]
     assert header.startswith("t [s],ID1.driving_shaft.torque [N m]")
     assert float(first.split(",")[0]) == 0.0
     data = np.loadtxt(io.StringIO(csv), delimiter=",", skiprows=1)
     assert data.shape == (len(dash.response.t), 2 + len(compute.RESPONSE_OUTPUTS))
-    eig = json.loads(dash._json().read())
+    eig = json.loads(dash.downloads.eigenvalues_json().read())
     assert eig["stable"] == dash.point.stable
     assert len(eig["eigenvalues"]) == len(dash.point.eigenvalues)
-    toml = dash._toml().read()
+    toml = dash.downloads.parameters_toml().read()
     parse_parameters(tomllib.loads(toml))  # a valid parameter file
 
 

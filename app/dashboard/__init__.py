@@ -1,8 +1,13 @@
 """The Panel dashboard: :class:`.dashboard.BogieDashboard` and its views.
 
-The dashboard owns the controls, the state and the first answers (status, root locus, time
-histories); each view (modes, nonlinear creep, sensitivity, studies, variant, uncertainty band)
-talks to it through its small public interface (``state()``, ``post()``, ``warn()``,
-``alive()``, ``params_path``, ``set_key``).  May use :mod:`app.report`, :mod:`app.results`,
-:mod:`app.services` and ``model``; never the server or the command line.
+The dashboard owns the parameters, the last valid results and the first answers (status, root
+locus, time histories); its pieces: :mod:`.controls` (the controls column), :mod:`.stages` (the
+state a computation depends on and the computations of a change), :mod:`.scheduler` (when and
+where they run), :mod:`.layout` (the page and the tabs), :mod:`.downloads`, :mod:`.session`
+(the served session's document).  Each view (modes, nonlinear creep, sensitivity, studies,
+variant, uncertainty band) gets the dashboard object and talks to it through its small public
+interface (``state()``, ``alive()``, ``post()``, ``run_locked()``, ``warn()``,
+``clear_warning()``, ``when_shown()``, ``flush_view()``, ``params_path``, ``set_key``); no view
+imports :mod:`.dashboard`.  May use :mod:`app.report`, :mod:`app.results`, :mod:`app.services`
+and ``model``; never the server or the command line.
 """

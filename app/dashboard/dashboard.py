@@ -1,121 +1,57 @@
 """The dashboard: a :class:`panel.viewable.Viewer` with ``param`` parameters, one per session.
 
-Controls are built per instance (never shared class attributes) and write into the parameters
-on ``value_throttled`` (slider release / keyboard step), so a drag triggers one computation.
-Heavy work runs in :mod:`app.results.compute` (cached, shared read-only across sessions).  In a served
-session it runs on a worker thread without the document lock, so several reviewers on one
-server do not queue behind each other; the results are applied on the next tick with the lock.
-Without a server (tests) everything runs synchronously.
+It owns the parameters, the last valid results and the first answers on screen (status, root
+locus, time histories, tables); its pieces have modules of their own:
 
-Two stages per change: *fast* (eigenvalues, status, creep, tables, mode shape, time histories)
-and *slow* (stability limit s0*(v), root locus), which only depend on part of the parameters and
-are usually cached.  A rejected parameter combination shows a notice and keeps the last valid
-results on screen.
+* :mod:`.controls` — the controls column (they write into the parameters);
+* :mod:`.stages` — the state a computation depends on, and the computations of a change;
+* :mod:`.scheduler` — when and where they run (served: on worker threads, the results shown on
+  the session's next tick) and the follow-ups (dense root locus, s0*(v));
+* :mod:`.layout` — the page, the tabs of the views and the views of the first tabs;
+* :mod:`.downloads` — the files (CSV, JSON, TOML, HTML report);
+* :mod:`.session` — the served session's document, its URL query, showing results with its lock.
+
+The views (modes, nonlinear creep, sensitivity, studies, variant) get the dashboard object and
+use its public interface only: ``state()``, ``alive()``, ``post(doc, function, *args)``,
+``run_locked(function, *args)``, ``warn(text)``, ``clear_warning()``, ``when_shown(tab,
+function, *args)``, ``flush_view(tab)``, ``params_path``, ``set_key``, the parameters, the last
+valid results (``point``, ``response``, ``locus_result``) and the plots they draw on.  A rejected
+parameter combination shows a notice and keeps the last valid results on screen.
 """
 
 from __future__ import annotations
 
-import asyncio
 import html
-import io
-import json
-import logging
-import re
-from dataclasses import dataclass
-from functools import partial
-from pathlib import Path
 
-import numpy as np
 import panel as pn
 import param
-from bokeh.document import without_document_lock
 
+from app.dashboard import layout
+from app.dashboard.controls import PUBLISHED_SPEED_KMH, Controls
+from app.dashboard.downloads import Downloads
 from app.dashboard.modes_view import ModeClickThrough
-from app.dashboard.nonlinear_view import NonlinearView  # issue 10
+from app.dashboard.nonlinear_view import NonlinearView
 from app.dashboard.panel_fixes import skip_detached_markup_models
-from app.dashboard.sensitivity_view import SensitivityView  # issue 12: sensitivity tornado
+from app.dashboard.scheduler import Scheduler
+from app.dashboard.sensitivity_view import SensitivityView
+from app.dashboard.session import post, run_locked, served_document, session_query
+from app.dashboard.stages import State
+from app.dashboard.studies_view import StudiesView
 from app.dashboard.url_state import make_query, parse_query
 from app.dashboard.variant_view import VariantView
 from app.results import compute
 from app.results.eigenvalue_sweep import Fig6Plot
-from app.results.plots import STABLE, UNSTABLE, CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
+from app.results.plots import CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
 from app.results.tables import eigen_table_html, peaks_html
-from app.services.thread_pools import (
-    FIRST_ANSWER_POOL,
-    FOLLOW_UP_POOL,
-    SIDE_VIEW_POOL,
-    LatestRequest,
-    limit_blas_threads,
-)
-from model import NoStabilityLimit, OperatingPointError, ParameterError
-from model.mechanics.parameters import dumps_parameters
+from app.services.thread_pools import limit_blas_threads
 
-log = logging.getLogger(__name__)
 skip_detached_markup_models()  # the views' tabs are dynamic (app/dashboard/panel_fixes.py)
 # the page loads the script of each extension model up front: the mode table (Tabulator) sits in
 # a tab that reaches the browser only when it is opened
 pn.extension("tabulator")
-ASSETS = Path(__file__).resolve().parents[2] / "assets"  # app/dashboard/ -> project
-MODEL_ERRORS = (OperatingPointError, ParameterError, NoStabilityLimit, ValueError,
-                np.linalg.LinAlgError)
-BUSY_DELAY_MS = 400  # the "computing…" notice appears when a change takes longer [ms]
-BUSY_TEXT = '<div class="busy-text">⏳ computing…</div>'
-PUBLISHED_CASES = {"stable": 0.005, "unstable": 0.014}  # s0 at 120 km/h (the study's two cases)
-
-CSS = """
-.status-box {font-size: 30px; font-weight: 700; padding: 6px 14px; border-radius: 6px;
-             color: white; text-align: center; letter-spacing: 0.05em}
-.status-box.ok {background: STABLE_COLOR} .status-box.bad {background: UNSTABLE_COLOR}
-table.bogie {border-collapse: collapse; font-size: 12px; width: 100%}
-table.bogie th, table.bogie td {border-bottom: 1px solid #ddd; padding: 2px 6px; text-align: right}
-table.bogie td.text, table.bogie th.text {text-align: left}
-table.bogie td.bad {color: UNSTABLE_COLOR; font-weight: 700}
-.busy-text {font-size: 13px; color: #555; font-style: italic}
-""".replace("UNSTABLE_COLOR", UNSTABLE).replace("STABLE_COLOR", STABLE)
-
-
-class ControlSlider(pn.widgets.FloatSlider):
-    """A control slider that hands a released value on at once.  Panel holds every browser
-    event of a widget for ``_debounce`` ms (50 by default) to batch events that arrive
-    together; a released slider sends ``value`` and ``value_throttled`` within a millisecond,
-    so 5 ms still batches them, and a slider step reaches the model ≈ 45 ms earlier (server
-    timeline of one s0 step: event received → the dashboard's watcher 52 ms)."""
-
-    _debounce = 5
-
-
-@dataclass(frozen=True)
-class State:
-    """The primitives a computation depends on (a snapshot of the parameters)."""
-
-    params_path: str
-    rail: str
-    s0: float
-    v: float
-    N0: float
-    b_M: float
-    M0: float
-    f: float
-    D: float
-    dt: float | None
-    t_end: float
-    locus: str
-
-    @property
-    def point(self) -> tuple:
-        return (self.params_path, self.rail, self.s0, self.v, self.N0, self.b_M)
-
-    @property
-    def locus_key(self) -> tuple:
-        """What the root locus depends on: (set, rail, swept parameter, fixed value, N0, b_M)."""
-        fixed = self.v if self.locus == "s0" else self.s0
-        return (self.params_path, self.rail, self.locus, fixed, self.N0, self.b_M)
-
-
-def _ignore_outcome(future) -> None:
-    """A computation whose result is no longer shown: retrieve its outcome when it ends (no
-    "exception was never retrieved" warning for a rejected, superseded parameter set)."""
-    future.add_done_callback(lambda f: f.cancelled() or f.exception())
+# the parameters whose change is computed (the others only change the view)
+COMPUTED = ["s0", "v", "N0", "b_M", "M0", "f", "D", "dt_auto", "dt", "t_end", "rail", "locus",
+            "variant"]
 
 
 class BogieDashboard(pn.viewable.Viewer):
@@ -145,8 +81,8 @@ class BogieDashboard(pn.viewable.Viewer):
         parameter values (they win over the query)."""
         limit_blas_threads()
         if query is None:
-            query = _session_query()
-        values, variant, self._query_tab, query_notices = parse_query(
+            query = session_query()
+        values, variant, query_tab, query_notices = parse_query(
             query, type(self).param, None, base=str(params_path or ""))
         params = {**values, **({"variant": variant} if variant else {}), **params}
         super().__init__(**params)
@@ -161,117 +97,33 @@ class BogieDashboard(pn.viewable.Viewer):
         self.limit: compute.LimitResult | None = None
         self._limit_for: tuple | None = None  # (rail, v, N0, b_M) of self.limit
         self.locus_result: compute.LocusResult | None = None
-        self._shown_locus: tuple | None = None  # (locus key, dense?) of the locus on screen
+        self.shown_locus: tuple | None = None  # (locus key, dense?) of the locus on screen
         self.response: compute.ResponseView | None = None
         self.error = ""  # last rejection message ("" if the current parameters are valid)
-        self._pending_views: dict[tuple[str, str], tuple] = {}  # (tab, what) -> (function, args)
-        self._dirty = False
-        self._busy = False
         self.closed = False  # the served session has ended: nothing more is computed for it
-        # one waiting follow-up per kind (app.services.thread_pools.LatestRequest): dense locus, s0*(v)
-        self._dense_requests = LatestRequest(FOLLOW_UP_POOL, self.alive)
-        self._limit_requests = LatestRequest(SIDE_VIEW_POOL, self.alive)
+        self.scheduler = Scheduler(self)
         self._build()
-        self.param.watch(self._on_change, ["s0", "v", "N0", "b_M", "M0", "f", "D", "dt_auto",
-                                           "dt", "t_end", "rail", "locus", "variant"])
-        self._restore_tab(query_notices)
+        self.param.watch(self._on_change, COMPUTED)
+        self._restore_tab(query_tab, query_notices)
         self.param.watch(self._share, list(self.param))
         self.tabs.param.watch(self._share, "active")
         self.tabs.param.watch(self._tab_shown, "active")
         self._tab_shown()
         self.param.watch(self._on_mode, ["mode"])
         self.param.watch(lambda e: self.locus_plot.zoom(e.new == "low"), ["zoom"])
-        doc = pn.state.curdoc
-        if doc is not None and doc.session_context is not None:
+        doc = served_document()
+        if doc is not None:
             doc.on_session_destroyed(self._session_closed)
             # served: show the fast results at once, the root locus and s0* when they are ready
-            self.refresh(slow=False)
-            self._request(doc, loading=False)
+            self.scheduler.refresh(slow=False)
+            self.scheduler.request(doc, loading=False)
         else:
-            self.refresh()
+            self.scheduler.refresh()
 
-    def alive(self) -> bool:
-        """Whether results are still wanted (False once the served session has ended)."""
-        return not self.closed
+    def __panel__(self):
+        return self.layout
 
-    def _session_closed(self, session_context) -> None:
-        """The browser has left: work not yet started for this session is dropped."""
-        self.closed = True
-
-    # --- controls ------------------------------------------------------------------------------
-
-    def _slider(self, name: str, label: str, step: float, fmt: str = "0[.]000"):
-        p = self.param[name]
-        widget = ControlSlider(label=label, start=p.bounds[0], end=p.bounds[1], step=step,
-                               value=getattr(self, name), format=fmt, css_classes=[f"ctl-{name}"],
-                               sizing_mode="stretch_width")
-        widget.param.watch(partial(self._set_control, name), "value_throttled")
-        self.param.watch(lambda event: setattr(widget, "value", event.new), name)
-        return widget
-
-    def _set_control(self, name: str, event) -> None:
-        """A slider's released value into the parameter; a value the parameter refuses (out
-        of its bounds, NaN, not a number: only a doctored client sends one) gives a notice and
-        changes nothing."""
-        try:
-            setattr(self, name, event.new)
-        except (ValueError, TypeError) as error:
-            self.warn(f"{name}: value {str(event.new)[:40]} not used: {str(error)[:200]}")
-
-    def _controls(self):
-        sliders = {
-            "s0": self._slider("s0", "creepage s0 [-]", 0.0005, "0.0000"),
-            "v": self._slider("v", "speed v [km/h]", 5.0, "0"),
-            "N0": self._slider("N0", "wheel force N0 [kN]", 1.0, "0"),
-            "b_M": self._slider("b_M", "motor slope b_M [N m s/rad]", 100.0, "0"),
-            "M0": self._slider("M0", "short circuit M0 [kN m]", 1.0, "0"),
-            "f": self._slider("f", "frequency f [Hz]", 1.0, "0"),
-            "D": self._slider("D", "decay D [-]", 0.005, "0.000"),
-            "dt": self._slider("dt", "time shift Δt [ms]", 0.05, "0.00"),
-            "t_end": self._slider("t_end", "simulated time [s]", 0.1, "0.0"),
-        }
-        sliders["dt"].disabled = self.dt_auto
-        self.param.watch(lambda e: setattr(sliders["dt"], "disabled", e.new), "dt_auto")
-        dt_auto = pn.widgets.Checkbox.from_param(self.param.dt_auto,
-                                                 label="Δt automatic (continuous torque)",
-                                                 css_classes=["ctl-dt_auto"])
-        rail = pn.widgets.Select.from_param(self.param.rail, label="rail condition (creep law)",
-                                            css_classes=["ctl-rail"], sizing_mode="stretch_width")
-        cases = []
-        for key, s0 in PUBLISHED_CASES.items():
-            button = pn.widgets.Button(label=f"Published case s0 = {s0} ({key})",
-                                       color="success" if key == "stable" else "danger",
-                                       css_classes=[f"case-{key}"], sizing_mode="stretch_width")
-            button.on_click(partial(self._published_case, s0))
-            cases.append(button)
-        self.sliders = sliders
-        downloads = [
-            pn.widgets.FileDownload(callback=self._csv, filename="time_histories.csv",
-                                    label="time histories (CSV)", css_classes=["dl-csv"],
-                                    sizing_mode="stretch_width"),
-            pn.widgets.FileDownload(callback=self._json, filename="eigenvalues.json",
-                                    label="eigenvalues (JSON)", css_classes=["dl-json"],
-                                    sizing_mode="stretch_width"),
-            pn.widgets.FileDownload(callback=self._toml, filename="parameters.toml",
-                                    label="parameter set (TOML)", css_classes=["dl-toml"],
-                                    sizing_mode="stretch_width"),
-            pn.widgets.FileDownload(callback=self.report_html, filename="bogie-report.html",
-                                    label="report (HTML, opens offline)",
-                                    css_classes=["dl-report"], sizing_mode="stretch_width"),
-        ]
-        return pn.Column(
-            "### Published cases (120 km/h)", *cases,
-            "### Operating point", sliders["s0"], sliders["v"], sliders["N0"], sliders["b_M"],
-            rail,
-            "### Short circuit M_C(t)", sliders["M0"], sliders["f"], sliders["D"], dt_auto,
-            sliders["dt"], sliders["t_end"],
-            *self.nonlinear.controls,  # issue 10
-            "### Downloads", *downloads, width=300)
-
-    def _published_case(self, s0: float, _event=None) -> None:
-        self.param.update(s0=s0, v=120.0)
-
-    # --- layout --------------------------------------------------------------------------------
+    # --- the page ------------------------------------------------------------------------------
 
     def _build(self) -> None:
         m = compute.model(self._params_path, "calibrated")
@@ -280,23 +132,17 @@ class BogieDashboard(pn.viewable.Viewer):
         self.creep_plot = CreepPlot()
         self.response_plots = ResponsePlots()
         self.mode_plot = ModeShapePlot(m.positions, m.parameters["wheel_radius"])
-        self.nonlinear = NonlinearView(self)  # issue 10: creep model, anti-slip, overlays
-        html_pane = partial(pn.pane.HTML, sizing_mode="stretch_width", stylesheets=[CSS])
-        self.status = html_pane("", css_classes=["stability-status"])
-        self.details = html_pane("")
-        # a static notice of fixed size, shown only for changes longer than BUSY_DELAY_MS: an
-        # overlay over the results made the browser re-lay out every plot (+300 ms per change),
-        # and an animated spinner kept every waiting page busy (measured with ten sessions)
-        self.busy = pn.pane.HTML("", width=300, height=22, css_classes=["busy"],
-                                 stylesheets=[CSS])
+        self.nonlinear = NonlinearView(self)  # creep model, anti-slip, overlays
+        self.status = layout.html_pane("", css_classes=["stability-status"])
+        self.details = layout.html_pane("")
         self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
                                     css_classes=["model-notice"], sizing_mode="stretch_width")
         # input that was not used (a bad link, file or value): stays until the next such notice
         self.input_notice = pn.pane.Alert("", alert_type="warning", visible=False,
                                           css_classes=["input-notice"],
                                           sizing_mode="stretch_width")
-        self.peaks = html_pane("")
-        self.eigen_table = html_pane("")
+        self.peaks = layout.html_pane("")
+        self.eigen_table = layout.html_pane("")
         self.mode_select = pn.widgets.Select(label="mode ν", options={}, width=420,
                                              css_classes=["ctl-mode"])
         self.mode_select.link(self, value="mode")
@@ -306,95 +152,112 @@ class BogieDashboard(pn.viewable.Viewer):
         zoom = pn.widgets.RadioButtonGroup.from_param(
             self.param.zoom, options={"all modes ≤ 20 Hz": "all", "low modes": "low"},
             css_classes=["ctl-zoom"])
-        bokeh_pane = partial(pn.pane.Bokeh, sizing_mode="stretch_width")
         self.sensitivity = SensitivityView(self.alive)  # sensitivity tornado
-        schematic = ASSETS / "schematic.svg"
         self.variant_view = VariantView(self)
         self.click = ModeClickThrough(self)  # tapped locus points and table rows -> mode views
-        # the views below the status and the root locus, one tab each; other modules add theirs
-        # with ``self.tabs.append((title, view))``.  Only the open tab is in the browser
-        # (dynamic; app/dashboard/panel_fixes.py), and the views of a hidden tab are brought up to date
-        # when it is opened (``when_shown``): with every view in the page and updated at every
-        # change, the browser re-styled and re-rendered the hidden ones too
-        self.tabs = pn.Tabs(
-            ("Response", pn.Column(
-                pn.Row(bokeh_pane(self.creep_plot.figure), pn.Column(self.peaks, width=520),
-                       sizing_mode="stretch_width"),
-                pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[:2]),
-                       sizing_mode="stretch_width"),
-                pn.Row(*(bokeh_pane(f) for f in self.response_plots.figures[2:]),
-                       sizing_mode="stretch_width"), sizing_mode="stretch_width")),
-            ("Fig. 6", pn.Column(
-                pn.pane.Markdown("Lightly damped complex branches (ζ < 0.3 somewhere on the "
-                                 "sweep) and the real eigenvalues of the root locus above, "
-                                 "against the swept parameter; red dashed: the stability limit "
-                                 "(s0*(v) over s0, the sweep's first unstable speed over v)."),
-                pn.Row(*(bokeh_pane(f) for f in self.fig6.figures[:2]),
-                       sizing_mode="stretch_width"),
-                pn.Row(bokeh_pane(self.fig6.figures[2]), sizing_mode="stretch_width"),
-                sizing_mode="stretch_width")),
-            ("Modes", pn.Column(
-                "#### Eigenvalues (layout of Table 1) and modes (layout of Table 2)",
-                pn.Row(pn.Column(self.eigen_table, width=420),
-                       pn.Column("**Modes** (dominant motion from kinetic/strain energy "
-                                 "shares; click a row, or a point of the root locus)",
-                                 self.click.table.table,
-                                 sizing_mode="stretch_width"),
-                       sizing_mode="stretch_width"),
-                "#### Mode shape",
-                self.mode_select, self.click.detail,
-                pn.Row(*(bokeh_pane(f) for f in self.mode_plot.figures),
-                       sizing_mode="stretch_width"), sizing_mode="stretch_width")),
+        self.view_tabs = layout.ViewTabs(
+            ("Response", layout.response_view(self.creep_plot, self.peaks, self.response_plots)),
+            ("Fig. 6", layout.fig6_view(self.fig6)),
+            ("Modes", layout.modes_view(self.eigen_table, self.click, self.mode_select,
+                                        self.mode_plot)),
             ("Variant", self.variant_view),
-            ("Schematic", pn.pane.SVG(schematic, width=640)
-             if schematic.is_file() else pn.pane.Markdown("*(schematic missing)*")),
-            dynamic=True, css_classes=["views"], sizing_mode="stretch_width")
+            ("Schematic", layout.schematic_view()))
+        self.tabs = self.view_tabs.tabs
         self.main = pn.Column(
-            self.notice, self.input_notice, self.nonlinear.notice,  # issue 10
-            pn.Row(pn.Column(self.status, self.busy, self.details, self.nonlinear.status,
-                             width=330),
-                   pn.Column(pn.Row(locus_choice, zoom), bokeh_pane(self.locus_plot.figure),
+            self.notice, self.input_notice, self.nonlinear.notice,
+            pn.Row(pn.Column(self.status, self.scheduler.busy_notice, self.details,
+                             self.nonlinear.status, width=330),
+                   pn.Column(pn.Row(locus_choice, zoom), layout.bokeh_pane(self.locus_plot.figure),
                              sizing_mode="stretch_width"),
                    sizing_mode="stretch_width"),
             self.tabs, sizing_mode="stretch_width")
-        self.tabs.append(("Sensitivity", self.sensitivity.panel))  # issue 12: sensitivity tornado
-        # issue 13: the "Studies" view (stability map over s0 × v) lives in app/dashboard/studies_view.py
-        from app.dashboard.studies_view import StudiesView
+        self.view_tabs.add("Sensitivity", self.sensitivity.panel)
+        self.studies = StudiesView(self)  # stability maps over s0 × v from the server's queue
+        self.view_tabs.add("Studies", self.studies.layout)
+        self.downloads = Downloads(self)
+        self.controls = Controls(self, self.nonlinear.controls, self.downloads.widgets)
+        self.sliders = self.controls.sliders
+        self.layout = pn.Row(self.controls.column, self.main, sizing_mode="stretch_width",
+                             stylesheets=[layout.CSS])
 
-        self.studies = StudiesView(self)
-        self.tabs.append(("Studies", self.studies.layout))
-        self.layout = pn.Row(
-            self._controls(), self.main, sizing_mode="stretch_width",
-            stylesheets=[CSS])
+    # --- the public interface of the views -----------------------------------------------------
 
-    def __panel__(self):
-        return self.layout
+    def alive(self) -> bool:
+        """Whether results are still wanted (False once the served session has ended)."""
+        return not self.closed
 
-    # --- state and computations --------------------------------------------------------------
+    def _session_closed(self, session_context) -> None:
+        """The browser has left: work not yet started for this session is dropped."""
+        self.closed = True
+
+    @property
+    def params_path(self) -> str:
+        """The bundled parameter file in use ("": the calibrated set); the variant, if any,
+        changes it (:attr:`set_key`)."""
+        return self._params_path
 
     @property
     def set_key(self) -> str:
         """The parameter set in use for app.results.compute: the bundled file, or a variant of it."""
         return f"{self._params_path}|{self.variant}" if self.variant else self._params_path
 
-    # --- shareable state (app.dashboard.url_state) -------------------------------------------------------
+    def state(self) -> State:
+        """The parameters as the primitives a computation depends on (:mod:`app.dashboard.stages`)."""
+        rnd = lambda x, n=6: float(round(x, n))  # noqa: E731 - cache keys without float noise
+        return State(self.set_key, self.rail, rnd(self.s0, 7), rnd(self.v, 3),
+                     rnd(self.N0, 3), rnd(self.b_M, 3), rnd(self.M0, 3), rnd(self.f, 3),
+                     rnd(self.D, 5), None if self.dt_auto else rnd(self.dt, 4), rnd(self.t_end, 3),
+                     self.locus)
+
+    def post(self, doc, function, *args) -> None:
+        """``function(*args)`` on the session's next tick, with its document lock; nothing if the
+        session has ended meanwhile (:func:`app.dashboard.session.post`)."""
+        post(doc, function, *args)
+
+    def run_locked(self, function, *args) -> None:
+        """Run ``function(*args)`` with the session's document lock: served, on the next tick;
+        otherwise at once (:func:`app.dashboard.session.run_locked`)."""
+        run_locked(function, *args)
+
+    def warn(self, text: str) -> None:
+        """Show a notice about input that was not used (the previous state is kept)."""
+        self.input_notice.object = html.escape(text)
+        self.input_notice.visible = True
+
+    def clear_warning(self) -> None:
+        """Hide the notice about unused input (the input it named has been corrected)."""
+        self.input_notice.visible = False
+
+    def when_shown(self, tab: str, function, *args) -> None:
+        """``function(*args)`` now if the view's tab (``tab_names``) is open or the dashboard is
+        not served, else when the tab is opened (of several calls of one function for a hidden
+        tab, the last one)."""
+        self.view_tabs.when_shown(tab, function, *args)
+
+    def flush_view(self, tab: str) -> None:
+        """Apply the updates the view ``tab`` missed while hidden, in the order they came."""
+        self.view_tabs.flush(tab)
+
+    def show_published_case(self, s0: float) -> None:
+        """The operating point of one of the study's published cases: ``s0`` at 120 km/h."""
+        self.param.update(s0=s0, v=PUBLISHED_SPEED_KMH)
+
+    # --- shareable state (app.dashboard.url_state) ----------------------------------------------
 
     @property
     def tab_names(self) -> list[str]:
         """The views' names in the URL (``tab=``): their titles in lower case, words joined
         by '-'."""
-        return [re.sub(r"[^a-z0-9]+", "-", str(title).lower()).strip("-")
-                for title in self.tabs._names]
+        return list(self.view_tabs.names)
 
     def share_query(self) -> str:
         """The URL query (without '?') that restores this session's settings."""
-        return make_query(self, self.tab_names[self.tabs.active] if self.tabs.active else None)
+        return make_query(self, self.view_tabs.shown if self.tabs.active else None)
 
-    def _restore_tab(self, notices: list[str]) -> None:
-        tab = self._query_tab
+    def _restore_tab(self, tab: str | None, notices: list[str]) -> None:
         if tab is not None:
-            if tab in self.tab_names:
-                self.tabs.active = self.tab_names.index(tab)
+            if tab in self.view_tabs.names:
+                self.tabs.active = self.view_tabs.names.index(tab)
             else:
                 notices.append(f"tab = '{tab[:40]}' is not one of {', '.join(self.tab_names)}")
         if notices:
@@ -404,31 +267,9 @@ class BogieDashboard(pn.viewable.Viewer):
     def _tab_shown(self, *_events) -> None:
         """Views that compute only while shown (the variant comparison) learn it here; the
         updates a hidden view missed are applied."""
-        shown = self.tab_names[self.tabs.active]
+        shown = self.view_tabs.shown
         self.variant_view.on_shown(shown == "variant")
         self.flush_view(shown)
-
-    def when_shown(self, tab: str, function, *args) -> None:
-        """``function(*args)`` now if the view's tab (``tab_names``) is open or the dashboard is
-        not served, else when the tab is opened (of several calls of one function for a hidden
-        tab, the last one)."""
-        served = pn.state.curdoc is not None and pn.state.curdoc.session_context is not None
-        if not served or self.tab_names[self.tabs.active] == tab:
-            self._pending_views.pop((tab, function.__name__), None)
-            function(*args)
-        else:
-            self._pending_views[tab, function.__name__] = (function, args)
-
-    def flush_view(self, tab: str) -> None:
-        """Apply the updates the view ``tab`` missed while hidden, in the order they came."""
-        for key in [key for key in self._pending_views if key[0] == tab]:
-            function, args = self._pending_views.pop(key)
-            function(*args)
-
-    def warn(self, text: str) -> None:
-        """Show a notice about input that was not used (the previous state is kept)."""
-        self.input_notice.object = html.escape(text)
-        self.input_notice.visible = True
 
     def _share(self, *_events) -> None:
         """Keep the browser's address (served) equal to the settings: a link to share."""
@@ -436,241 +277,17 @@ class BogieDashboard(pn.viewable.Viewer):
         if location is not None and pn.state.curdoc.session_context is not None:
             location.search = "?" + self.share_query()
 
-    def state(self) -> State:
-        rnd = lambda x, n=6: float(round(x, n))  # noqa: E731 - cache keys without float noise
-        return State(self.set_key, self.rail, rnd(self.s0, 7), rnd(self.v, 3),
-                     rnd(self.N0, 3), rnd(self.b_M, 3), rnd(self.M0, 3), rnd(self.f, 3),
-                     rnd(self.D, 5), None if self.dt_auto else rnd(self.dt, 4), rnd(self.t_end, 3),
-                     self.locus)
-
-    # the four computations of a change; each independent of the others (run in parallel
-    # when served).  One BLAS thread each: set once per process (app.services.thread_pools.limit_blas_threads)
-    @staticmethod
-    def _point(state: State):
-        return compute.point_result(*state.point)
-
-    @staticmethod
-    def _response(state: State):
-        return compute.response_result(*state.point, state.M0, state.f, state.D, state.dt,
-                                       state.t_end)
-
-    @staticmethod
-    def _limit(state: State):
-        return compute.limit_result(state.params_path, state.rail, state.v, state.N0, state.b_M)
-
-    @staticmethod
-    def _locus(state: State):
-        """The coarse root locus (shown first)."""
-        return compute.locus_result(*state.locus_key)
-
-    @staticmethod
-    def _dense_locus(state: State):
-        """The dense root locus (replaces the coarse one)."""
-        return compute.dense_locus_result(*state.locus_key)
-
-    def compute_fast(self, state: State):
-        """(point result, response result) for a state (raises a MODEL_ERRORS on rejection)."""
-        return self._point(state), self._response(state)
-
-    def compute_slow(self, state: State):
-        """(stability limit, dense root locus) for a state."""
-        return self._limit(state), self._dense_locus(state)
-
-    def refresh(self, slow: bool = True) -> None:
-        """Compute and show everything synchronously (initial view, tests); ``slow=False``
-        skips the stability limit and the root locus."""
-        state = self.state()
-        try:
-            fast = self.compute_fast(state)
-        except MODEL_ERRORS as error:
-            self._reject(error)
-            return
-        self._apply_fast(state, fast)
-        if not slow:
-            return
-        try:
-            slow = self.compute_slow(state)
-        except MODEL_ERRORS as error:
-            self._reject(error)
-            return
-        self._apply_slow(state, slow)
+    # --- computing and showing results ---------------------------------------------------------
 
     def _on_change(self, *_events) -> None:
-        doc = pn.state.curdoc
-        if doc is None or doc.session_context is None:
-            self.refresh()
-            return
-        self._request(doc)
-
-    def _request(self, doc, loading: bool = True) -> None:
-        self._dirty = True
-        if self._busy:
-            return  # the running worker picks up the newest parameters when it is done
-        self._busy = True
-        if loading:
-            doc.add_timeout_callback(self._show_busy, BUSY_DELAY_MS)
-        doc.add_next_tick_callback(without_document_lock(partial(self._worker, doc)))
-
-    async def _worker(self, doc) -> None:
-        loop = asyncio.get_running_loop()
-        try:
-            while self._dirty and not self.closed:
-                self._dirty = False
-                state = self.state()
-                # the coarse root locus (≈ 0.3 s on two threads when not cached) starts at once,
-                # beside the fast stage (one thread), and is shown when both are done; then the
-                # dense one replaces it when ready.  Nothing to do if the dense locus of this
-                # (set, rail, sweep, fixed value, N0, b_M) is on screen already
-                need_locus = self._shown_locus != (state.locus_key, True)
-                locus_future = (loop.run_in_executor(FIRST_ANSWER_POOL, self._locus, state)
-                                if need_locus else None)
-                try:
-                    fast = await loop.run_in_executor(FIRST_ANSWER_POOL, self.compute_fast, state)
-                except MODEL_ERRORS as error:
-                    self._post(doc, self._reject, error)
-                    if locus_future is not None:
-                        _ignore_outcome(locus_future)
-                    continue
-                # issue 10: the nonlinear history, if shown, starts once the linear first answer
-                # is computed, not beside it: its step loop is mostly Python and shared the GIL
-                # with the fast stage (linear result 304 ms beside it, median of 12 steps)
-                self.nonlinear.prefetch(state)
-                self._post(doc, self._apply_fast, state, fast)
-                if self._dirty:
-                    if locus_future is not None:
-                        _ignore_outcome(locus_future)  # it still fills the cache
-                    continue
-                if locus_future is not None:
-                    try:
-                        locus = await locus_future
-                    except MODEL_ERRORS as error:
-                        self._post(doc, self._reject, error)
-                        continue
-                    if self._dirty:
-                        continue
-                    self._post(doc, self._apply_locus, state, locus)
-                    dense = self._dense_requests.submit(self._dense_if_current, state)
-                    dense.add_done_callback(partial(self._dense_done, doc, state))
-                    # s0*(v) after the dense locus (which has a target: ≤ 2 s after a speed
-                    # change): at a lower priority beside it, its full eigen-analyses still
-                    # took ≈ 1.3 CPU-s of the two cores while the dense sweep ran (py-spy)
-                    dense.add_done_callback(lambda _f, s=state: self._start_limit(doc, s))
-                else:
-                    self._start_limit(doc, state)
-        except Exception as error:  # keep the server and the session alive, say what happened
-            log.exception("dashboard computation failed")
-            self._post(doc, self._reject, error)
-        finally:
-            self._busy = False
-            self._post(doc, self._done)
-
-    def _start_limit(self, doc, state: State) -> None:
-        """s0*(v) (≈ 0.7 s when not cached) is not waited for: a change arriving meanwhile
-        starts at once; the limit is shown when ready if it still belongs to the parameters."""
-        limit = self._limit_requests.submit(self._limit_if_current, state)
-        limit.add_done_callback(partial(self._limit_done, doc, state))
-
-    def _limit_current(self, state: State) -> bool:
-        """Whether s0*(v) for ``state`` is still the one to show (same v, N0, b_M, rail)."""
-        current = self.state()
-        return (current.rail, current.v, current.N0, current.b_M) == (state.rail, state.v,
-                                                                      state.N0, state.b_M)
-
-    def _limit_if_current(self, state: State) -> compute.LimitResult | None:
-        """s0*(v), unless superseded before it started (a speed slider dragged over ten values
-        must not queue ten 0.7 s root findings in front of the next change's fast stage)."""
-        return self._limit(state) if self._limit_current(state) else None
-
-    def _dense_if_current(self, state: State) -> compute.LocusResult | None:
-        """The dense root locus, unless superseded before it started."""
-        return self._dense_locus(state) if self.state().locus_key == state.locus_key else None
-
-    def _dense_done(self, doc, state: State, future) -> None:
-        self._background_done(doc, state, future, "dense root locus", self._apply_locus,
-                              lambda: self.state().locus_key == state.locus_key)
-
-    def _limit_done(self, doc, state: State, future) -> None:
-        self._background_done(doc, state, future, "stability limit", self._apply_limit,
-                              lambda: self._limit_current(state))
-
-    def _background_done(self, doc, state: State, future, what: str, apply, current) -> None:
-        """A background result (``None``: skipped) is shown with ``apply(state, result)`` if
-        ``current()`` still holds (nothing otherwise: another speed, sweep … is shown)."""
-        if future.cancelled() or not current():
-            return
-        error = future.exception()
-        if error is not None:
-            if isinstance(error, MODEL_ERRORS):
-                self._post(doc, self._reject, error)
-            else:
-                log.error("%s failed", what, exc_info=error)
-            return
-        if future.result() is not None:
-            self._post(doc, apply, state, future.result())
-
-    def run_locked(self, function, *args) -> None:
-        """Run ``function(*args)`` with the session's document lock: served, on the next tick
-        (a Panel widget callback may run without the lock; changing Bokeh models there raised
-        "_pending_writes should be non-None"); otherwise at once."""
-        doc = pn.state.curdoc
-        if doc is None or doc.session_context is None:
-            function(*args)
+        doc = served_document()
+        if doc is None:
+            self.scheduler.refresh()
         else:
-            self._post(doc, function, *args)
+            self.scheduler.request(doc)
 
-    def _post(self, doc, function, *args) -> None:
-        """``function(*args)`` on the session's next tick, with its document lock; nothing if the
-        session has ended meanwhile (a closed browser tab: its document is destroyed, and
-        Bokeh raised AttributeError on scheduling into it)."""
-        if doc.session_context is None or getattr(doc.session_context, "destroyed", False):
-            return
-        try:
-            doc.add_next_tick_callback(partial(self._locked, doc, function, *args))
-        except (AttributeError, RuntimeError):
-            log.debug("session ended: result not shown")
-
-    @staticmethod
-    def _locked(doc, function, *args) -> None:
-        from panel.io.state import set_curdoc
-
-        # Bokeh's own hold: all changes of one result go to the browser in one go and are
-        # rendered once (Panel's ``hold`` bypasses the document lock and lost the changes of
-        # a session whose websocket was not connected yet)
-        with set_curdoc(doc):
-            held = doc.callbacks.hold_value is not None
-            if not held:
-                doc.hold("combine")
-            try:
-                function(*args)
-            finally:
-                if not held:
-                    doc.unhold()
-
-    def _done(self) -> None:
-        if not self._busy and self.busy.object:
-            self.busy.object = ""
-
-    def _show_busy(self) -> None:
-        if self._busy:
-            self.busy.object = BUSY_TEXT
-
-    def _reject(self, error: Exception) -> None:
-        message = error.args[0] if error.args else str(error)
-        self.error = str(message)
-        self.notice.object = (f"**The model rejects this combination:** {html.escape(str(message))}"
-                              " — showing the last valid result.")
-        self.notice.visible = True
-
-    def _on_mode(self, *_events) -> None:
-        if self.point is not None and 1 <= self.mode <= len(self.point.modes):
-            self.mode_plot.update(self.point.modes[self.mode - 1].displacement)
-            self.mode_select.value = self.mode
-            self.click.show_point_mode()
-            self.sensitivity.show(mode=self.mode)  # issue 12: sensitivity tornado
-
-    # --- showing results -----------------------------------------------------------------------
-
-    def _apply_fast(self, state: State, fast) -> None:
+    def show_fast(self, state: State, fast) -> None:
+        """Show the first answer ``(point result, response result)`` for ``state``."""
         point, response = fast
         self.point, self.response, self.error = point, response, ""
         self.notice.visible = False
@@ -681,10 +298,9 @@ class BogieDashboard(pn.viewable.Viewer):
         self.peaks.object = peaks_html(response)
         self.when_shown("modes", self._show_modes, point)
         self.locus_plot.zoom(self.zoom == "low")
-        # issue 12: sensitivity tornado (computed when its tab is open, shown when ready)
+        # the sensitivity tornado is computed when its tab is open, shown when ready
         self.when_shown("sensitivity", self.sensitivity.request, self, state)
-
-        self.nonlinear.on_fast(state)  # issue 10: the nonlinear result follows
+        self.nonlinear.on_fast(state)  # the nonlinear result follows
 
     def _show_modes(self, point: compute.PointResult) -> None:
         """The Modes tab: eigenvalue table, mode table, mode choice and the selected mode."""
@@ -695,25 +311,37 @@ class BogieDashboard(pn.viewable.Viewer):
         self.mode_select.value = min(self.mode, len(point.modes))
         self._on_mode()
 
-    def _apply_slow(self, state: State, slow) -> None:
-        limit, locus = slow
-        self._apply_limit(state, limit)
-        self._apply_locus(state, locus)
+    def _on_mode(self, *_events) -> None:
+        if self.point is not None and 1 <= self.mode <= len(self.point.modes):
+            self.mode_plot.update(self.point.modes[self.mode - 1].displacement)
+            self.mode_select.value = self.mode
+            self.click.show_point_mode()
+            self.sensitivity.show(mode=self.mode)
 
-    def _apply_limit(self, state: State, limit: compute.LimitResult) -> None:
-        self.limit, self._limit_for = limit, (state.rail, state.v, state.N0, state.b_M)
+    def show_limit(self, state: State, limit: compute.LimitResult) -> None:
+        """Show the stability limit s0*(v) computed for ``state``."""
+        self.limit, self._limit_for = limit, state.limit_key
         self.creep_plot.update_limit(limit)
         self.when_shown("fig-6", self.fig6.update_limit, limit.s0_limit)
         self._show_status()
 
-    def _apply_locus(self, state: State, locus: compute.LocusResult) -> None:
+    def show_locus(self, state: State, locus: compute.LocusResult) -> None:
+        """Show the root locus computed for ``state`` (nothing if another sweep is shown now)."""
         if self.state().locus_key != state.locus_key:
             return  # a late result of a sweep no longer shown
         self.locus_result = locus
-        self._shown_locus = (state.locus_key, locus.dense)
+        self.shown_locus = (state.locus_key, locus.dense)
         self.locus_plot.update_locus(locus)
         self.when_shown("fig-6", self.fig6.update_locus, locus)
         self.locus_plot.zoom(self.zoom == "low")
+
+    def reject(self, error: Exception) -> None:
+        """The model rejects the parameters: say why, keep the last valid results on screen."""
+        message = error.args[0] if error.args else str(error)
+        self.error = str(message)
+        self.notice.object = (f"**The model rejects this combination:** {html.escape(str(message))}"
+                              " — showing the last valid result.")
+        self.notice.visible = True
 
     def _show_status(self) -> None:
         point = self.point
@@ -736,54 +364,3 @@ class BogieDashboard(pn.viewable.Viewer):
             f"divergent real eigenvalues: <b>{point.divergence}</b><br>{limit}<br>"
             f"μ(s0) = {point.mu0:.4f}, μ_max = {point.mu_max:.4f} at s = {point.s_max:.4f}<br>"
             f"M_ad = 2 N0 r0 μ_max = {point.M_ad:,.0f} N m</div>")
-
-    # --- downloads -----------------------------------------------------------------------------
-
-    def _csv(self):
-        r = self.response
-        names = list(r.outputs)
-        header = "t [s]," + ",".join(f"{n} [{r.units[n]}]" for n in names) + ",M_C [N m]"
-        data = np.column_stack([r.t, *r.outputs.values(), r.M_C])
-        buffer = io.StringIO()
-        np.savetxt(buffer, data, delimiter=",", header=header, comments="", fmt="%.8g")
-        buffer.seek(0)
-        return buffer
-
-    def _json(self):
-        p = self.point
-        lam = p.eigenvalues
-        order = np.lexsort((lam.real, lam.imag))
-        data = {"operating_point": {"s0": p.key[2], "v_kmh": p.key[3], "N0": p.key[4] * 1e3,
-                                    "b_M": p.key[5], "rail": p.key[1]},
-                "stable": p.stable, "max_real_part": p.max_real_part, "flutter_pairs": p.flutter,
-                "divergent_real": p.divergence, "rigid_body": p.n_rigid,
-                "modes": [{"nu": m.number, "re": m.eigenvalue.real, "im_hz": m.im_hz,
-                           "damping_ratio": m.damping_ratio, "description": m.description}
-                          for m in p.modes],
-                "eigenvalues": [{"re": float(x.real), "im": float(x.imag)} for x in lam[order]]}
-        return io.StringIO(json.dumps(data, indent=1))
-
-    def report_html(self):
-        """The self-contained HTML report of the current state (app.report.page)."""
-        from app.report.page import build_report
-
-        state = self.state()
-        return io.StringIO(build_report(state.params_path, state.rail, state.s0, state.v,
-                                        state.N0, state.b_M, state.M0, state.f, state.D,
-                                        state.dt, state.t_end))
-
-    def _toml(self):
-        state = self.state()
-        p = compute.parameters(state.params_path, state.rail)
-        header = (f"parameter set in use by the dashboard (rail condition: {state.rail})\n"
-                  f"operating point: s0 = {state.s0}, v = {state.v} km/h, N0 = {state.N0} kN, "
-                  f"b_M = {state.b_M} N m s/rad")
-        return io.StringIO(dumps_parameters(p, header))
-
-
-def _session_query() -> dict:
-    """The URL query arguments of the served session being built ({} without a server)."""
-    doc = pn.state.curdoc
-    if doc is None or doc.session_context is None:
-        return {}
-    return dict(pn.state.session_args or {})

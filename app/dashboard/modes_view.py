@@ -116,7 +116,7 @@ class ModeClickThrough:
         point = self.dashboard.point
         if point is None or not 1 <= number <= len(point.modes):
             return
-        self.dashboard.mode = number  # the mode views follow (BogieDashboard._on_mode)
+        self.dashboard.mode = number  # the dashboard's mode views follow
 
     def show_point_mode(self) -> None:
         """Detail of the dashboard's selected mode ν at the current point."""

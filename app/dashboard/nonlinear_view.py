@@ -1,6 +1,6 @@
-"""Dashboard part of issue 10: the creep-model switch, the anti-slip controls, the nonlinear
-histories overlaid on the linear ones, each wheel's creepage path on the creep plot, and the
-required reaction time of the protection in the status area for unstable points.
+"""The nonlinear creep model in the dashboard: the creep-model switch, the anti-slip controls,
+the nonlinear histories overlaid on the linear ones, each wheel's creepage path on the creep plot,
+and the required reaction time of the protection in the status area for unstable points.
 
 The linear closed form stays the fast first answer (the dashboard's fast stage); this view
 starts its own computations after it, on worker threads of its own when served, and shows
@@ -8,10 +8,10 @@ them when ready, if they still belong to what is on screen (a notice says "compu
 meantime; the page never waits).  Bad anti-slip input shows a notice and keeps the last valid
 values and results.
 
-Hooks in :mod:`app.dashboard.dashboard` (marked "issue 10"): ``NonlinearView(dashboard)`` in ``_build``
-(its ``controls``, ``notice`` and ``status`` placed in the layout) and ``on_fast(state)`` at the
-end of ``_apply_fast``.  Computations here take primitives only (``pn.cache`` keys) and return
-plain read-only data, like :mod:`app.results.compute`.
+The dashboard builds ``NonlinearView(dashboard)`` and places its ``controls``, ``notice`` and
+``status`` in its page; it calls ``prefetch(state)`` when the linear first answer is computed
+(served) and ``on_fast(state)`` when that answer is shown.  Computations here take primitives
+only (``pn.cache`` keys) and return plain read-only data, like :mod:`app.results.compute`.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ import panel as pn
 
 from app.results import compute
 from app.results.plots import SeriesSource
-from app.services.thread_pools import NONLINEAR_POOL, SEARCH_POOL, LatestRequest
+from app.services.thread_pools import NONLINEAR_POOL, SEARCH_POOL, LatestRequest, ignore_outcome
 from model.analysis.antislip import required_reaction_time
 from model.analysis.nonlinear import AntiSlip, NonlinearError, nonlinear_response
 from model.analysis.response import ShortCircuit
@@ -260,7 +260,7 @@ class NonlinearView:
         key = self._key(state)
         if key != self._shown_key:
             future = self._histories.submit(nonlinear_histories, *key)
-            future.add_done_callback(lambda f: f.cancelled() or f.exception())  # on_fast reports
+            ignore_outcome(future)  # on_fast shows its result or its error
 
     def on_fast(self, state) -> None:
         """Hook: the dashboard has shown the linear result for ``state``."""
@@ -352,11 +352,10 @@ class NonlinearView:
         if error is not None:
             if not isinstance(error, ValueError | np.linalg.LinAlgError):
                 log.error("nonlinear computation failed", exc_info=error)
-            doc.add_next_tick_callback(partial(self.dash._locked, doc, self._reject, error))
+            self.dash.post(doc, self._reject, error)
             return
         if future.result() is not None:
-            doc.add_next_tick_callback(partial(self.dash._locked, doc, apply, key,
-                                               future.result()))
+            self.dash.post(doc, apply, key, future.result())
 
     def _apply_histories(self, key, histories: NonlinearHistories) -> None:
         if self.creep.value != "nonlinear" or key != self._key():

@@ -1,5 +1,5 @@
 """Which parameter moves what, live: a tornado chart of normalized sensitivities at the
-dashboard's current operating point (issue 12; :mod:`model.analysis.sensitivity`).
+dashboard's current operating point (:mod:`model.analysis.sensitivity`).
 
 Targets (a radio group, CSS class ``ctl-sensitivity-target``):
 
@@ -21,7 +21,7 @@ from __future__ import annotations
 import html
 import logging
 from dataclasses import dataclass
-from functools import lru_cache, partial
+from functools import lru_cache
 
 import numpy as np
 import panel as pn
@@ -29,6 +29,7 @@ from bokeh.models import ColumnDataSource, FactorRange
 from bokeh.plotting import figure
 
 from app.results import compute
+from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest
 from model.analysis.sensitivity import eigen_sensitivities, limit_sensitivity
 
 log = logging.getLogger(__name__)
@@ -102,8 +103,6 @@ class SensitivityView:
     def __init__(self, alive=lambda: True):
         """``alive()``: whether the session still wants results (its requests are dropped once
         it has ended)."""
-        from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest
-
         self.data: SensitivityData | None = None
         self.mode = 1
         self._wanted: tuple | None = None  # key of the newest requested point
@@ -145,10 +144,9 @@ class SensitivityView:
                     f.exception() is None and f.result() is None):
                 return
             if f.exception() is not None:
-                doc.add_next_tick_callback(partial(dashboard._locked, doc, self._failed, key,
-                                                   f.exception()))
+                dashboard.post(doc, self._failed, key, f.exception())
                 return
-            doc.add_next_tick_callback(partial(dashboard._locked, doc, self._apply, f.result()))
+            dashboard.post(doc, self._apply, f.result())
 
         future.add_done_callback(done)
 

@@ -32,7 +32,7 @@ from bokeh.palettes import RdBu10
 
 from app.dashboard.uncertainty_band import BandLayer, UncertaintyBand, band_mismatch, read_band
 from app.results import compute
-from app.results.plots import _figure
+from app.results.plots import new_figure
 from app.services.study_queue import FAILED, WAITING, StudyQueue, StudyTicket, study_queue, wait_until_ended
 from model.mechanics.operating_point import KMH
 
@@ -82,8 +82,8 @@ class StudyMapPlot:
     """Heat map of the largest real part over (v, s0) with s0*(v) on top."""
 
     def __init__(self):
-        self.figure = _figure("Stability map: largest real part [1/s]", "speed v [km/h]",
-                              "creepage s0 [-]")
+        self.figure = new_figure("Stability map: largest real part [1/s]", "speed v [km/h]",
+                                 "creepage s0 [-]")
         self.figure.height = 380
         # an even number of colours on a range symmetric about 0: the blue/red boundary is
         # exactly Re λ = 0 (stable blue, unstable red)
@@ -99,7 +99,8 @@ class StudyMapPlot:
         self.figure.line("v", "s0", source=self.limit, line_color="black", line_width=2,
                          legend_label="s0*(v)")
         self.figure.scatter("v", "s0", source=self.limit, color="black", size=4)
-        self.band = BandLayer(self.figure, name="study-s0-band")  # issue 12: uncertainty band
+        # an uncertainty result's 5–95 % band of s0*(v), drawn when it matches the map
+        self.band = BandLayer(self.figure, name="study-s0-band")
         self.figure.legend.location = "top_right"
 
     def update(self, view: MapView) -> None:
@@ -174,8 +175,6 @@ class StudiesView(pn.viewable.Viewer):
         self.uncertainty_button = pn.widgets.Button(label="Open result",
                                                     css_classes=["study-open-uncertainty"],
                                                     width=120)
-        self.uncertainty_button.on_click(
-            lambda _event: self.open_uncertainty(self.uncertainty_select.value))
         self.band_status = pn.pane.HTML("", css_classes=["study-band-status"],
                                         sizing_mode="stretch_width")
         self.band_notice = pn.pane.Alert("", alert_type="warning", visible=False,
@@ -186,9 +185,15 @@ class StudiesView(pn.viewable.Viewer):
         variant_figure = getattr(getattr(dashboard, "variant_view", None), "limits_figure", None)
         self.variant_band = (BandLayer(variant_figure, name="variant-s0-band")
                              if variant_figure is not None else None)
-        self.start_button.on_click(lambda _event: self.start())
-        self.stop_button.on_click(lambda _event: self.stop())
-        self.open_button.on_click(lambda _event: self.open(self.store_select.value))
+        # a button's callback may run without the session's document lock (Panel runs a click
+        # that arrives while a widget change is pending as a coroutine without it); the plots'
+        # Bokeh sources may only change with the lock: dashboard.run_locked
+        locked = dashboard.run_locked
+        self.start_button.on_click(lambda _event: locked(self.start))
+        self.stop_button.on_click(lambda _event: locked(self.stop))
+        self.open_button.on_click(lambda _event: locked(self.open, self.store_select.value))
+        self.uncertainty_button.on_click(
+            lambda _event: locked(self.open_uncertainty, self.uncertainty_select.value))
         self.refresh_button.on_click(lambda _event: self.refresh_lists())
         self.layout = pn.Column(
             self.notice,
@@ -262,7 +267,7 @@ class StudiesView(pn.viewable.Viewer):
             return
         try:
             study = self.study()
-            parameters = compute.parameters(self.dashboard._params_path, self.dashboard.rail)
+            parameters = compute.parameters(self.dashboard.params_path, self.dashboard.rail)
             ticket = self.queue.submit(self.owner, study, parameters)
         except ValueError as error:  # StudyRefused is a ValueError
             self._reject(str(error.args[0] if error.args else error))
@@ -360,7 +365,7 @@ class StudiesView(pn.viewable.Viewer):
         self.plot.update(view)
         self.check_band()
 
-    # --- the uncertainty band (issue 12) ---------------------------------------------------------
+    # --- the uncertainty band of s0*(v) --------------------------------------------------------
 
     def open_uncertainty(self, name) -> None:
         """Open an uncertainty result of the folder's list; a name not in the list or a bad file
@@ -392,7 +397,7 @@ class StudiesView(pn.viewable.Viewer):
         d = self.dashboard
         # the set's hash with the result's creep law (a different rail is its own reason)
         rail = self.uncertainty.rail if self.uncertainty is not None else d.rail
-        parameters = compute.parameters(d._params_path, rail if rail in compute.RAIL_CONDITIONS
+        parameters = compute.parameters(d.params_path, rail if rail in compute.RAIL_CONDITIONS
                                         else d.rail)
         return parameter_hash(parameters), d.N0 * 1e3, d.b_M, d.rail, "the dashboard's set"
 

@@ -20,7 +20,7 @@ import panel as pn
 from bokeh.models import ColumnDataSource
 
 from app.results import compute
-from app.results.plots import UNSTABLE, _figure
+from app.results.plots import UNSTABLE, new_figure
 from app.results.variants import (
     EDITABLE,
     MAX_UPLOAD_BYTES,
@@ -35,6 +35,7 @@ from app.results.variants import (
     set_hash,
     set_key,
 )
+from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest, ignore_outcome
 from model.mechanics.parameters import SCHEMA, ParameterError
 
 LIMIT_SPEEDS_KMH = (40.0, 80.0, 120.0, 160.0, 200.0)  # speeds of the s0*(v) comparison [km/h]
@@ -111,11 +112,9 @@ class VariantView(pn.viewable.Viewer):
 
     def __init__(self, dashboard, **params):
         super().__init__(**params)
-        from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest
-
         self.dashboard = dashboard
         self._requests = LatestRequest(SIDE_VIEW_POOL, dashboard.alive)
-        self.base_name = dashboard._params_path
+        self.base_name = dashboard.params_path
         self.base = compute.parameters(self.base_name, "calibrated")
         self.inputs: dict[str, pn.widgets.FloatInput] = {}
         cards = []
@@ -134,10 +133,12 @@ class VariantView(pn.viewable.Viewer):
             cards.append(pn.Card(*widgets, title=group, collapsed=index > 0, width=310))
         apply = pn.widgets.Button(label="Apply variant", color="primary",
                                   css_classes=["var-apply"], width=150)
-        apply.on_click(lambda _event: self.apply_inputs())
+        # with the session's document lock: a new variant may clear the s0*(v) sources, and a
+        # button's callback may run without the lock (app/dashboard/studies_view.py says when)
+        apply.on_click(lambda _event: dashboard.run_locked(self.apply_inputs))
         reset = pn.widgets.Button(label="Back to the baseline", css_classes=["var-reset"],
                                   width=150)
-        reset.on_click(lambda _event: self.set_changes({}))
+        reset.on_click(lambda _event: dashboard.run_locked(self.set_changes, {}))
         self.upload = pn.widgets.FileInput(accept=".toml", css_classes=["var-upload"],
                                            multiple=False)
         self.upload.param.watch(self._on_upload, "value")
@@ -153,8 +154,8 @@ class VariantView(pn.viewable.Viewer):
                                   css_classes=["variant-comparison"],
                                   stylesheets=[".changed {background: #fff3b0; "
                                                "font-weight: 700}"])
-        self.limits_figure = _figure("Stability limit s0*(v): baseline and variant",
-                                     "speed v [km/h]", "s0* [-]")
+        self.limits_figure = new_figure("Stability limit s0*(v): baseline and variant",
+                                        "speed v [km/h]", "s0* [-]")
         self.limits_figure.name = "variant-limits"
         self.limit_sources = {}
         for label, color, dash in (("baseline", "#555555", "solid"),
@@ -200,7 +201,7 @@ class VariantView(pn.viewable.Viewer):
         except (VariantError, ParameterError) as error:
             self.dashboard.warn(f"Variant not applied (previous one kept): {error}")
             return False
-        self.dashboard.input_notice.visible = False
+        self.dashboard.clear_warning()
         self.dashboard.variant = encode(changes)
         return True
 
@@ -283,11 +284,9 @@ class VariantView(pn.viewable.Viewer):
         if doc is None or doc.session_context is None:
             self._show(state, self._compute(state, base_key))
             return
-        from app.dashboard.dashboard import _ignore_outcome
-
         self.table.object = "<i>⏳ comparing with the baseline…</i>"
         future = self._requests.submit(self._compute_if_current, state, base_key)
-        _ignore_outcome(future)
+        ignore_outcome(future)
         future.add_done_callback(partial(self._done, doc, state))
 
     @staticmethod
@@ -311,7 +310,7 @@ class VariantView(pn.viewable.Viewer):
                 self.dashboard.warn(f"Comparison failed: {error}")
             elif self.dashboard.state() == state:
                 self._show(state, future.result())
-        self.dashboard._post(doc, show)
+        self.dashboard.post(doc, show)
 
     def _show(self, state, sides: tuple[Side, Side]) -> None:
         self.comparison = sides

@@ -8,8 +8,10 @@ crossings, the code version and the date.  The figures are the dashboard's own
 (:mod:`app.results.plots`, :mod:`app.results.eigenvalue_sweep`), fed with the same cached
 results (:mod:`app.results.compute`).
 
-``bogie report --s0 … --v … --out report.html`` (:mod:`app.cli.report`) writes the same file
-as the dashboard's "report (HTML)" button.
+:func:`build_report` runs four stages: the results (:func:`report_results`), the figures
+(:func:`report_figures`), their embedding (:mod:`app.report.embedding`) and the page with its
+tables (:func:`report_page`).  ``bogie report --s0 … --v … --out report.html``
+(:mod:`app.cli.report`) writes the same file as the dashboard's "report (HTML)" button.
 """
 
 from __future__ import annotations
@@ -17,19 +19,17 @@ from __future__ import annotations
 import datetime
 import html
 import subprocess
+from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 
-from bokeh.document import Document
-from bokeh.embed import components
-from bokeh.embed.bundle import bundle_for_objs_and_resources
-from bokeh.io.doc import patch_curdoc
 from bokeh.layouts import column, row
-from bokeh.resources import INLINE
 
+from app.report.embedding import EmbeddedFigures, embed_inline
 from app.results import compute
 from app.results.eigenvalue_sweep import Fig6Plot
 from app.results.plots import CreepPlot, ResponsePlots, RootLocusPlot
+from app.results.tables import eigen_table_html, mode_table_html, peaks_html
 from app.results.variants import differences, parameters_of_key, set_hash, split_key
 from model.mechanics.parameters import SCHEMA
 
@@ -61,49 +61,69 @@ def code_version() -> str:
     return version
 
 
-def _table(rows: list[tuple[str, str]]) -> str:
-    return ('<table class="bogie">' + "".join(
-        f'<tr><td class="text">{html.escape(a)}</td><td class="text">{b}</td></tr>'
-        for a, b in rows) + "</table>")
+@dataclass(frozen=True)
+class ReportCase:
+    """What a report is made for, in the units of :mod:`app.results.compute`."""
+
+    set_key: str  # the parameter set: a bundled file or a variant of it (app.results.variants)
+    rail: str  # rail condition (creep law)
+    s0: float  # creepage [-]
+    v_kmh: float  # speed [km/h]
+    N0_kN: float  # static wheel force [kN]
+    b_M: float  # motor slope [N m s/rad]
+    M0_kNm: float  # short-circuit amplitude [kN m]
+    f: float  # short-circuit frequency [Hz]
+    D: float  # short-circuit decay [-]
+    dt_ms: float | None  # short-circuit time shift [ms] (None: continuous motor torque)
+    t_end: float  # simulated time [s]
+
+    @property
+    def point(self) -> tuple:
+        """The operating point's arguments of :mod:`app.results.compute`."""
+        return (self.set_key, self.rail, self.s0, self.v_kmh, self.N0_kN, self.b_M)
 
 
-def build_report(set_key: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
-                 M0_kNm: float, f: float, D: float, dt_ms: float | None, t_end: float,
-                 progress=None, now: datetime.datetime | None = None) -> str:
-    """The report as one HTML text.  Arguments as in :mod:`app.results.compute` (``set_key``: the
-    parameter set, a bundled file or a variant of it, :mod:`app.results.variants`)."""
-    from app.results.tables import eigen_table_html, mode_table_html, peaks_html
+@dataclass(frozen=True)
+class ReportResults:
+    """The results a report shows (cached, plain data)."""
 
-    say = progress or (lambda _text: None)
-    point_args = (set_key, rail, s0, v_kmh, N0_kN, b_M)
+    point: compute.PointResult
+    response: compute.ResponseView
+    locus: compute.LocusResult  # the dense root locus over s0 at the case's speed
+    limit: compute.LimitResult
+
+
+def report_results(case: ReportCase, say=lambda _text: None) -> ReportResults:
+    """Compute (or take from the cache) what the report shows; ``say(text)`` names each step."""
     say("eigenvalues and modes")
-    point = compute.point_result(*point_args)
+    point = compute.point_result(*case.point)
     say("short-circuit response")
-    response = compute.response_result(*point_args, M0_kNm, f, D, dt_ms, t_end)
+    response = compute.response_result(*case.point, case.M0_kNm, case.f, case.D, case.dt_ms,
+                                       case.t_end)
     say("root locus (dense sweep over s0)")
-    locus = compute.dense_locus_result(set_key, rail, "s0", v_kmh, N0_kN, b_M)
+    locus = compute.dense_locus_result(case.set_key, case.rail, "s0", case.v_kmh, case.N0_kN,
+                                       case.b_M)
     say("stability limit s0*(v)")
-    limit = compute.limit_result(set_key, rail, v_kmh, N0_kN, b_M)
-    say("writing the report")
+    limit = compute.limit_result(case.set_key, case.rail, case.v_kmh, case.N0_kN, case.b_M)
+    return ReportResults(point, response, locus, limit)
 
-    base_name, changes = split_key(set_key)
-    parameters = parameters_of_key(set_key)
-    diff = differences(parameters_of_key(base_name), parameters)
-    now = now or datetime.datetime.now(datetime.UTC)
 
+def report_figures(results: ReportResults) -> dict:
+    """The dashboard's figures fed with the results: name -> Bokeh model (``locus``, ``fig6``,
+    ``creep``, ``response``)."""
     locus_plot = RootLocusPlot()
-    locus_plot.update_locus(locus)
-    locus_plot.update_point(point)
+    locus_plot.update_locus(results.locus)
+    locus_plot.update_point(results.point)
     locus_plot.zoom(False)
     fig6 = Fig6Plot()
-    fig6.update_locus(locus)
-    fig6.update_limit(limit.s0_limit)
+    fig6.update_locus(results.locus)
+    fig6.update_limit(results.limit.s0_limit)
     creep = CreepPlot()
-    creep.update_point(point)
-    creep.update_limit(limit)
+    creep.update_point(results.point)
+    creep.update_limit(results.limit)
     responses = ResponsePlots()
-    responses.update(response)
-    figures = {
+    responses.update(results.response)
+    return {
         "locus": locus_plot.figure,
         "fig6": column(row(*fig6.figures[:2], sizing_mode="stretch_width"), fig6.figures[2],
                        sizing_mode="stretch_width"),
@@ -112,73 +132,106 @@ def build_report(set_key: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
                            row(*responses.figures[2:], sizing_mode="stretch_width"),
                            sizing_mode="stretch_width"),
     }
-    # bokeh's embedding asks curdoc() for its settings; in a served callback that can be another
-    # session's document (bokeh keeps one global stack of patched documents for all threads),
-    # destroyed by the time it is read: give it a fresh one of its own
-    fresh = Document()
-    with patch_curdoc(fresh):
-        script, divs = components(figures)
-    # only what these figures need, inline: BokehJS and its styles as text.  Files to load
-    # (``bundle.js_files``: Panel adds its module shim to every bundle once imported) are left
-    # out: they would be fetched from a server, and plain Bokeh figures do not use them
-    bundle = bundle_for_objs_and_resources(list(figures.values()), INLINE)
-    inline_resources = "\n".join([*(f"<style>{css}</style>" for css in bundle.css_raw),
-                                   *(f"<script>{js}</script>" for js in bundle.js_raw)])
 
-    verdict = "STABLE" if point.stable else "UNSTABLE"
+
+# --- the page's tables ---------------------------------------------------------------------------
+
+def _table(rows: list[tuple[str, str]]) -> str:
+    return ('<table class="bogie">' + "".join(
+        f'<tr><td class="text">{html.escape(a)}</td><td class="text">{b}</td></tr>'
+        for a, b in rows) + "</table>")
+
+
+def operating_table(case: ReportCase) -> str:
+    """The operating point and the excitation, in SI units (N, N m, s)."""
+    return _table([
+        ("creepage s0 [-]", f"{case.s0:g}"), ("speed v [km/h]", f"{case.v_kmh:g}"),
+        ("static wheel force N0 [N]", f"{case.N0_kN * 1e3:g}"),
+        ("motor slope b_M [N m s/rad]", f"{case.b_M:g}"), ("rail condition (creep law)", case.rail),
+        ("short circuit M0 [N m]", f"{case.M0_kNm * 1e3:g}"), ("frequency f [Hz]", f"{case.f:g}"),
+        ("decay D [-]", f"{case.D:g}"),
+        ("time shift Δt [s]", "automatic (continuous motor torque)" if case.dt_ms is None
+         else f"{case.dt_ms * 1e-3:g}"),
+        ("simulated time [s]", f"{case.t_end:g}")])
+
+
+def stability_table(case: ReportCase, results: ReportResults) -> str:
+    """The status numbers, s0*(v) and the margin to it, the adhesion limit."""
+    point, limit = results.point, results.limit
     if limit.s0_limit is None:
         limit_text = f"none ({html.escape(limit.message)})"
     else:
-        margin = limit.s0_limit - s0
+        margin = limit.s0_limit - case.s0
         limit_text = (f"{limit.s0_limit:.5f} (margin s0* − s0 = {margin:+.5f}, "
                       f"{margin / limit.s0_limit:+.0%})")
-    operating = _table([
-        ("creepage s0 [-]", f"{s0:g}"), ("speed v [km/h]", f"{v_kmh:g}"),
-        ("static wheel force N0 [N]", f"{N0_kN * 1e3:g}"),
-        ("motor slope b_M [N m s/rad]", f"{b_M:g}"), ("rail condition (creep law)", rail),
-        ("short circuit M0 [N m]", f"{M0_kNm * 1e3:g}"), ("frequency f [Hz]", f"{f:g}"),
-        ("decay D [-]", f"{D:g}"),
-        ("time shift Δt [s]", "automatic (continuous motor torque)" if dt_ms is None
-         else f"{dt_ms * 1e-3:g}"),
-        ("simulated time [s]", f"{t_end:g}")])
-    status = _table([
+    return _table([
         ("largest Re λ [1/s]", f"{point.max_real_part:+.4f}"),
         ("flutter pairs (Re > 0)", str(point.flutter)),
         ("divergent real eigenvalues", str(point.divergence)),
-        (f"s0*({v_kmh:g} km/h) [-]", limit_text),
+        (f"s0*({case.v_kmh:g} km/h) [-]", limit_text),
         ("μ(s0), μ_max", f"{point.mu0:.4f}, {point.mu_max:.4f} at s = {point.s_max:.4f}"),
         ("M_ad = 2 N0 r0 μ_max [N m]", f"{point.M_ad:,.0f}")])
-    if diff:
-        diff_html = ('<table class="bogie"><tr><th class="text">parameter</th><th>baseline</th>'
-                     "<th>this set</th><th class='text'>unit</th></tr>" + "".join(
-                         f'<tr><td class="text">{html.escape(n)}</td><td>{a:.6g}</td>'
-                         f"<td><b>{b:.6g}</b></td><td class='text'>{html.escape(SCHEMA[n][0])}</td></tr>"
-                         for n, (a, b) in diff.items()) + "</table>")
-    else:
-        diff_html = "<p>none: the bundled set itself</p>"
+
+
+def differences_table(diff: dict[str, tuple[float, float]]) -> str:
+    """The parameters that differ from the bundled baseline (name -> (baseline, this set), SI)."""
+    if not diff:
+        return "<p>none: the bundled set itself</p>"
+    return ('<table class="bogie"><tr><th class="text">parameter</th><th>baseline</th>'
+            "<th>this set</th><th class='text'>unit</th></tr>" + "".join(
+                f'<tr><td class="text">{html.escape(n)}</td><td>{a:.6g}</td>'
+                f"<td><b>{b:.6g}</b></td><td class='text'>{html.escape(SCHEMA[n][0])}</td></tr>"
+                for n, (a, b) in diff.items()) + "</table>")
+
+
+# --- the page --------------------------------------------------------------------------------------
+
+def report_page(case: ReportCase, results: ReportResults, figures: EmbeddedFigures,
+                now: datetime.datetime) -> str:
+    """The report as one HTML text: the tables of ``results``, the embedded ``figures``."""
+    base_name, changes = split_key(case.set_key)
+    parameters = parameters_of_key(case.set_key)
+    diff = differences(parameters_of_key(base_name), parameters)
+    point, divs = results.point, figures.divs
+    verdict = "STABLE" if point.stable else "UNSTABLE"
     name = html.escape(base_name or "calibrated (bundled: assets/parameters/calibrated.toml)")
+    s0, v_kmh = case.s0, case.v_kmh
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <title>Bogie drive dynamics — report: {verdict} at s0 = {s0:g}, v = {v_kmh:g} km/h</title>
-{inline_resources}
+{figures.resources}
 <style>{STYLE}</style>
 </head><body>
 <h1>Bogie drive dynamics — design-review report</h1>
 <p class="sub">{now:%Y-%m-%d %H:%M} UTC · code {html.escape(code_version())} ·
 parameter set {name}{' (variant)' if changes else ''}, hash <code>{set_hash(parameters)}</code></p>
 <p><span class="verdict {'ok' if point.stable else 'bad'}">{verdict}</span></p>
-<div class="cols"><div><h2>Operating point and excitation</h2>{operating}</div>
-<div><h2>Stability</h2>{status}</div>
-<div><h2>Differences from the baseline</h2>{diff_html}</div></div>
-<h2>Root locus over s0 at {v_kmh:g} km/h ({len(locus.values)} points)</h2>{divs['locus']}
+<div class="cols"><div><h2>Operating point and excitation</h2>{operating_table(case)}</div>
+<div><h2>Stability</h2>{stability_table(case, results)}</div>
+<div><h2>Differences from the baseline</h2>{differences_table(diff)}</div></div>
+<h2>Root locus over s0 at {v_kmh:g} km/h ({len(results.locus.values)} points)</h2>{divs['locus']}
 <h2>Fig. 6: eigenvalues against s0</h2>{divs['fig6']}
 <div class="cols"><div>{eigen_table_html(point)}</div><div>{mode_table_html(point)}</div></div>
 <h2>Short-circuit response</h2>
-<div class="cols"><div>{divs['creep']}</div><div>{peaks_html(response)}</div></div>
+<div class="cols"><div>{divs['creep']}</div><div>{peaks_html(results.response)}</div></div>
 {divs['response']}
 <p class="sub">Time histories min/max-decimated for plotting (every extreme kept); the peaks are
 from the full 10 kHz history.  Generated by the dashboard's report button or
 <code>bogie report</code>.</p>
-{script}
+{figures.script}
 </body></html>
 """
+
+
+def build_report(set_key: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
+                 M0_kNm: float, f: float, D: float, dt_ms: float | None, t_end: float,
+                 progress=None, now: datetime.datetime | None = None) -> str:
+    """The report as one HTML text.  Arguments as in :mod:`app.results.compute` (``set_key``: the
+    parameter set, a bundled file or a variant of it, :mod:`app.results.variants`); ``progress``:
+    called with the name of each step; ``now``: the date shown (default: now, UTC)."""
+    case = ReportCase(set_key, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, t_end)
+    say = progress or (lambda _text: None)
+    results = report_results(case, say)
+    say("writing the report")
+    now = now or datetime.datetime.now(datetime.UTC)
+    return report_page(case, results, embed_inline(report_figures(results)), now)

@@ -17,7 +17,7 @@ from bokeh.models import ColumnDataSource, Label, Span
 from bokeh.palettes import Category10_10
 
 from app.results.compute import LocusResult, broken_columns
-from app.results.plots import UNSTABLE, _figure
+from app.results.plots import UNSTABLE, new_figure
 
 FIG6_MAX_DAMPING = 0.3  # complex branches shown: damping ratio below this somewhere on the sweep
 REAL_TOL = 1e-9  # |Im λ| below this [1/s]: a real eigenvalue
@@ -82,8 +82,8 @@ class Fig6Plot:
         self.figures = []
         shared_x = None
         for name, title, y_label in specs:
-            fig = _figure(title, "creepage s0 [-]", y_label,
-                          **({"x_range": shared_x} if shared_x else {}))
+            fig = new_figure(title, "creepage s0 [-]", y_label,
+                             **({"x_range": shared_x} if shared_x else {}))
             shared_x = shared_x or fig.x_range
             fig.name = name
             fig.height = 300

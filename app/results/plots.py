@@ -41,7 +41,10 @@ STABLE = "#1e8449"
 TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
 
-def _figure(title: str, x_label: str, y_label: str, **kwargs):
+def new_figure(title: str, x_label: str, y_label: str, **kwargs):
+    """A Bokeh figure in the style every view shares: pan/zoom/reset/save tools, the page's
+    width, 320 px high, no Bokeh logo (axis labels with their units; keyword arguments as for
+    :func:`bokeh.plotting.figure`)."""
     fig = figure(title=title, tools=TOOLS, sizing_mode="stretch_width", height=320,
                  x_axis_label=x_label, y_axis_label=y_label, **kwargs)
     fig.toolbar.logo = None
@@ -100,8 +103,8 @@ class RootLocusPlot:
     current point's eigenvalues highlighted, the unstable half-plane shaded."""
 
     def __init__(self):
-        self.figure = _figure("Root locus", "Re λ [1/s]", "Im λ [Hz]",
-                              x_range=Range1d(-6.0, 2.5), y_range=Range1d(0.0, 14.0))
+        self.figure = new_figure("Root locus", "Re λ [1/s]", "Im λ [Hz]",
+                                 x_range=Range1d(-6.0, 2.5), y_range=Range1d(0.0, 14.0))
         self.figure.name = "root-locus"
         fig = self.figure
         fig.add_layout(BoxAnnotation(left=0.0, fill_color=UNSTABLE, fill_alpha=0.08,
@@ -184,8 +187,8 @@ class CreepPlot:
     """μ(s) at the current speed with the operating point, the maximum and s0* marked."""
 
     def __init__(self):
-        self.figure = _figure("Creep characteristic μ(s) at the current speed", "creepage s [-]",
-                              "adhesion coefficient μ [-]")
+        self.figure = new_figure("Creep characteristic μ(s) at the current speed", "creepage s [-]",
+                                 "adhesion coefficient μ [-]")
         fig = self.figure
         self.curve = ColumnDataSource({"s": [], "mu": []})
         self.point = ColumnDataSource({"s": [], "mu": []})
@@ -232,8 +235,8 @@ class ResponsePlots:
         self.ad_spans = []
         shared_x = None
         for drive in ("ID1", "ID2"):
-            fig = _figure(f"{drive}: torques", "t [s]", "torque [N m]",
-                          **({"x_range": shared_x} if shared_x else {}))
+            fig = new_figure(f"{drive}: torques", "t [s]", "torque [N m]",
+                             **({"x_range": shared_x} if shared_x else {}))
             shared_x = shared_x or fig.x_range
             for quantity, color in zip(TORQUES, ("#1f77b4", "#d62728"), strict=True):
                 label = {"driving_shaft.torque": "driving shaft M_DS",
@@ -248,8 +251,8 @@ class ResponsePlots:
             fig.legend.click_policy = "hide"
             fig.legend.label_text_font_size = "10px"
             self.torque[drive] = fig
-        self.forces = _figure("Disc clutch forces (ID1 —, ID2 - -)", "t [s]",
-                              "force [N]", x_range=shared_x)
+        self.forces = new_figure("Disc clutch forces (ID1 —, ID2 - -)", "t [s]",
+                                 "force [N]", x_range=shared_x)
         for quantity, color in zip(FORCES, Category10_10[2:5], strict=True):
             axis = quantity[-1]
             self.sources.line(self.forces, f"ID1.{quantity}", color=color,
@@ -258,8 +261,8 @@ class ResponsePlots:
                               legend_label=f"F_{axis} ID2")
         self.forces.legend.click_policy = "hide"
         self.forces.legend.label_text_font_size = "10px"
-        self.excitation = _figure("Short-circuit torque M_C(t) on ID1's rotor", "t [s]",
-                                  "M_C [N m]", x_range=shared_x)
+        self.excitation = new_figure("Short-circuit torque M_C(t) on ID1's rotor", "t [s]",
+                                     "M_C [N m]", x_range=shared_x)
         self.sources.line(self.excitation, "M_C", color="black")
         self.ad_label = Label(x=60, y=5, x_units="screen", y_units="screen", text="",
                               text_font_size="10px")
@@ -312,8 +315,8 @@ class ModeShapePlot:
         self.segments = drawing_segments(positions)
         self.views = {}
         for name, (a, b), label in (("side", (0, 2), "z [m]"), ("top", (0, 1), "y [m]")):
-            fig = _figure(f"{'Side' if name == 'side' else 'Top'} view", "x [m]", label,
-                          match_aspect=True)
+            fig = new_figure(f"{'Side' if name == 'side' else 'Top'} view", "x [m]", label,
+                             match_aspect=True)
             fig.height = 300
             base = ColumnDataSource(self._lines(np.zeros(3), a, b, {}))
             moved = ColumnDataSource(self._lines(np.zeros(3), a, b, {}))

@@ -42,6 +42,12 @@ NONLINEAR_POOL = prioritized_pool(1, FOLLOW_UP, "bogie-nonlinear")
 SEARCH_POOL = prioritized_pool(1, SEARCH, "bogie-reaction")
 
 
+def ignore_outcome(future) -> None:
+    """Retrieve ``future``'s outcome (a concurrent or an asyncio future) when it ends, for a
+    computation whose result is no longer shown: no "exception was never retrieved" warning for a
+    rejected, superseded parameter set."""
+    future.add_done_callback(lambda f: f.cancelled() or f.exception())
+
 
 class LatestRequest:
     """One view's requests of one session on a shared pool: at most one waits in the pool's queue.
