@@ -29,6 +29,7 @@ from __future__ import annotations
 import errno
 import json
 import os
+import re
 import socket
 import stat
 import statistics
@@ -202,7 +203,7 @@ def _status(page) -> str:
     return page.evaluate(STATUS)
 
 
-def _wait_status(page, prefix: str, timeout_ms: float = 240_000) -> None:
+def _wait_status(page, prefix: str, timeout_ms: float = 600_000) -> None:
     page.wait_for_function(f"() => ({STATUS})().startsWith({json.dumps(prefix)})",
                            timeout=timeout_ms)
 
@@ -274,9 +275,11 @@ def test_no_browser_input_makes_the_server_connect(setup, chromium, request):
                 page.locator(f".{button} button").click()
             page.wait_for_timeout(200)
         # a real study on the server's engine, started with the address in every input
+        page.evaluate(SET_EVERY_INPUT, payloads[0])
+        page.wait_for_timeout(1000)  # the refused values are processed before the valid ones
         _fill(page, "study-s0-points", "3")
         _fill(page, "study-v-points", "2")
-        page.evaluate(SET_EVERY_INPUT, payloads[0])
+        page.wait_for_timeout(500)
         page.locator(".study-start button").click()
         _wait_status(page, "done: 2/2")
         page.wait_for_timeout(1000)
@@ -337,8 +340,10 @@ def test_names_outside_the_list_reveal_nothing(setup, chromium):
         _tab(page, "Studies")
         page.wait_for_function("""() => [...Bokeh.documents[0].all_models]
           .some(m => (m.css_classes || []).includes('study-store'))""", timeout=60_000)
-        assert sorted(page.evaluate("""() => [...Bokeh.documents[0].all_models]
-          .find(m => (m.css_classes || []).includes('study-store')).options""")) == ["good.zarr"]
+        listed = page.evaluate("""() => [...Bokeh.documents[0].all_models]
+          .find(m => (m.css_classes || []).includes('study-store')).options""")
+        assert "good.zarr" in listed  # (with the maps the other tests made)
+        assert not {"linkdir.zarr", "holed.zarr"} & set(listed)
         for select, button, reset in (("study-store", "study-open", "good.zarr"),
                                       ("study-uncertainty", "study-open-uncertainty",
                                        "good.json")):
@@ -398,6 +403,14 @@ def test_names_given_straight_to_the_view_are_refused_alike(tmp_path):
 
 # --- bounded study work ------------------------------------------------------------------------------
 
+def _running_unfinished(status: str) -> bool:
+    """A status line of a running study that still has lines to do ("running: 3/24 …"); a page
+    refreshes its line every 0.5 s, so the study that just finished may still read "running:
+    24/24" while the next one has started."""
+    match = re.match(r"running: (\d+)/(\d+)", status)
+    return match is not None and int(match.group(1)) < int(match.group(2))
+
+
 def test_five_sessions_queue_with_one_running(setup, chromium):
     pages = [_page(chromium, setup["url"]) for _ in range(5)]
     try:
@@ -420,7 +433,7 @@ def test_five_sessions_queue_with_one_running(setup, chromium):
         deadline = time.monotonic() + 600
         while len(done_at) < len(pages) and time.monotonic() < deadline:
             texts = [_status(page) for page in pages]
-            most_running = max(most_running, sum(t.startswith("running") for t in texts))
+            most_running = max(most_running, sum(_running_unfinished(t) for t in texts))
             most_processes = max(most_processes, 1 + len(descendants(setup["pid"])))
             for index, text in enumerate(texts):
                 if text.startswith("done") and index not in done_at:
