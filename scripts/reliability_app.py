@@ -22,7 +22,7 @@ Bokeh's protocol client (``bokeh.client``: the same messages a browser sends, no
    session must leave it working (a valid change afterwards still gives new results) and the
    server alive (liveness 200).
 
-The functions are also used by ``tests/test_app_reliability.py`` with short settings.
+The functions are also used by ``tests/app/server/test_reliability.py`` with short settings.
 """
 
 from __future__ import annotations

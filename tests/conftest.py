@@ -26,6 +26,7 @@ from pathlib import Path
 import pytest
 
 CHROMIUM = Path("/usr/bin/chromium")
+ROOT = Path(__file__).resolve().parent.parent  # the project
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -204,6 +205,56 @@ def install_study_queue(folder: Path, engine_factory=InProcessEngine, **settings
         queue.close()
 
     return queue, restore
+
+
+# --- shared test data and checks ------------------------------------------------------------------
+
+SPEEDS = (40.0, 120.0, 200.0)  # speeds of the small uncertainty results [km/h]
+
+
+def uncertainty_result_file(path: Path, parameters, method="posterior", names=None, seed=3) -> Path:
+    """A small uncertainty result of ``parameters`` written by the model's own
+    ``UncertaintyResult.as_dict`` (the band's logic needs its provenance and percentiles, not a
+    model run; a real CLI run is in the posterior tests)."""
+    import json
+
+    import numpy as np
+
+    from model.mechanics.parameters import parameter_hash
+    from model.studies.uncertainty import (
+        UNCERTAIN_PARAMETERS,
+        UncertaintyResult,
+        output_names,
+        output_units,
+    )
+
+    names = tuple(p.name for p in UNCERTAIN_PARAMETERS) if names is None else names
+    outputs = output_names(SPEEDS)
+    rng = np.random.default_rng(seed)
+    n = 8
+    values = rng.uniform(0.5, 1.5, (n, len(outputs)))
+    values[:, :len(SPEEDS)] *= np.array([0.012, 0.0082, 0.006])  # s0* [-]
+    blank = np.full((len(outputs), len(names)), np.nan)
+    result = UncertaintyResult(names, tuple((1.0, 2.0) for _ in names), outputs,
+                               output_units(SPEEDS), n, n, rng.uniform(1, 2, (n, len(names))),
+                               values, blank, blank, np.array([blank, blank]),
+                               np.array([blank, blank]), seed, values.mean(axis=0),
+                               method=method, indices=False, speeds_kmh=SPEEDS,
+                               parameters_hash=parameter_hash(parameters),
+                               wheel_force=parameters["wheel_force"],
+                               motor_slope=parameters["motor_slope"])
+    path.write_text(json.dumps(result.as_dict(), allow_nan=False), encoding="utf-8")
+    return path
+
+
+def assert_self_contained_html(text: str) -> None:
+    """An HTML page that opens offline: no external script, stylesheet or image; BokehJS inline."""
+    import re
+
+    assert re.search(r"<script[^>]*\bsrc=", text) is None
+    assert re.search(r"<link\b", text) is None
+    assert re.search(r"<img[^>]*\bsrc=[\"']?https?:", text) is None
+    assert "Bokeh" in text  # BokehJS itself is inline
 
 
 # --- golden files (tests/golden/*.json) ------------------------------------------------------------

@@ -12,7 +12,7 @@ inverse-trace identities); a point failing the checks is solved by a full eigen-
 becomes the new anchor (counted in ``LineResult.fallbacks``).  s0* is found by Brent's method on
 the same continuation.  Against a full eigen-analysis at every point of 100-point lines at 40,
 120 and 250 km/h: all eigenvalues within 6.5·10⁻⁹ relative, the counts identical
-(``scripts/bench_study.py --check-lines``, tests/test_continuation.py).
+(``scripts/bench_study.py --check-lines``, tests/model/analysis/test_continuation.py).
 
 The reduced method, :func:`reduced_s0_line` (method "reduced", the default: it is
 cheaper, see BENCHMARKS.md), reuses one Galerkin-reduced model (:class:`model.analysis.locus._Reduced`)

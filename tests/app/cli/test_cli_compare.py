@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 
 import pytest
+from conftest import assert_self_contained_html
 from test_cli import run  # the in-process CLI runner (tests/ is on sys.path under pytest)
 
 from model.mechanics.parameters import CALIBRATED_FILE, load_parameters, save_parameters
@@ -86,14 +87,13 @@ def test_bad_input_is_one_line_and_exit_2(args, capsys):
 
 @pytest.mark.slow
 def test_report_command_writes_a_self_contained_file(tmp_path, capsys):
-    from test_app_review import _assert_self_contained
 
     out = tmp_path / "report.html"
     code, stdout, err = run(["report", "--s0", "0.005", "--v", "120", "--t-end", "0.3",
                              "--variant", "yaw_damping:1e5", "--out", str(out)], capsys)
     assert code == 0, err
     text = out.read_text()
-    _assert_self_contained(text)
+    assert_self_contained_html(text)
     assert "yaw_damping" in text
     assert str(out) in stdout
 

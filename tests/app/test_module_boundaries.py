@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]  # the project (tests/app/)
 APP_MODULES = sorted((ROOT / "app").rglob("*.py"))
 # private names of other libraries that a module uses on purpose: (module, name) -> why
 THIRD_PARTY = {

@@ -14,11 +14,9 @@ These are not literature tests: they guard against unintended changes, at tight 
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
-from conftest import golden_parameters, load_golden
+from conftest import ROOT, golden_parameters, load_golden
 from scipy.optimize import linear_sum_assignment
 
 from model import (
@@ -31,7 +29,7 @@ from model import (
 )
 from model.mechanics.operating_point import KMH, OperatingPoint
 
-GOLDEN_FILE = Path(__file__).resolve().parent / "golden" / "calibrated.json"
+GOLDEN_FILE = ROOT / "tests" / "golden" / "calibrated.json"
 REGENERATE = "regenerate with: .venv/bin/python scripts/make_golden.py"
 
 # Eigenvalue tolerance |Δλ| <= RTOL |λ| + ATOL.  RTOL = 1e-8 is the requested tightness.  ATOL:

@@ -14,14 +14,13 @@ at worst, docs/response.md), and 0.5 s of the nonlinear response does not amplif
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import pytest
-from conftest import golden_parameters, load_golden
+from conftest import ROOT, golden_parameters, load_golden
 
 from model import build_model
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = ROOT
 GOLDEN_FILE = ROOT / "tests" / "golden" / "nonlinear.json"
 REGENERATE = "regenerate with: .venv/bin/python scripts/make_golden_nonlinear.py"
 RTOL = 1e-7

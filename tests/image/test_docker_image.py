@@ -22,10 +22,11 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
+from conftest import ROOT
 
 pytestmark = [pytest.mark.slow, pytest.mark.docker]
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = ROOT
 SCRIPT = ROOT / "scripts" / "build_image.sh"
 IMAGE = "localhost/bogie:test"
 

@@ -2,7 +2,7 @@
 
 The result files are written by the model's own :meth:`UncertaintyResult.as_dict` (a small
 result assembled from plain arrays: the band's logic needs the provenance and the percentiles,
-not a model run; a real CLI run is in tests/test_posterior.py).  Checked: a result of the set
+not a model run; a real CLI run is in tests/model/studies/test_posterior.py).  Checked: a result of the set
 and conditions on screen draws its 5–95 % band and median at its speeds, with the method and
 sample count in the legend; a different wheel force, motor slope, rail condition or parameter
 set clears the band and the notice says which; a result without provenance (the older format:
@@ -13,13 +13,12 @@ map on screen the map's set and conditions count.
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import param
 import pytest
 from bokeh.document import Document
-from conftest import install_study_queue
+from conftest import ROOT, SPEEDS, install_study_queue, uncertainty_result_file
 
 from app.dashboard.dashboard import BogieDashboard
 from app.dashboard.studies_view import MapView
@@ -27,30 +26,8 @@ from app.dashboard.uncertainty_band import band_mismatch, read_band
 from app.results import compute
 from app.services.studies_folder import refusal
 from model.mechanics.parameters import parameter_hash
-from model.studies.uncertainty import UNCERTAIN_PARAMETERS, UncertaintyResult, output_names, output_units
 
-SPEEDS = (40.0, 120.0, 200.0)
 B_M = compute.parameters("", "calibrated")["motor_slope"]  # the set's b_M [N m s/rad]
-
-
-def _result_file(path: Path, parameters, method="posterior", names=None, seed=3) -> Path:
-    names = tuple(p.name for p in UNCERTAIN_PARAMETERS) if names is None else names
-    outputs = output_names(SPEEDS)
-    rng = np.random.default_rng(seed)
-    n = 8
-    values = rng.uniform(0.5, 1.5, (n, len(outputs)))
-    values[:, :len(SPEEDS)] *= np.array([0.012, 0.0082, 0.006])  # s0* [-]
-    blank = np.full((len(outputs), len(names)), np.nan)
-    result = UncertaintyResult(names, tuple((1.0, 2.0) for _ in names), outputs,
-                               output_units(SPEEDS), n, n, rng.uniform(1, 2, (n, len(names))),
-                               values, blank, blank, np.array([blank, blank]),
-                               np.array([blank, blank]), seed, values.mean(axis=0),
-                               method=method, indices=False, speeds_kmh=SPEEDS,
-                               parameters_hash=parameter_hash(parameters),
-                               wheel_force=parameters["wheel_force"],
-                               motor_slope=parameters["motor_slope"])
-    path.write_text(json.dumps(result.as_dict(), allow_nan=False), encoding="utf-8")
-    return path
 
 
 @pytest.fixture(scope="module")
@@ -65,7 +42,7 @@ def dash(tmp_path_factory):
 
 def _in_folder(view, name: str, parameters, **kwargs) -> str:
     """Write a result into the server's studies folder; its name (what a reviewer picks)."""
-    _result_file(view.queue.folder.root / name, parameters, **kwargs)
+    uncertainty_result_file(view.queue.folder.root / name, parameters, **kwargs)
     return name
 
 
@@ -153,7 +130,7 @@ def test_other_parameter_set_and_old_format_are_not_drawn(view):
     assert "parameter set: result" in view.band_notice.object
     assert "re-calibrated" in view.band_notice.object
     # a result written before studies recorded their set: the stored study without its hash
-    stored = json.loads((Path(__file__).resolve().parent.parent / "assets" / "data"
+    stored = json.loads((ROOT / "assets" / "data"
                          / "uncertainty_n16.json").read_text(encoding="utf-8"))
     stored.pop("parameters_hash")
     stored.pop("conditions", None)
@@ -201,7 +178,7 @@ def test_the_map_on_screen_decides(view):
 def test_band_mismatch_without_sampled_motor_slope(tmp_path):
     parameters = compute.parameters("", "calibrated")
     names = ("creep_slope",)
-    band = read_band(_result_file(tmp_path / "u.json", parameters, method="prior", names=names))
+    band = read_band(uncertainty_result_file(tmp_path / "u.json", parameters, method="prior", names=names))
     assert band.method == "prior"
     assert not band.motor_slope_sampled
     assert band_mismatch(band, parameter_hash(parameters), 100e3, B_M, "calibrated") is None

@@ -8,12 +8,10 @@ by ``scripts/bench_app.py --screenshots``).
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
-from conftest import open_app
+from conftest import ROOT, open_app
 
-OUTPUT = Path(__file__).resolve().parent.parent / "test-artifacts"  # git-ignored
+OUTPUT = ROOT / "test-artifacts"  # git-ignored
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 # JS: fingerprint of what a change must update (eigenvalues on the locus, time histories)

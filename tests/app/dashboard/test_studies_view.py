@@ -3,7 +3,7 @@ rail runs on the server's study queue in the background, its progress and heat m
 result equals the serial study, a finished store is opened by its name from the server's list,
 bad input (an empty range, too many points, a name not in the list) shows a notice and keeps the
 map.  The queue runs in this process here (tests/conftest.py ``InProcessEngine``); the served app
-with the local Dask cluster is in tests/test_server_boundary.py."""
+with the local Dask cluster is in tests/app/server/test_boundary.py."""
 
 from __future__ import annotations
 

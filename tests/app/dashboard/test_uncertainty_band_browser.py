@@ -1,7 +1,7 @@
 """The s0*(v) uncertainty band in the served Studies tab (headless Chromium).
 
 A result of the calibrated set at the dashboard's default N0 and b_M (written by the model's
-``UncertaintyResult.as_dict``, see tests/test_uncertainty_band.py) into the server's studies
+``UncertaintyResult.as_dict``, see tests/app/dashboard/test_uncertainty_band.py) into the server's studies
 folder is picked by its name from the list (after ↻ made the list again); the
 band's data reach the browser, the figure renders without console errors, and a result of
 another wheel force shows the notice instead.  Screenshot: ``test-artifacts/uncertainty_band.png``.
@@ -9,15 +9,12 @@ another wheel force shows the notice instead.  Screenshot: ``test-artifacts/unce
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
-from conftest import open_app
-from test_uncertainty_band import SPEEDS, _result_file
+from conftest import ROOT, SPEEDS, open_app, uncertainty_result_file
 
 from app.results import compute
 
-OUTPUT = Path(__file__).resolve().parent.parent / "test-artifacts"  # git-ignored
+OUTPUT = ROOT / "test-artifacts"  # git-ignored
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 BAND = """() => {
@@ -40,8 +37,8 @@ def test_band_is_drawn_and_a_mismatch_is_explained(own_server, chromium):
     OUTPUT.mkdir(exist_ok=True)
     parameters = compute.parameters("", "calibrated")
     studies = own_server[2]
-    _result_file(studies / "good.json", parameters)
-    _result_file(studies / "other.json", parameters.replace(wheel_force=120e3))
+    uncertainty_result_file(studies / "good.json", parameters)
+    uncertainty_result_file(studies / "other.json", parameters.replace(wheel_force=120e3))
     # a server of its own: an earlier test in this process may have registered Panel models
     # whose scripts a page of the in-process server then asks a CDN for (vizzu.min.js, seen)
     page = open_app(chromium, own_server[0])

@@ -40,13 +40,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import start_bogie_serve, stop_process, wait_for_liveness
+from conftest import ROOT, start_bogie_serve, stop_process, uncertainty_result_file, wait_for_liveness
 
 from app.services.studies_folder import refusal
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
-ARTIFACTS = Path(__file__).resolve().parent.parent / "test-artifacts"  # git-ignored
+ARTIFACTS = ROOT / "test-artifacts"  # git-ignored
 WORKERS = max(1, len(os.sched_getaffinity(0)))  # the server's local cluster (one per core)
 MAX_POINTS = 1000
 
@@ -123,13 +123,11 @@ class FifoWatch:
 
 def _result_json(parameters) -> str:
     """A small uncertainty result of ``parameters`` at the dashboard's conditions (the model's
-    own writer, as tests/test_uncertainty_band.py makes it)."""
+    own writer, as tests/app/dashboard/test_uncertainty_band.py makes it)."""
     import tempfile
 
-    from test_uncertainty_band import _result_file
-
     with tempfile.TemporaryDirectory() as folder:
-        return _result_file(Path(folder) / "u.json", parameters).read_text(encoding="utf-8")
+        return uncertainty_result_file(Path(folder) / "u.json", parameters).read_text(encoding="utf-8")
 
 
 @pytest.fixture(scope="module")

@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import assert_self_contained_html
 
 from app.results import compute
 from app.results.eigenvalue_sweep import fig6_series
@@ -318,15 +319,6 @@ def test_bad_editor_values_give_a_notice_and_change_nothing(dash, value):
 
 # --- report ----------------------------------------------------------------------------------------
 
-def _assert_self_contained(text: str) -> None:
-    import re
-
-    assert re.search(r"<script[^>]*\bsrc=", text) is None
-    assert re.search(r"<link\b", text) is None
-    assert re.search(r"<img[^>]*\bsrc=[\"']?https?:", text) is None
-    assert "Bokeh" in text  # BokehJS itself is inline
-
-
 @pytest.mark.slow
 def test_report_of_a_variant_is_self_contained_and_complete():
     from app.report.page import build_report
@@ -336,7 +328,7 @@ def test_report_of_a_variant_is_self_contained_and_complete():
     key = f"|gear_ratio:{base['gear_ratio'] * 1.1!r}"
     text = build_report(key, "calibrated", 0.014, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None,
                         0.5)
-    _assert_self_contained(text)
+    assert_self_contained_html(text)
     point = compute.point_result(key, "calibrated", 0.014, 120.0, 100.0, 3000.0)
     verdict = "STABLE" if point.stable else "UNSTABLE"
     assert f'">{verdict}</span>' in text

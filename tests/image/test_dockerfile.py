@@ -1,6 +1,6 @@
 """The Dockerfile: hadolint clean, and the contract of docs/docker.md (fast, no image is built).
 
-The image itself is built and served in tests/test_docker_image.py (slow, needs buildah).
+The image itself is built and served in tests/image/test_docker_image.py (slow, needs buildah).
 """
 
 from __future__ import annotations
@@ -14,8 +14,9 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import ROOT
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = ROOT
 DOCKERFILE = ROOT / "Dockerfile"
 
 

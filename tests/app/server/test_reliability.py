@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import importlib.util
 from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
 
 import pytest
+from conftest import ROOT
 
 pytestmark = pytest.mark.slow
 
-SCRIPT = Path(__file__).resolve().parent.parent / "scripts" / "reliability_app.py"
+SCRIPT = ROOT / "scripts" / "reliability_app.py"
 
 
 def in_thread(function, *args, **kwargs):

@@ -1,5 +1,5 @@
 """Unit tests of the calibration's pieces (model/studies/calibration.py) — not of the calibrated numbers
-(those are tests/test_literature.py), and without running the search (minutes)."""
+(those are tests/literature/test_table1.py), and without running the search (minutes)."""
 
 from __future__ import annotations
 
