@@ -58,6 +58,7 @@ from scipy.sparse.csgraph import connected_components
 
 from .assembly import BogieModel
 from .eigen import eigen_analysis, state_space
+from .linear_system import massless_coordinates
 from .operating_point import (
     OperatingPoint,
     creep_coefficients,
@@ -103,11 +104,17 @@ class Anchor:
 
 
 def update_vectors(model: BogieModel) -> tuple[np.ndarray, np.ndarray]:
-    """(U, V), 2n x 4 each: A(c) = A_ref + (c − c_ref) U Vᵀ [U: 1/kg …, V: 1]."""
+    """(U, V), N x 4 each: A(c) = A_ref + (c − c_ref) U Vᵀ [U: 1/kg …, V: 1].  The creep acts on
+    the rims only (inertial coordinates): U = −[0; M_ii⁻¹ G_i], V = [0; G_i] on the state
+    [Δq; Δq̇_inertial] (:mod:`model.linear_system`)."""
     n = model.n
     G = longitudinal_creep_pattern(model)
+    inertial = np.setdiff1d(np.arange(n), massless_coordinates(model.M))
+    if np.any(G[np.setdiff1d(np.arange(n), inertial)]):
+        raise ValueError("the creep acts on a massless coordinate")
     Minv = state_space(model).inverse_mass
-    return (np.vstack([np.zeros((n, 4)), -Minv @ G]), np.vstack([np.zeros((n, 4)), G]))
+    G_i = G[inertial]
+    return (np.vstack([np.zeros((n, 4)), -Minv @ G_i]), np.vstack([np.zeros((n, 4)), G_i]))
 
 
 def _clusters(poles: np.ndarray, extra: np.ndarray | float = 0.0):

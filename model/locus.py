@@ -46,6 +46,7 @@ from scipy.optimize import linear_sum_assignment
 from .assembly import BogieModel
 from .contact import creep_block
 from .eigen import eigen_analysis
+from .linear_system import first_order_matrix, massless_coordinates
 from .operating_point import OperatingPoint, creep_coefficients, damping_matrix
 
 
@@ -97,20 +98,40 @@ def _coefficients(model: BogieModel, op: OperatingPoint) -> np.ndarray:
 
 
 class _Reduced:
-    """Projected matrices of the sweep on a basis Φ."""
+    """Projected matrices of the sweep on a basis Φ.
+
+    The massless coordinates (the Maxwell elements' internal coordinates,
+    :mod:`model.linear_system`) are kept exactly: Φ = [Φ_i, E_m] with Φ_i an orthonormal basis
+    of the inertial parts of the given vectors and E_m the unit vectors of the massless
+    coordinates, so the reduced model has the full model's first-order structure (its reduced
+    mass is ``diag(I, 0)`` in the mass-normalized coordinates) and an eigenvector whose inertial
+    part lies in span(Φ_i) is reproduced exactly."""
 
     def __init__(self, model: BogieModel, op: OperatingPoint, patterns, vectors: list[np.ndarray]):
-        U, s, _ = np.linalg.svd(np.hstack(vectors), full_matrices=False)
-        Phi = U[:, s > 1e-12 * s[0]]
+        massless = massless_coordinates(model.M)
+        stacked = np.hstack(vectors)
+        stacked[massless] = 0.0
+        U, s, _ = np.linalg.svd(stacked, full_matrices=False)
+        Phi_i = U[:, s > 1e-12 * s[0]]
+        E_m = np.zeros((model.n, len(massless)))
+        E_m[massless, np.arange(len(massless))] = 1.0
+        Phi = np.hstack([Phi_i, E_m])
+        r_i = Phi_i.shape[1]
         self.Phi = Phi
+        self.inertial = np.arange(r_i)  # reduced coordinates with mass
+        self.massless = np.arange(r_i, Phi.shape[1])  # the massless coordinates, kept
         self.M_Phi = model.M @ Phi
         self.K_Phi = model.K @ Phi
         C0 = model.B + op.b_M * model.motor_pattern
         self.C0_Phi = C0 @ Phi
         self.P_Phi = [P @ Phi for P in patterns]
-        # mass-normalize the reduced coordinates: Φᵀ M Φ = L Lᵀ
-        L = np.linalg.cholesky(Phi.T @ self.M_Phi)
-        self.Linv = sla.solve_triangular(L, np.eye(len(L)), lower=True)
+        if any(np.any(P[massless]) or np.any(P[:, massless]) for P in patterns):
+            raise ValueError("a creep pattern acts on a massless coordinate")
+        # mass-normalize the inertial reduced coordinates: Φ_iᵀ M Φ_i = L Lᵀ (Linv: block
+        # diagonal with the identity on the massless ones)
+        L = np.linalg.cholesky(Phi_i.T @ self.M_Phi[:, :r_i])
+        self.Linv = np.eye(Phi.shape[1])
+        self.Linv[:r_i, :r_i] = sla.solve_triangular(L, np.eye(r_i), lower=True)
         project = lambda X: self.Linv @ (Phi.T @ X) @ self.Linv.T  # noqa: E731
         self.K_r = project(self.K_Phi)
         self.C0_r = project(self.C0_Phi)
@@ -120,14 +141,23 @@ class _Reduced:
     def size(self) -> int:
         return self.Phi.shape[1]
 
+    @property
+    def mass_diagonal(self) -> np.ndarray:
+        """The reduced (mass-normalized) mass matrix's diagonal: 1 inertial, 0 massless."""
+        d = np.zeros(self.size)
+        d[self.inertial] = 1.0
+        return d
+
+    def first_order(self, K: np.ndarray, C: np.ndarray) -> np.ndarray:
+        """The reduced state matrix (state: reduced coordinates, velocities of the inertial
+        ones; :func:`model.linear_system.first_order_matrix`)."""
+        return first_order_matrix(np.eye(len(self.inertial)), C, K, self.inertial, self.massless)
+
     def solve(self, c: np.ndarray):
         """Ritz values and displacement vectors (Φ coordinates, unit norm) at coefficients c."""
         r = self.size
         C = self.C0_r + sum(ck * Pk for ck, Pk in zip(c, self.P_r, strict=True))
-        A = np.zeros((2 * r, 2 * r))
-        A[:r, r:] = np.eye(r)
-        A[r:, :r] = -self.K_r
-        A[r:, r:] = -C
+        A = self.first_order(self.K_r, C)
         lam, V = np.linalg.eig(A)  # numpy releases the GIL: the points run on several threads
         X = self.Linv.T @ V[:r]  # back from mass-normalized to Φ coordinates
         X /= np.linalg.norm(X, axis=0)
@@ -368,9 +398,24 @@ def _assign(previous_vectors, previous_values, vectors, values):
 
 
 def dense_generalized_eigenvalues(model: BogieModel, op: OperatingPoint) -> np.ndarray:
-    """All 2n eigenvalues of ``[λ N + P] u = 0`` (eqs. 21–22), dense QZ — the naive reference."""
+    """All finite eigenvalues of ``[λ N + P] u = 0`` (eqs. 21–22), dense QZ — the naive reference.
+
+    A massless coordinate (zero row of M, :mod:`model.linear_system`) would make the first block
+    row of eq. 22 vanish; there ``M̂`` (M with a unit entry on the massless diagonal) takes M's
+    place in N's first row and P, which keeps ``w = λ q`` for every coordinate and adds one
+    infinite eigenvalue per massless coordinate, dropped.  Without massless coordinates this is
+    eqs. 21–22 as published (2n eigenvalues)."""
     n = model.n
     Z = np.zeros((n, n))
-    N = np.block([[Z, model.M], [model.M, damping_matrix(model, op)]])
-    P = np.block([[-model.M, Z], [Z, model.K]])
-    return sla.eig(-P, N, right=False, check_finite=False)
+    M_hat = model.M.copy()
+    massless = massless_coordinates(model.M)
+    M_hat[massless, massless] = np.abs(np.diag(model.M)).max()
+    N = np.block([[Z, M_hat], [model.M, damping_matrix(model, op)]])
+    P = np.block([[-M_hat, Z], [Z, model.K]])
+    alpha, beta = sla.eig(-P, N, right=False, check_finite=False, homogeneous_eigvals=True)
+    if not len(massless):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return alpha / beta
+    order = np.argsort(np.abs(beta) / np.maximum(np.abs(alpha), 1e-300))
+    finite = np.sort(order[len(massless):])  # the n_m eigenvalues nearest to infinity dropped
+    return alpha[finite] / beta[finite]
