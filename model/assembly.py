@@ -6,15 +6,22 @@ the vertical axis through the bogie centre (positions and geometric directions m
 assembled once; an operating point only adds the motor slope ``B_M`` and the creep blocks
 ``B_ad`` (see :mod:`model.operating_point`).
 
-DOF layout (193 coordinates; the study had 189 without stating its breakdown):
+DOF layout (197 coordinates; the study had 189 without stating its breakdown):
 
 * per drive ``IDk`` (93): ``rotor.ry``, ``pinion.ry``, ``gear.ry`` (spins in the gear housing;
   they translate and tilt with the stator), ``stator.{x,y,z,rx,ry,rz}``, hollow shaft beam nodes
   ``hs5…hs9`` (6 each; disc clutch at 5, claw clutch at 9), axle beam nodes ``ax10…ax16``
   (6 each; claw clutch at 10, journals 11 and 15, wheels 12 and 14, centre 13, under the gear 16),
   wheel rims ``rim12``, ``rim14`` (6 each);
-* ``BF.{x,y,z,rx,ry,rz}`` bogie frame, ``CB.z`` half car body (vertical only: its other motions
-  are restrained by the whole locomotive and are not part of the study's table of modes).
+* ``BF.{x,y,z,rx,ry,rz}`` bogie frame; ``CB.x``, ``CB.z``, ``CB.rz`` half car body (longitudinal,
+  vertical, yaw about the vertical through the bogie centre; its lateral, roll and pitch are held
+  by the rest of the locomotive); ``secondary.yaw_damper_{left,right}.stroke`` the massless inner
+  coordinates of the two yaw dampers (Maxwell elements: damper in series with its end bushes).
+
+Rigid-body modes (``K r = 0``, from the kinematics): the spin of each drivetrain (rotor at −p times
+the wheel) and, since nothing in this model holds the vehicle to the track longitudinally or in
+yaw but the creep (a damping), the longitudinal translation and the yaw about the bogie centre of
+the whole vehicle (car body, frame, drives) — four in all.
 """
 
 from __future__ import annotations
@@ -26,7 +33,7 @@ import numpy as np
 
 from .beam import TubeSection, beam_global_matrices
 from .bodies import Body, carried_body, free_body, rigid_mass_matrix
-from .connections import Spring, SpringDamper, axis_springs
+from .connections import MaxwellDamper, Spring, SpringDamper, axis_springs
 from .dofs import AXES6, DofMap
 from .parameters import Parameters
 
@@ -35,6 +42,8 @@ AXLE_NODES = (10, 11, 12, 13, 14, 15, 16)
 RIM_NODES = (12, 14)
 DRIVES = ("ID1", "ID2")
 CENTRAL_SYMMETRY = np.diag([-1.0, -1.0, 1.0])  # drive 2 = drive 1 turned 180° about z
+CAR_BODY_AXES = ("x", "z", "rz")  # the half car body's coordinates
+YAW_DAMPERS = ("secondary.yaw_damper_left", "secondary.yaw_damper_right")  # +y, −y side
 
 
 def dof_names() -> tuple[str, ...]:
@@ -51,7 +60,8 @@ def dof_names() -> tuple[str, ...]:
             names += [f"{prefix}.rim{node}.{a}" for a in AXES6]
         return names
 
-    return tuple(drive("ID1") + [f"BF.{a}" for a in AXES6] + ["CB.z"] + drive("ID2"))
+    return tuple(drive("ID1") + [f"BF.{a}" for a in AXES6] + [f"CB.{a}" for a in CAR_BODY_AXES]
+                 + [f"{damper}.stroke" for damper in YAW_DAMPERS] + drive("ID2"))
 
 
 @dataclass(frozen=True)
@@ -73,11 +83,12 @@ class BogieModel:
     B: np.ndarray  # structural damping (incl. track), without B_M and B_ad [N s/m, …]
     mass_parts: dict[str, Part]  # component name -> its share of M (kinetic energy bookkeeping)
     stiffness_parts: dict[str, Part]  # element group -> its share of K (strain energy)
-    connections: list[SpringDamper]  # every connection, for output quantities
+    connections: list[SpringDamper | MaxwellDamper]  # every connection, for output quantities
     rims: dict[str, np.ndarray]  # "ID1.rim12" -> indices of [x, y, z, rx, ry, rz]
     motor_pattern: np.ndarray  # n x n: B_M for b_M = 1 (ID2 rotor–stator, relative form)
     short_circuit_force: np.ndarray  # generalized force per unit M_C on ID1 (rotor, stator)
-    rigid_body_modes: np.ndarray  # n x 2: rigid spin of each whole drivetrain (K r = 0)
+    rigid_body_modes: np.ndarray  # n x 4: rigid spin of each whole drivetrain, longitudinal
+    # translation and yaw of the whole vehicle (K r = 0)
     positions: dict[str, np.ndarray] = field(default_factory=dict)  # part -> reference point [m]
 
     @property
@@ -94,10 +105,17 @@ class _Assembler:
         self.B = np.zeros((n, n), dtype=dtype)
         self.mass_parts: dict[str, np.ndarray] = {}
         self.stiffness_parts: dict[str, np.ndarray] = {}
-        self.connections: list[SpringDamper] = []
+        self.connections: list[SpringDamper | MaxwellDamper] = []
+        self.bodies: list[Body] = []  # free bodies and beam nodes (rigid-body modes)
 
     def _add_part(self, store: dict, name: str, matrix: np.ndarray) -> None:
         store[name] = store.get(name, 0.0) + matrix
+
+    def free(self, name: str, origin, axes=AXES6) -> Body:
+        """A free body owning ``name.<axis>`` (kept for the rigid-body modes)."""
+        body = free_body(name, origin, self.dofs, axes)
+        self.bodies.append(body)
+        return body
 
     def add_mass(self, component: str, body: Body, M6: np.ndarray) -> None:
         contribution = body.W.T @ M6 @ body.W
@@ -117,7 +135,7 @@ class _Assembler:
         self._add_part(self.stiffness_parts, group, K)
         self._add_part(self.mass_parts, component, M)
 
-    def add_connection(self, connection: SpringDamper) -> None:
+    def add_connection(self, connection: SpringDamper | MaxwellDamper) -> None:
         K, B = connection.matrices()
         self.K += K
         self.B += B
@@ -158,8 +176,8 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
     y_gear, y_claw = p["gear_lateral_position"], p["claw_clutch_lateral_position"]
     x_motor = axle_x - (r_gear + r_pinion)  # motor axis towards the bogie centre
 
-    stator = free_body(f"{prefix}.stator", pos(x_motor + p["stator_offset_x"], 0.0,
-                                               p["stator_offset_z"]), dofs)
+    stator = asm.free(f"{prefix}.stator", pos(x_motor + p["stator_offset_x"], 0.0,
+                                              p["stator_offset_z"]))
     rotor = carried_body(f"{prefix}.rotor", pos(x_motor, 0.0, 0.0), stator, dofs)
     pinion = carried_body(f"{prefix}.pinion", pos(x_motor, y_gear, 0.0), stator, dofs)
     gear = carried_body(f"{prefix}.gear", pos(axle_x, y_gear, 0.0), stator, dofs)
@@ -173,11 +191,11 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
 
     # hollow shaft and axle beam nodes
     hs_y = np.linspace(y_gear, y_claw, len(HOLLOW_SHAFT_NODES))
-    hs = {k: free_body(f"{prefix}.hs{k}", pos(axle_x, y, 0.0), dofs)
+    hs = {k: asm.free(f"{prefix}.hs{k}", pos(axle_x, y, 0.0))
           for k, y in zip(HOLLOW_SHAFT_NODES, hs_y, strict=True)}
     c, j = p["contact_half_distance"], p["journal_half_distance"]
     axle_y = {11: -j, 12: -c, 10: y_claw, 13: 0.0, 16: y_gear, 14: c, 15: j}
-    ax = {k: free_body(f"{prefix}.ax{k}", pos(axle_x, y, 0.0), dofs) for k, y in axle_y.items()}
+    ax = {k: asm.free(f"{prefix}.ax{k}", pos(axle_x, y, 0.0)) for k, y in axle_y.items()}
     hollow = TubeSection(p["hollow_shaft_outer_radius"], p["hollow_shaft_inner_radius"])
     for k1, k2 in pairwise(HOLLOW_SHAFT_NODES):
         asm.add_beam(f"{prefix}.hollow_shaft", f"{prefix}.hollow_shaft", hs[k1], hs[k2], hollow, p)
@@ -195,7 +213,7 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
     # rims (elastic wheels) and track
     rims = {}
     for k in RIM_NODES:
-        rim = free_body(f"{prefix}.rim{k}", ax[k].origin, dofs)
+        rim = asm.free(f"{prefix}.rim{k}", ax[k].origin)
         rims[k] = rim
         Jr = p["rim_diametral_inertia"]
         asm.add_mass(rim.name, rim, rigid_mass_matrix(p["rim_mass"], (Jr, p["rim_polar_inertia"], Jr)))
@@ -264,6 +282,24 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
     return bodies
 
 
+def _rigid_motion(bodies: list[Body], dofs: DofMap, translation: np.ndarray,
+                  rotation: np.ndarray) -> np.ndarray:
+    """q of a rigid motion of every free body (displacement ``translation + rotation × r`` at a
+    body's reference point r, rotation ``rotation``): carried bodies follow their carriers with
+    no spin of their own; the yaw dampers' strokes stay zero (both ends move alike)."""
+    q = np.zeros(len(dofs))
+    for body in bodies:
+        motion = np.concatenate([translation + np.cross(rotation, np.real(body.origin)), rotation])
+        for k, axis in enumerate(AXES6):
+            name = f"{body.name}.{axis}"
+            if name in dofs._index:  # type: ignore[attr-defined]
+                q[dofs.index(name)] = motion[k]
+            elif abs(motion[k]) > 0:
+                raise ValueError(f"a rigid motion moves {body.name} along {axis}, which it does "
+                                 "not own")
+    return q
+
+
 def build_model(parameters: Parameters) -> BogieModel:
     """Assemble the constant matrices of the bogie for a parameter set."""
     p = parameters
@@ -274,11 +310,14 @@ def build_model(parameters: Parameters) -> BogieModel:
     positions: dict[str, np.ndarray] = {}
     n = len(dofs)
 
-    frame = free_body("BF", (0.0, 0.0, p["frame_height"]), dofs)
+    frame = asm.free("BF", (0.0, 0.0, p["frame_height"]))
     asm.add_mass("BF", frame, rigid_mass_matrix(
         p["frame_mass"], (p["frame_inertia_x"], p["frame_inertia_y"], p["frame_inertia_z"])))
-    car_body = free_body("CB", (0.0, 0.0, p["secondary_height"] + 1.0), dofs, axes=("z",))
-    asm.add_mass("CB", car_body, np.diag([0, 0, p["car_body_mass"], 0, 0, 0]))
+    # the half car body: longitudinal, vertical and yaw about the vertical through the bogie
+    # centre (its reference point lies on that axis)
+    car_body = asm.free("CB", (0.0, 0.0, p["secondary_height"] + 1.0), axes=CAR_BODY_AXES)
+    m_cb = p["car_body_mass"]
+    asm.add_mass("CB", car_body, np.diag([m_cb, 0, m_cb, 0, 0, p["car_body_yaw_inertia"]]))
     positions["BF"], positions["CB"] = frame.origin, car_body.origin
 
     half_base = p["wheelbase"] / 2
@@ -299,10 +338,24 @@ def build_model(parameters: Parameters) -> BogieModel:
         asm.add_connection(SpringDamper(
             "secondary.lateral_damper", "secondary", frame, car_body, np.array([0.0, side * sy, sh]),
             axis_springs((0, 0, 0), (0, p["secondary_damping_y"], 0))))
-        asm.add_connection(SpringDamper(
-            "secondary.yaw_damper", "secondary", frame, car_body,
-            np.array([0.0, side * p["yaw_damper_half_base_y"], p["yaw_damper_height"]]),
-            axis_springs((0, 0, 0), (p["yaw_damping"], 0, 0))))
+    # yaw dampers: longitudinal dampers between frame and car body, each in series with its
+    # rubber end bushes (a Maxwell element with a massless inner coordinate, the damper's stroke)
+    k_bush = p["yaw_damper_series_stiffness"]
+    for damper, side in zip(YAW_DAMPERS, (1.0, -1.0), strict=True):
+        point = np.array([0.0, side * p["yaw_damper_half_base_y"], p["yaw_damper_height"]])
+        asm.add_connection(MaxwellDamper(
+            damper, "yaw_dampers", frame, car_body, point, np.array([1.0, 0.0, 0.0]), k_bush,
+            p["yaw_damping"], dofs.index(f"{damper}.stroke"),
+            spring_damping=p["rubber_loss_time"] * k_bush))
+        positions[damper] = point
+    # traction linkage: frame to car body on the bogie's centre line, longitudinal
+    k_link = p["traction_link_stiffness"]
+    link_point = np.array([0.0, 0.0, p["traction_link_height"]])
+    asm.add_connection(SpringDamper(
+        "secondary.traction_link", "traction_link", frame, car_body, link_point,
+        axis_springs((k_link, 0, 0), (p["rubber_loss_time"] * k_link, 0, 0),
+                     channels=("force", "", ""))))
+    positions["secondary.traction_link"] = link_point
 
     # healthy motor (ID2): torque depends on the rotor's speed relative to the stator
     motor = np.zeros((n, n))
@@ -316,13 +369,16 @@ def build_model(parameters: Parameters) -> BogieModel:
     short_circuit[dofs.index("ID1.rotor.ry")] = -1.0
     short_circuit[dofs.index("ID1.stator.ry")] = 1.0
 
-    rigid = np.zeros((n, 2), dtype=dtype)
+    rigid = np.zeros((n, 4), dtype=dtype)
     for column, prefix in enumerate(DRIVES):
         for name in dofs.names:
             if name.startswith(prefix) and name.endswith(".ry") and ".stator." not in name:
                 rigid[dofs.index(name), column] = 1.0
         for part in ("rotor", "pinion"):
             rigid[dofs.index(f"{prefix}.{part}.ry"), column] = -p["gear_ratio"]
+    # the whole vehicle: longitudinal translation, yaw about the vertical through the bogie centre
+    rigid[:, 2] = _rigid_motion(asm.bodies, dofs, np.array([1.0, 0.0, 0.0]), np.zeros(3))
+    rigid[:, 3] = _rigid_motion(asm.bodies, dofs, np.zeros(3), np.array([0.0, 0.0, 1.0]))
 
     rims = {f"{prefix}.rim{k}": dofs.indices([f"{prefix}.rim{k}.{a}" for a in AXES6])
             for prefix in DRIVES for k in RIM_NODES}
