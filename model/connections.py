@@ -128,8 +128,10 @@ class MaxwellDamper:
         """Global stiffness and damping contributions (n x n)."""
         h = self.spring_elongation()
         outer = np.outer(h, h)
-        K = self.stiffness * outer
-        B = self.spring_damping * outer
+        dtype = np.result_type(outer, np.asarray(self.stiffness), np.asarray(self.damping),
+                               np.asarray(self.spring_damping))  # complex for complex steps
+        K = (self.stiffness * outer).astype(dtype)
+        B = (self.spring_damping * outer).astype(dtype)
         B[self.stroke_index, self.stroke_index] += self.damping
         return K, B
 

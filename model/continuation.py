@@ -277,10 +277,13 @@ class Continuation:
             poles = members[k, :sizes[k]]
             block = np.diag(a.poles[poles]) + dc * (a.Ut[poles] @ a.Vt[:, poles])
             values = np.linalg.eigvals(block)
-            for i in np.flatnonzero(groups[pole_of] == k):  # nearest block value to each root
-                best = int(np.argmin(np.abs(values - tracked.roots[i])))
-                result[i] = values[best]
-                values[best] = np.inf
+            # the block's values to the group's roots by an optimal assignment on distance (a
+            # greedy nearest choice in index order cascaded when two real poles of the group
+            # merged into a pair: each took its neighbour's value, the last one a far one)
+            roots = np.flatnonzero(groups[pole_of] == k)
+            rows, columns = linear_sum_assignment(
+                np.abs(tracked.roots[roots][:, None] - values[None, :]))
+            result[roots[rows]] = values[columns]
         return result
 
     def _groups(self, dc: float, mu: np.ndarray) -> np.ndarray:
