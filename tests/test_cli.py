@@ -214,7 +214,7 @@ def test_eigen_json_contract(capsys, model):
     assert code == 0, err
     data = json.loads(out)
     assert set(data) >= EIGEN_KEYS
-    assert data["rigid_body"] == 2
+    assert data["rigid_body"] == 4  # drivetrain spins, vehicle translation and yaw
     assert isinstance(data["stable"], bool)
     assert len(data["complex"]) == 6
     assert len(data["real"]) == 6

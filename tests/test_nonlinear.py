@@ -22,6 +22,7 @@ import pytest
 
 from model import build_model, default_operating_point, load_parameters
 from model.contact import PolachLaw
+from model.eigen import bogie_system
 from model.nonlinear import (
     AntiSlip,
     NonlinearError,
@@ -136,25 +137,38 @@ def test_tangent_law_reproduces_the_closed_form(bogie, s0):
 
 @pytest.mark.parametrize(("s0", "t_end"), [(0.005, 2.0), (0.014, 0.1)])
 def test_tiny_excitation_is_linear(bogie, s0, t_end):
+    """M_C scaled by ε: the response divided by ε tends to the linear one, the difference (the
+    creep law's curvature) falling as ε — measured 1.0e-3 at ε = 1e-4 and 1.0e-4 at ε = 1e-5
+    (s0 = 0.005, 2 s: the free vehicle's translation and the yaw dampers' forces carry the
+    largest remainder), 8.6e-4 and 8.6e-5 at s0 = 0.014."""
     parameters, model = bogie
     op = default_operating_point(parameters, s0, 120.0)
     linear = short_circuit_response(model, op, ShortCircuit(), t_end, 10_000.0)
-    small = nonlinear_response(model, op, ShortCircuit(), t_end, 10_000.0, excitation_scale=1e-4)
-    errors = relative_errors(perturbations(small), perturbations(linear), linear.outputs, 1e4)
-    worst = max(errors, key=errors.get)
-    assert errors[worst] <= 1e-3, (worst, errors[worst])
+    worst = {}
+    for scale in (1e-4, 1e-5):
+        small = nonlinear_response(model, op, ShortCircuit(), t_end, 10_000.0,
+                                   excitation_scale=scale)
+        errors = relative_errors(perturbations(small), perturbations(linear), linear.outputs,
+                                 1 / scale)
+        worst[scale] = max(errors.values())
+    assert worst[1e-5] <= 2e-4, worst
+    assert 8 <= worst[1e-4] / worst[1e-5] <= 12, worst  # O(ε): the law's curvature, not rounding
 
 
 @pytest.mark.parametrize("s0", [0.005, 0.014])
 def test_energy_balance(bogie, s0):
-    """∫ creep power = ΔE + ∫ q̇ᵀ B_nl q̇ − ∫ (input power of M_C and of the protection)."""
+    """∫ creep power = ΔE + ∫ q̇ᵀ B_nl q̇ − ∫ (input power of M_C and of the protection); q̇ of
+    every coordinate, the yaw dampers' strokes included (their c ḋ² is part of the loss)."""
     parameters, model = bogie
     op = default_operating_point(parameters, s0, 120.0)
     fs = 40_000.0
     r = nonlinear_response(model, op, ShortCircuit(), 0.5, fs, keep_states=True,
                            anti_slip=AntiSlip(delay=0.05))
     n = model.n
-    q, qd = r.states[:, :n], r.states[:, n:]
+    # the states are [Δq; Δq̇ of the inertial coordinates]; the yaw dampers' strokes' velocities
+    # (massless coordinates) follow from their first-order equations: q̇ = V x
+    q = r.states[:, :n]
+    qd = r.states @ bogie_system(model, op).velocity_map.T
     energy = 0.5 * ((qd @ model.M) * qd).sum(axis=1) + 0.5 * ((q @ model.K) * q).sum(axis=1)
     dissipation = ((qd @ damping_without_longitudinal_creep(model, op).T) * qd).sum(axis=1)
     inputs = qd @ model.short_circuit_force * r.M_C + qd @ motor2_force(model) * r.torque_reduction
