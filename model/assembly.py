@@ -96,20 +96,31 @@ class BogieModel:
         return len(self.dofs)
 
 
+def _support(W: np.ndarray) -> np.ndarray:
+    """Indices of the columns of W that are not zero (the coordinates a body's map touches)."""
+    return np.flatnonzero(np.any(W != 0, axis=0))
+
+
 class _Assembler:
+    """Adds each contribution on the coordinates it touches (a contribution is a few of the
+    ~200 coordinates: dense n x n products made an assembly 3-4x slower, and the complex-step
+    sensitivities assemble once per parameter)."""
+
     def __init__(self, dofs: DofMap, dtype=float):
         self.dofs = dofs
         n = len(dofs)
         self.M = np.zeros((n, n), dtype=dtype)
         self.K = np.zeros((n, n), dtype=dtype)
         self.B = np.zeros((n, n), dtype=dtype)
-        self.mass_parts: dict[str, np.ndarray] = {}
-        self.stiffness_parts: dict[str, np.ndarray] = {}
+        # name -> contributions (index, matrix) of each component (M) and element group (K)
+        self.mass_parts: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
+        self.stiffness_parts: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
         self.connections: list[SpringDamper | MaxwellDamper] = []
         self.bodies: list[Body] = []  # free bodies and beam nodes (rigid-body modes)
 
-    def _add_part(self, store: dict, name: str, matrix: np.ndarray) -> None:
-        store[name] = store.get(name, 0.0) + matrix
+    @staticmethod
+    def _add_part(store: dict, name: str, index: np.ndarray, matrix: np.ndarray) -> None:
+        store.setdefault(name, []).append((index, matrix))
 
     def free(self, name: str, origin, axes=AXES6) -> Body:
         """A free body owning ``name.<axis>`` (kept for the rigid-body modes)."""
@@ -118,28 +129,36 @@ class _Assembler:
         return body
 
     def add_mass(self, component: str, body: Body, M6: np.ndarray) -> None:
-        contribution = body.W.T @ M6 @ body.W
-        self.M += contribution
-        self._add_part(self.mass_parts, component, contribution)
+        index = _support(body.W)
+        W = body.W[:, index]
+        contribution = W.T @ M6 @ W
+        contribution = 0.5 * (contribution + contribution.T)  # exactly symmetric
+        self.M[np.ix_(index, index)] += contribution
+        self._add_part(self.mass_parts, component, index, contribution)
 
     def add_beam(self, group: str, component: str, node_a: Body, node_b: Body,
                  section: TubeSection, p: Parameters) -> None:
         K12, M12 = beam_global_matrices(node_a.origin, node_b.origin, section, p["young_modulus"],
                                         p["poisson_ratio"], p["steel_density"])
         G = np.vstack([node_a.W, node_b.W])
+        index = _support(G)
+        G = G[:, index]
         K = G.T @ K12 @ G
         M = G.T @ M12 @ G
-        self.K += K
-        self.B += p["shaft_loss_time"] * K
-        self.M += M
-        self._add_part(self.stiffness_parts, group, K)
-        self._add_part(self.mass_parts, component, M)
+        K, M = 0.5 * (K + K.T), 0.5 * (M + M.T)  # exactly symmetric
+        block = np.ix_(index, index)
+        self.K[block] += K
+        self.B[block] += p["shaft_loss_time"] * K
+        self.M[block] += M
+        self._add_part(self.stiffness_parts, group, index, K)
+        self._add_part(self.mass_parts, component, index, M)
 
     def add_connection(self, connection: SpringDamper | MaxwellDamper) -> None:
-        K, B = connection.matrices()
-        self.K += K
-        self.B += B
-        self._add_part(self.stiffness_parts, connection.group, K)
+        index, K, B = connection.local_matrices()
+        block = np.ix_(index, index)
+        self.K[block] += K
+        self.B[block] += B
+        self._add_part(self.stiffness_parts, connection.group, index, K)
         self.connections.append(connection)
 
     def add_ground_spring(self, group: str, index: int, stiffness: float, damping: float,
@@ -147,19 +166,24 @@ class _Assembler:
         self.K[index, index] += stiffness
         self.B[index, index] += damping
         self.M[index, index] += mass
-        k = np.zeros_like(self.K)
-        k[index, index] = stiffness
-        self._add_part(self.stiffness_parts, group, k)
-        m = np.zeros_like(self.M)
-        m[index, index] = mass
-        self._add_part(self.mass_parts, component, m)
+        at = np.array([index])
+        self._add_part(self.stiffness_parts, group, at, np.array([[stiffness]]))
+        self._add_part(self.mass_parts, component, at, np.array([[mass]]))
 
 
-def _parts(store: dict[str, np.ndarray]) -> dict[str, Part]:
+def _parts(store: dict[str, list[tuple[np.ndarray, np.ndarray]]]) -> dict[str, Part]:
+    """Each name's contributions summed on the union of their coordinates, without the rows and
+    columns that stay zero."""
     parts = {}
-    for name, matrix in store.items():
-        index = np.flatnonzero(np.any(matrix != 0, axis=0) | np.any(matrix != 0, axis=1))
-        parts[name] = Part(index, matrix[np.ix_(index, index)].copy())
+    for name, items in store.items():
+        union = np.unique(np.concatenate([index for index, _ in items]))
+        dtype = np.result_type(*[matrix for _, matrix in items])
+        matrix = np.zeros((len(union), len(union)), dtype=dtype)
+        for index, contribution in items:
+            position = np.searchsorted(union, index)
+            matrix[np.ix_(position, position)] += contribution
+        keep = np.any(matrix != 0, axis=0) | np.any(matrix != 0, axis=1)
+        parts[name] = Part(union[keep], matrix[np.ix_(keep, keep)].copy())
     return parts
 
 
@@ -348,6 +372,12 @@ def build_model(parameters: Parameters) -> BogieModel:
             p["yaw_damping"], dofs.index(f"{damper}.stroke"),
             spring_damping=p["rubber_loss_time"] * k_bush))
         positions[damper] = point
+    # anti-roll bar: a torsion bar between frame and car body, stiff in their relative roll (the
+    # half car body does not roll: it acts on the frame's roll alone)
+    k_roll = p["anti_roll_bar_stiffness"]
+    asm.add_connection(SpringDamper(
+        "secondary.anti_roll_bar", "anti_roll_bar", frame, car_body, np.array([0.0, 0.0, sh]),
+        axis_springs((k_roll, 0, 0), (p["shaft_loss_time"] * k_roll, 0, 0), rotational=True)))
     # traction linkage: frame to car body on the bogie's centre line, longitudinal
     k_link = p["traction_link_stiffness"]
     link_point = np.array([0.0, 0.0, p["traction_link_height"]])

@@ -217,8 +217,13 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
     out = Path(args.out) if args.out else CALIBRATED_FILE
     if not out.parent.is_dir():
         raise UsageError(f"directory '{out.parent}' does not exist")
-    run(start, out, max_evaluations=args.max_evaluations, scale=args.budget_scale,
-        progress=lambda text: print(text, file=sys.stderr if args.json else sys.stdout, flush=True))
+    from .calibration import OUTER_STEPS
+
+    rows, table = run(start, out, outer_steps=args.steps or OUTER_STEPS,
+                      progress=lambda text: print(text, file=sys.stderr, flush=True))
+    emit(args, {"out": str(out), "targets": [
+        {"name": row.name, "published": row.target, "achieved": row.achieved, "unit": row.unit,
+         "error": row.error} for row in rows]}, table)
 
 
 def cmd_export(args: argparse.Namespace) -> None:
@@ -267,14 +272,11 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("calibrate", help="fit the uncertain parameters to the published results")
     p.add_argument("--start", default=None, metavar="FILE", help="starting set (default: estimate.toml)")
     p.add_argument("--out", default=None, metavar="FILE", help="output (default: calibrated.toml)")
-    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=2400,
-                   help="trial parameter sets of stages B1 and B2 (the characters, then Table 1 "
-                        "by rank), each up to three eigen-analyses (default %(default)s)")
-    p.add_argument("--budget-scale", type=number("--budget-scale", 0.001, 10, high_open=False,
-                                                 allowed="must be in (0.001, 10]"),
-                   default=1.0, help="multiply the evaluation budgets of stages D-F (the ranking; "
-                                     "default %(default)s; smaller for a quick check)")
-    p.add_argument("--json", action="store_true", help="progress to stderr")
+    p.add_argument("--steps", type=positive_int("--steps"), default=None,
+                   help="least-squares steps (the characters re-assigned between steps) at most "
+                        "(default: the calibration's own, as for the bundled set)")
+    p.add_argument("--json", action="store_true", help="machine-readable JSON output (progress "
+                                                       "goes to stderr either way)")
     p.set_defaults(func=cmd_calibrate)
 
     p = sub.add_parser("export", help="export M, B, K, outputs at an operating point (.npz)")

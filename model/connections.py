@@ -62,21 +62,26 @@ class SpringDamper:
                             spring.stiffness * g, spring.damping * g))
         return out
 
-    def matrices(self) -> tuple[np.ndarray, np.ndarray]:
-        """Global stiffness and damping contributions (n x n)."""
-        n = self.a.W.shape[1]
+    def local_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(index, K, B): the stiffness and damping contributions on the coordinates they touch
+        (index: global indices; K, B: len(index) square)."""
         values = [self.a.W, self.b.W, self.a.origin, self.b.origin, self.position]
         for spring in self.springs:
             values += [spring.direction, np.asarray(spring.stiffness), np.asarray(spring.damping)]
-        dtype = np.result_type(*values)
-        K = np.zeros((n, n), dtype=dtype)  # complex for complex-step sensitivities
-        B = np.zeros((n, n), dtype=dtype)
-        for spring in self.springs:
-            g = self.relative(spring)
-            outer = np.outer(g, g)
+        dtype = np.result_type(*values)  # complex for complex-step sensitivities
+        rows = np.array([self.relative(spring) for spring in self.springs], dtype=dtype)
+        index = np.flatnonzero(np.any(rows != 0, axis=0)) if len(rows) else np.zeros(0, int)
+        K = np.zeros((len(index), len(index)), dtype=dtype)
+        B = np.zeros((len(index), len(index)), dtype=dtype)
+        for spring, row in zip(self.springs, rows[:, index], strict=True):
+            outer = np.outer(row, row)  # exactly symmetric, as is a sum of them
             K += spring.stiffness * outer
             B += spring.damping * outer
-        return K, B
+        return index, K, B
+
+    def matrices(self) -> tuple[np.ndarray, np.ndarray]:
+        """Global stiffness and damping contributions (n x n)."""
+        return _scatter(self.a.W.shape[1], *self.local_matrices())
 
 
 @dataclass(frozen=True)
@@ -124,16 +129,33 @@ class MaxwellDamper:
         h = self.spring_elongation()
         return [(f"{self.name}.{self.channel}", "N", self.stiffness * h, self.spring_damping * h)]
 
-    def matrices(self) -> tuple[np.ndarray, np.ndarray]:
-        """Global stiffness and damping contributions (n x n)."""
+    def local_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(index, K, B) on the coordinates the element touches (its stroke included)."""
         h = self.spring_elongation()
-        outer = np.outer(h, h)
+        index = np.flatnonzero(h != 0)
+        hl = h[index]
+        outer = np.outer(hl, hl)
         dtype = np.result_type(outer, np.asarray(self.stiffness), np.asarray(self.damping),
                                np.asarray(self.spring_damping))  # complex for complex steps
         K = (self.stiffness * outer).astype(dtype)
         B = (self.spring_damping * outer).astype(dtype)
-        B[self.stroke_index, self.stroke_index] += self.damping
-        return K, B
+        stroke = int(np.flatnonzero(index == self.stroke_index)[0])
+        B[stroke, stroke] += self.damping
+        return index, K, B
+
+    def matrices(self) -> tuple[np.ndarray, np.ndarray]:
+        """Global stiffness and damping contributions (n x n)."""
+        return _scatter(len(self.spring_elongation()), *self.local_matrices())
+
+
+def _scatter(n: int, index: np.ndarray, K: np.ndarray, B: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """The local matrices placed in n x n ones."""
+    out_K = np.zeros((n, n), dtype=K.dtype)
+    out_B = np.zeros((n, n), dtype=B.dtype)
+    out_K[np.ix_(index, index)] = K
+    out_B[np.ix_(index, index)] = B
+    return out_K, out_B
 
 
 def _scalar(value) -> float | complex:

@@ -121,6 +121,7 @@ SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "secondary_stiffness_z": ("N/m", "secondary vertical stiffness per spring", _POS),
     "traction_link_stiffness": ("N/m", "longitudinal stiffness of the traction link between frame and car body", _POS),
     "yaw_damper_series_stiffness": ("N/m", "series stiffness of each yaw damper (its rubber end bushes)", _POS),
+    "anti_roll_bar_stiffness": ("N m/rad", "roll stiffness of the anti-roll bar between frame and car body", _NONNEG),
     "track_stiffness": ("N/m", "track stiffness k_R under each wheel (eq. 11)", _POS),
     # --- damping -----------------------------------------------------------------------------------
     "primary_damping_z": ("N s/m", "primary vertical damper per axle box", _NONNEG),

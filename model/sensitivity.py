@@ -145,27 +145,30 @@ def _step(value: float) -> float:
 _derivative_lock = threading.Lock()
 
 
-def structural_derivatives(model: BogieModel, progress=None) -> dict[str, MatrixDerivative]:
+def structural_derivatives(model: BogieModel, progress=None,
+                           names: Iterable[str] | None = None) -> dict[str, MatrixDerivative]:
     """∂(M, B, K)/∂p of the constant assembly for every parameter that enters it (complex step
-    through :func:`model.assembly.build_model`; one complex assembly per parameter).  Cached on
-    the model: they depend on the parameter set only.  ``progress(done, total)`` if given."""
+    through :func:`model.assembly.build_model`; one complex assembly per parameter), or for those
+    of ``names`` only (the calibration's free parameters).  Cached on the model per parameter:
+    they depend on the parameter set only.  ``progress(done, total)`` if given.  A parameter
+    that does not enter the assembly has no entry."""
     with _derivative_lock:
-        cached = model.__dict__.get("_structural_derivatives")
-        if cached is not None:
-            return cached
+        cache = model.__dict__.setdefault("_structural_derivatives", {})
+        done_names = model.__dict__.setdefault("_structural_derivatives_done", set())
         p = model.parameters
-        names = [name for name in SCHEMA if name not in NOT_IN_ASSEMBLY]
-        derivatives: dict[str, MatrixDerivative] = {}
-        for done, name in enumerate(names):
+        wanted = [name for name in (SCHEMA if names is None else names)
+                  if name not in NOT_IN_ASSEMBLY]
+        missing = [name for name in wanted if name not in done_names]
+        for done, name in enumerate(missing):
             h = _step(p[name])
             perturbed = build_model(complex_step_parameters(p, name, h))
             derivative = _restrict(perturbed.M.imag / h, perturbed.B.imag / h, perturbed.K.imag / h)
             if derivative is not None:
-                derivatives[name] = derivative
+                cache[name] = derivative
+            done_names.add(name)
             if progress is not None:
-                progress(done + 1, len(names))
-        model.__dict__["_structural_derivatives"] = derivatives
-        return derivatives
+                progress(done + 1, len(missing))
+        return {name: cache[name] for name in wanted if name in cache}
 
 
 def _law(values: Mapping, N0) -> PolachLaw:
@@ -425,7 +428,7 @@ def eigen_sensitivities(model: BogieModel, op: OperatingPoint, indices: Iterable
                      f"{NEAR_REPEATED:g}): a twin of the two drives; its derivatives are not "
                      "meaningful and are NaN")
 
-    structural = structural_derivatives(model)
+    structural = structural_derivatives(model, names=wanted)
     names = tuple(wanted) + tuple(OPERATING_PARAMETERS)
     units = tuple(SCHEMA[name][0] for name in wanted) + tuple(OPERATING_PARAMETERS.values())
     values = np.array([model.parameters[name] for name in wanted]
