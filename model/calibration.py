@@ -171,14 +171,16 @@ STRUCTURAL_PARAMETERS = (
                   "2e7 N m/rad"),
     FreeParameter("driving_shaft_stiffness", 2.1e6, 1.9e7, "steel quill shaft, x3 around "
                   "6.4 MN m/rad"),
-    # a 3.5 t frame: side members (~60 % of the mass) at y = ±1.0 m over x = ±1.75 m, cross
-    # members (~40 %) near the centre: I_x ≈ 2 100 + 600, I_y ≈ 2 100 + 800 kg m^2; with all
-    # the mass at the outer edges (the physical limit) I_x ≈ 3 500 · 1.1² ≈ 4 200 kg m^2
-    FreeParameter("frame_inertia_x", 900.0, 3200.0, "3.5 t frame 2.2 m wide: ~2 700 kg m^2 for "
-                  "side members at ±1.0 m; x½ … 1.2x"),
-    FreeParameter("frame_inertia_y", 1200.0, 5000.0, "3.5 t frame 3.5 m long: ~2 900 kg m^2; "
-                  "x½ … 1.7x"),
-    FreeParameter("frame_inertia_z", 1800.0, 8000.0, "I_z <= I_x + I_y (see with_constraints)"),
+    # the frame with what it carries, 4.9 t (the rest of the 16 t bogie): a 3.5 t structure
+    # (side members, ~60 % of it, at y = ±1.0 m over x = ±1.75 m; cross members near the centre)
+    # and ~1.4 t of equipment near the wheels; all of it at the outer edges (the physical limit)
+    # would give I_x ≈ 4 900 · 1.1² ≈ 5 900, I_y ≈ 4 900 · 1.6² ≈ 12 500 kg m^2
+    FreeParameter("frame_inertia_x", 1400.0, 4200.0, "4.9 t frame with equipment, 2.2 m wide: "
+                  "~2 800 kg m^2; x½ … x1.5"),
+    FreeParameter("frame_inertia_y", 2300.0, 7000.0, "4.9 t frame with equipment, 3.5 m long: "
+                  "~4 600 kg m^2; x½ … x1.5"),
+    FreeParameter("frame_inertia_z", 3500.0, 11000.0, "~7 000 kg m^2, x½ … x1.6; |I_x − I_y| <= "
+                  "I_z <= I_x + I_y (see constraint_values)"),
     # 2.6 t: a 0.7 m motor (cylinder, m r²/2 ≈ 160 kg m^2) plus a gear housing reaching to the axle
     FreeParameter("stator_inertia_y", 90.0, 400.0, "2.6 t motor (~160 kg m^2 as a 0.7 m "
                   "cylinder) with its gear housing towards the axle (~150 kg m^2)"),
@@ -214,15 +216,26 @@ SEARCH_PARAMETERS = CREEP_SHAPE_PARAMETERS + STRUCTURAL_PARAMETERS
 FREE_PARAMETERS = CREEP_PARAMETERS + SEARCH_PARAMETERS
 
 
-# a rigid body's principal inertias obey I_z <= I_x + I_y (equality for a flat body); Polach's
-# kS <= kA: the search keeps both as it moves the others
+# a rigid body's principal inertias obey the triangle inequalities |I_x − I_y| <= I_z <= I_x + I_y
+# (equality on the right for a flat body); Polach's kS <= kA
+def constraint_values(parameters: Parameters) -> np.ndarray:
+    """The constraints as g <= 0 (dimensionless): I_z <= I_x + I_y, I_z >= I_y − I_x,
+    I_z >= I_x − I_y of the frame, kS <= kA."""
+    Ix, Iy, Iz = (parameters[f"frame_inertia_{a}"] for a in "xyz")
+    return np.array([(Iz - Ix - Iy) / (Ix + Iy), (Iy - Ix - Iz) / (Ix + Iy),
+                     (Ix - Iy - Iz) / (Ix + Iy),
+                     (parameters["polach_kS"] - parameters["polach_kA"]) / parameters["polach_kA"]])
+
+
 def with_constraints(parameters: Parameters) -> Parameters:
-    """``parameters`` with the frame's yaw inertia limited to the sum of its roll and pitch
-    inertias and Polach's kS limited to kA."""
+    """``parameters`` with the frame's yaw inertia kept within |I_x − I_y| … I_x + I_y and
+    Polach's kS limited to kA."""
     changes = {}
-    limit = parameters["frame_inertia_x"] + parameters["frame_inertia_y"]
-    if parameters["frame_inertia_z"] > limit:
-        changes["frame_inertia_z"] = float(limit)
+    Ix, Iy, Iz = (parameters[f"frame_inertia_{a}"] for a in "xyz")
+    if Iz > Ix + Iy:
+        changes["frame_inertia_z"] = float(Ix + Iy)
+    elif Iz < abs(Ix - Iy):
+        changes["frame_inertia_z"] = float(abs(Ix - Iy))
     if parameters["polach_kS"] > parameters["polach_kA"]:
         changes["polach_kS"] = float(parameters["polach_kA"])
     return parameters.replace(**changes) if changes else parameters
@@ -421,12 +434,11 @@ DIVERGENCE_SCALE = math.log(1.3)  # the two positive reals at 0.014, log ratio, 
 DIVERGENCE_WEIGHT = 0.3
 STABILITY_SCALE = 0.01  # [1/s] a positive real part where the bogie must be stable
 STABILITY_WEIGHT = 10.0
-PRIOR_WEIGHT = 0.1
+PRIOR_WEIGHT = 0.5  # the prior (log ratio to the estimate over ln 3): 1 at x3 or x⅓
 CONSTRAINT_SCALE = 0.001
 OPERATING_SCALE = 0.001  # [-] relative error of an operating datum (exact when stage A can be)
 LOSS_SCALE = 1.0  # soft-L1 loss: residuals beyond this count linearly (a far miss does not rule)
-OUTER_STEPS = 40  # re-assignments of the characters at most
-INNER_EVALUATIONS = 6  # trial sets of one least-squares step (fixed assignment)
+MAX_EXTRA = 6  # extra pairs below the cut followed at most (fixed residual slots)
 LIMIT_CHECK = 0.98 * STABILITY_LIMIT  # the bogie must still be stable here (no early flutter)
 
 _STAGE_A = tuple(f.name for f in CREEP_PARAMETERS)
@@ -472,94 +484,60 @@ def _stage_a_derivative(parameters: Parameters, free) -> np.ndarray:
     return out
 
 
-def _mac_matrix(model, reference: np.ndarray, shapes: np.ndarray) -> np.ndarray:
-    """Mass-weighted MAC between reference shapes (n x r) and shapes (n x c)."""
-    Mr, Ms = model.M @ reference, model.M @ shapes
-    cross = np.abs(reference.conj().T @ Ms) ** 2
-    return cross / np.outer(np.real(np.einsum("ij,ij->j", reference.conj(), Mr)),
-                            np.real(np.einsum("ij,ij->j", shapes.conj(), Ms)))
-
-
-@dataclass(frozen=True)
-class Assignment:
-    """The modes one least-squares step follows: Table 2's ten characters and the pairs without
-    a character below the cut, as reference shapes (fixed within the step)."""
-
-    shapes: np.ndarray  # n x m displacement shapes
-    eigenvalues: np.ndarray  # m [1/s]
-    roles: tuple[int, ...]  # 0…9: Table 2's character; −1: an extra pair
-
-    @property
-    def key(self) -> tuple:
-        return self.roles
-
-
-def assign_characters(parameters: Parameters) -> Assignment:
-    """Table 2's characters assigned to the pairs below :data:`CANDIDATE_HZ` at s0 = 0.005 (the
-    optimal assignment on the signature scores) and the other pairs below the cut."""
-    model = build_model(parameters)
-    result = eigen_analysis(model, _operating_point(parameters, S0_STABLE))
+def _assignment(model, result) -> tuple[dict[int, int], list[int]]:
+    """Table 2's characters assigned to the pairs below :data:`CANDIDATE_HZ` at s0 = 0.005 — the
+    literature tests' assignment (:func:`match_table1_modes`: what is fitted is what is checked)
+    — as {character 0…9: eigenvalue index}, and the other pairs below :data:`EXTRA_CUT`."""
     index = result.complex_index
     frequency = result.eigenvalues[index].imag / (2 * np.pi)
     candidates = index[:max(CANDIDATES, int(np.count_nonzero(frequency < CANDIDATE_HZ)))]
-    # the same assignment as the literature tests' (match_table1_modes): what is fitted is what
-    # is checked
     rows, columns, _, _ = _signature_assignment(model, result, candidates)
-    role = {int(c): int(r) for r, c in zip(rows, columns, strict=True)}
-    chosen, roles = [], []
-    for position, i in enumerate(candidates):
-        f = result.eigenvalues[i].imag / (2 * np.pi)
-        if position in role:
-            chosen.append(i)
-            roles.append(role[position])
-        elif f < EXTRA_CUT:
-            chosen.append(i)
-            roles.append(-1)
-    shapes = np.column_stack([result.mode_shape(i) for i in chosen])
-    return Assignment(shapes, result.eigenvalues[chosen], tuple(roles))
-
-
-@dataclass
-class _Evaluation:
-    x: np.ndarray
-    start: Parameters
-    parameters: Parameters
-    model: object
-    results: dict  # s0 -> EigenResult
-    residual: np.ndarray
-    terms: list  # per residual: (kind, s0, eigenvalue index or None, data)
-    tracked: dict  # role position -> eigenvalue index at s0 = 0.005
-
-
-def _track(model, result, assignment: Assignment) -> np.ndarray:
-    """Index (into result.eigenvalues) of each reference mode: optimal assignment on
-    1 − MAC + 0.3 |ln(f/f_ref)| over the pairs below the candidate limit."""
-    index = result.complex_index
-    frequency = result.eigenvalues[index].imag / (2 * np.pi)
-    candidates = index[:max(CANDIDATES, int(np.count_nonzero(frequency < 1.3 * CANDIDATE_HZ)))]
-    shapes = np.column_stack([result.mode_shape(i) for i in candidates])
-    mac = _mac_matrix(model, assignment.shapes, shapes)
-    f_ref = assignment.eigenvalues.imag / (2 * np.pi)
-    f = result.eigenvalues[candidates].imag / (2 * np.pi)
-    cost = 1 - mac + 0.3 * np.abs(np.log(f[None, :] / f_ref[:, None]))
-    rows, columns = linear_sum_assignment(cost)
-    out = np.full(len(f_ref), -1)
-    out[rows] = candidates[columns]
-    mac_kept = np.zeros(len(f_ref))
-    mac_kept[rows] = mac[rows, columns]
-    return out, mac_kept
+    characters = {int(r): int(candidates[c]) for r, c in zip(rows, columns, strict=True)}
+    taken = set(characters.values())
+    extra = [int(i) for i in candidates
+             if int(i) not in taken and result.eigenvalues[i].imag / (2 * np.pi) < EXTRA_CUT]
+    return characters, extra[:MAX_EXTRA]
 
 
 def _hinge(value: float) -> float:
     return value if value > 0 else 0.0
 
 
-def _evaluate_j(x: np.ndarray, base: Parameters, free, assignment: Assignment,
-                x_prior: np.ndarray) -> _Evaluation:
-    p = _from_x(x, base, free)
+@dataclass
+class _Evaluation:
+    """Residuals at one parameter set and what their Jacobian needs."""
+
+    x: np.ndarray
+    parameters: Parameters
+    model: object
+    results: dict  # s0 -> EigenResult
+    residual: np.ndarray
+    terms: list  # per residual: (kind, s0, eigenvalue index or indices, data)
+    characters: dict  # character 0…9 -> eigenvalue index at s0 = 0.005
+    extra: list  # eigenvalue indices of the extra pairs below the cut
+
+
+@dataclass(frozen=True)
+class Weights:
+    """Weights of the residual groups in one phase of stage J (1: as scaled above)."""
+
+    order: float = 1.0  # Table 1's order of the characters
+    real: float = RE_WEIGHT  # the real parts of modes 1, 3, 4, 8, 9, 10
+    divergence: float = DIVERGENCE_WEIGHT  # the two divergence rates at s0 = 0.014
+
+
+# the phases of stage J (trial sets, weights): the characters' frequencies first (a smoother
+# landscape, as stage B1 of the compass search was), then everything
+PHASES = ((60, Weights(order=0.0, real=0.0, divergence=0.0)), (60, Weights()))
+
+
+def _evaluate_j(x: np.ndarray, start: Parameters, free, x_prior: np.ndarray,
+                weights: Weights = Weights()) -> _Evaluation:
+    """The residuals of stage J at x (module comment above), the characters assigned at x."""
+    p = _from_x(x, start, free)
     model = build_model(p)
     stable = eigen_analysis(model, _operating_point(p, S0_STABLE))
-    tracked, mac = _track(model, stable, assignment)
+    characters, extra = _assignment(model, stable)
     residual, terms = [], []
 
     def add(value, kind, s0=None, index=None, data=None):
@@ -569,54 +547,45 @@ def _evaluate_j(x: np.ndarray, base: Parameters, free, assignment: Assignment,
     for j, row in enumerate(operating_rows(p)):  # zero whenever stage A can meet them
         add(row.error / OPERATING_SCALE, "operating", data=(j,))
     lam = stable.eigenvalues
-    freq = {}
-    for position, role in enumerate(assignment.roles):
-        i = int(tracked[position])
-        if role >= 0:
-            freq[role] = i
-    for k in range(len(TABLE1_IM_HZ)):
-        i = freq[k]
-        f = lam[i].imag / (2 * np.pi)
-        add(math.log(f / TABLE1_IM_HZ[k]) / FREQUENCY_SCALE, "logf", S0_STABLE, i,
-            (1.0 / FREQUENCY_SCALE,))
+    for k, target in enumerate(TABLE1_IM_HZ):
+        i = characters[k]
+        add(math.log(lam[i].imag / (2 * np.pi) / target) / FREQUENCY_SCALE, "logf", S0_STABLE,
+            i, (1.0 / FREQUENCY_SCALE,))
     for k in range(len(TABLE1_IM_HZ) - 1):  # Table 1's order
-        a, b = freq[k], freq[k + 1]
+        a, b = characters[k], characters[k + 1]
         g = math.log(lam[a].imag / lam[b].imag) + ORDER_MARGIN
-        add(_hinge(g) / ORDER_SCALE, "order", S0_STABLE, (a, b), (g > 0,))
-    first = TABLE1_IM_HZ[0]
-    for position, role in enumerate(assignment.roles):
-        if role >= 0:
-            continue
-        i = int(tracked[position])
-        if i < 0 or mac[position] < 0.3:  # the mode left (e.g. turned into two real ones)
+        add(weights.order * _hinge(g) / ORDER_SCALE, "order", S0_STABLE, (a, b),
+            (g > 0, weights.order))
+    for slot in range(MAX_EXTRA):  # fixed slots: the residual's length does not change
+        if slot >= len(extra):
             add(0.0, "none")
             continue
+        i = extra[slot]
         f = lam[i].imag / (2 * np.pi)
-        if f < 0.9 * first:  # below Table 1's first row: to overdamping
+        if f < 0.9 * TABLE1_IM_HZ[0]:  # below Table 1's first row: to overdamping
             zeta = -lam[i].real / abs(lam[i])
             add(_hinge(OVERDAMPED - zeta) / ZETA_SCALE, "zeta", S0_STABLE, i, (zeta < OVERDAMPED,))
         else:
             g = math.log(EXTRA_CUT / f)
             add(_hinge(g) / EXTRA_SCALE, "extra", S0_STABLE, i, (g > 0,))
     for k in RE_MODES:
-        i = freq[k - 1]
-        add(RE_WEIGHT * real_part_residual(lam[i].real, TABLE1_RE[k - 1]), "re", S0_STABLE, i,
-            (TABLE1_RE[k - 1],))
+        i = characters[k - 1]
+        add(weights.real * real_part_residual(lam[i].real, TABLE1_RE[k - 1]), "re", S0_STABLE,
+            i, (TABLE1_RE[k - 1], weights.real))
     ds = driving_shaft_mode(model, stable)
     add(math.log(lam[ds].imag / (2 * np.pi) / DRIVING_SHAFT_HZ) / FREQUENCY_SCALE, "logf",
         S0_STABLE, ds, (1.0 / FREQUENCY_SCALE,))
     results = {S0_STABLE: stable}
     unstable = eigen_analysis(model, _operating_point(p, S0_UNSTABLE), vectors=False)
     results[S0_UNSTABLE] = unstable
-    reals = unstable.real_index
-    for target, i in zip(DIVERGENCE_RATES, reals[:2], strict=False):
+    for target, i in zip(DIVERGENCE_RATES, unstable.real_index[:2], strict=True):
         value = unstable.eigenvalues[i].real
         if value > 0:
-            add(DIVERGENCE_WEIGHT * math.log(value / target) / DIVERGENCE_SCALE, "logre",
-                S0_UNSTABLE, int(i), (DIVERGENCE_WEIGHT / DIVERGENCE_SCALE,))
+            add(weights.divergence * math.log(value / target) / DIVERGENCE_SCALE, "logre",
+                S0_UNSTABLE, int(i), (weights.divergence / DIVERGENCE_SCALE,))
         else:  # not diverging: linear towards the target
-            add(DIVERGENCE_WEIGHT * (value - target) / (target * DIVERGENCE_SCALE), "linre",
-                S0_UNSTABLE, int(i), (DIVERGENCE_WEIGHT / (target * DIVERGENCE_SCALE),))
+            add(weights.divergence * (value - target) / (target * DIVERGENCE_SCALE), "linre",
+                S0_UNSTABLE, int(i), (weights.divergence / (target * DIVERGENCE_SCALE),))
     below = eigen_analysis(model, _operating_point(p, LIMIT_CHECK), vectors=False)
     results[LIMIT_CHECK] = below
     top = int(np.argmax(below.eigenvalues.real))
@@ -626,15 +595,26 @@ def _evaluate_j(x: np.ndarray, base: Parameters, free, assignment: Assignment,
     for j, f in enumerate(free):  # the prior towards the estimate
         span = math.log(3.0) if f.log else (f.high - f.low) / 2
         add(PRIOR_WEIGHT * (x[j] - x_prior[j]) / span, "prior", data=(j, PRIOR_WEIGHT / span))
-    names = [f.name for f in free]
-    if "frame_inertia_z" in names:
-        g = (p["frame_inertia_z"] - p["frame_inertia_x"] - p["frame_inertia_y"]) / p["frame_inertia_z"]
-        add(_hinge(g) / CONSTRAINT_SCALE, "constraint", data=("inertia", g > 0))
-    if "polach_kS" in names:
-        g = (p["polach_kS"] - p["polach_kA"]) / p["polach_kA"]
-        add(_hinge(g) / CONSTRAINT_SCALE, "constraint", data=("polach", g > 0))
-    return _Evaluation(x.copy(), base, p, model, results, np.array(residual), terms,
-                       {k: freq[k] for k in freq})
+    for j, g in enumerate(constraint_values(p)):
+        add(_hinge(g) / CONSTRAINT_SCALE, "constraint", data=(j, g > 0))
+    return _Evaluation(x.copy(), p, model, results, np.array(residual), terms, characters, extra)
+
+
+def _constraint_gradient(x: np.ndarray, start: Parameters, free, which: int) -> np.ndarray:
+    """d(constraint_values[which])/dx by central differences (no model: parameter arithmetic)."""
+    def value(z):
+        values = dict(start.values)
+        values.update({f.name: float(math.exp(v) if f.log else v)
+                       for f, v in zip(free, z, strict=True)})
+        return constraint_values(Parameters(values))[which]
+
+    out = np.zeros(len(free))
+    for j in range(len(free)):
+        up, down = x.copy(), x.copy()
+        up[j] += 1e-7
+        down[j] -= 1e-7
+        out[j] = (value(up) - value(down)) / 2e-7
+    return out
 
 
 def _operating_jacobian(x: np.ndarray, start: Parameters, free) -> np.ndarray:
@@ -658,7 +638,7 @@ def _operating_jacobian(x: np.ndarray, start: Parameters, free) -> np.ndarray:
     return out
 
 
-def _jacobian_j(e: _Evaluation, free) -> np.ndarray:
+def _jacobian_j(e: _Evaluation, start: Parameters, free) -> np.ndarray:
     """d(residual)/dx from the eigenvalue sensitivities (model/sensitivity.py) at each operating
     point, with stage A's implicit dependence on the creep shape."""
     from .sensitivity import eigen_sensitivities
@@ -690,7 +670,7 @@ def _jacobian_j(e: _Evaluation, free) -> np.ndarray:
     J = np.zeros((len(e.residual), len(free)))
     operating = [r for r, term in enumerate(e.terms) if term[0] == "operating"]
     if operating:
-        J[operating] = _operating_jacobian(e.x, e.start, free)
+        J[operating] = _operating_jacobian(e.x, start, free)
     for r, (kind, s0, index, data) in enumerate(e.terms):
         if kind in ("none", "operating"):
             continue
@@ -698,20 +678,9 @@ def _jacobian_j(e: _Evaluation, free) -> np.ndarray:
             J[r, data[0]] = data[1]
             continue
         if kind == "constraint":
-            which, active = data
-            if not active:
-                continue
-            for j, f in enumerate(free):
-                if which == "inertia" and f.name in ("frame_inertia_x", "frame_inertia_y",
-                                                     "frame_inertia_z"):
-                    Iz = p["frame_inertia_z"]
-                    d = ((p["frame_inertia_x"] + p["frame_inertia_y"]) / Iz if f.name ==
-                         "frame_inertia_z" else -p[f.name] / Iz)
-                    J[r, j] = d / CONSTRAINT_SCALE * (1.0 if f.log else 1.0 / p[f.name])
-                if which == "polach" and f.name in ("polach_kS", "polach_kA"):
-                    ratio = p["polach_kS"] / p["polach_kA"]
-                    d = ratio if f.name == "polach_kS" else -ratio
-                    J[r, j] = d / CONSTRAINT_SCALE * (1.0 if f.log else 1.0 / p[f.name])
+            j_constraint, active = data
+            if active:  # the constraints are parameter arithmetic: central differences in x
+                J[r] = _constraint_gradient(e.x, start, free, j_constraint) / CONSTRAINT_SCALE
             continue
         lam_of = lambda i, s0=s0: e.results[s0].eigenvalues[i]  # noqa: E731
         d_of = lambda i, s0=s0: per_point[s0][i]  # noqa: E731
@@ -720,7 +689,8 @@ def _jacobian_j(e: _Evaluation, free) -> np.ndarray:
         elif kind == "order":
             if data[0]:
                 a, b = index
-                J[r] = (d_of(a).imag / lam_of(a).imag - d_of(b).imag / lam_of(b).imag) / ORDER_SCALE
+                J[r] = data[1] * (d_of(a).imag / lam_of(a).imag
+                                  - d_of(b).imag / lam_of(b).imag) / ORDER_SCALE
         elif kind == "extra":
             if data[0]:
                 J[r] = -(d_of(index).imag / lam_of(index).imag) / EXTRA_SCALE
@@ -733,9 +703,9 @@ def _jacobian_j(e: _Evaluation, free) -> np.ndarray:
         elif kind == "re":
             lam, d, published = lam_of(index), d_of(index), data[0]
             if abs(published) >= 0.2 and lam.real * published > 0:
-                J[r] = RE_WEIGHT * d.real / (lam.real * math.log(1.3))
+                J[r] = data[1] * d.real / (lam.real * math.log(1.3))
             else:
-                J[r] = RE_WEIGHT * d.real / max(0.3 * abs(published), 0.05)
+                J[r] = data[1] * d.real / max(0.3 * abs(published), 0.05)
         elif kind == "logre":
             J[r] = data[0] * d_of(index).real / lam_of(index).real
         elif kind == "linre":
@@ -743,80 +713,65 @@ def _jacobian_j(e: _Evaluation, free) -> np.ndarray:
     return J
 
 
-def _least_squares_step(x: np.ndarray, start: Parameters, free, assignment: Assignment,
-                        x_prior: np.ndarray, bounds, max_nfev: int):
-    """One trust-region-reflective least-squares run with the assignment held fixed."""
+def _phase(x0: np.ndarray, start: Parameters, free, x_prior: np.ndarray, weights: Weights,
+           evaluations: int, progress: Callable, label: str, began: float) -> np.ndarray:
+    """One least-squares run of stage J with the given weights; returns its solution."""
+    low, high = _bounds(free)
     cache: dict = {}
+    best = [math.inf]
 
     def evaluation(z: np.ndarray) -> _Evaluation:
         key = z.tobytes()
         if key not in cache:
-            cache.clear()
-            cache[key] = _evaluate_j(z, start, free, assignment, x_prior)
+            if len(cache) > 4:
+                cache.pop(next(iter(cache)))
+            cache[key] = _evaluate_j(z, start, free, x_prior, weights)
         return cache[key]
 
-    size = len(evaluation(x).residual)
+    size = len(evaluation(x0).residual)
 
     def fun(z: np.ndarray) -> np.ndarray:
         try:
-            return evaluation(z).residual
+            residual = evaluation(z).residual
         except (ValueError, np.linalg.LinAlgError):  # a trial set the model cannot analyse
             return np.full(size, 1e3)
+        cost = float(np.sum(np.sqrt(1 + (residual / LOSS_SCALE) ** 2) - 1))
+        if cost < best[0]:
+            best[0] = cost
+            progress(f"  {label}: cost {cost:.6g} ({time.perf_counter() - began:.0f} s)")
+        return residual
 
-    return least_squares(fun, x, jac=lambda z: _jacobian_j(evaluation(z), free), bounds=bounds,
-                         method="trf", x_scale="jac", loss="soft_l1", f_scale=LOSS_SCALE,
-                         max_nfev=max_nfev, ftol=1e-8, xtol=1e-10, gtol=1e-10)
-
-
-def merit(x: np.ndarray, start: Parameters, free, x_prior: np.ndarray
-          ) -> tuple[float, Assignment]:
-    """The stage's objective at x with the characters assigned at x itself: the soft-L1 sum of
-    the residuals (a step of the fixed-assignment least squares is kept only if it lowers it)."""
-    assignment = assign_characters(_from_x(x, start, free))
-    residual = _evaluate_j(x, start, free, assignment, x_prior).residual
-    z = (residual / LOSS_SCALE) ** 2
-    return float(LOSS_SCALE**2 * np.sum(np.sqrt(1 + z) - 1)), assignment
+    solution = least_squares(fun, x0, jac=lambda z: _jacobian_j(evaluation(z), start, free),
+                             bounds=(low, high), method="trf", x_scale="jac", loss="soft_l1",
+                             f_scale=LOSS_SCALE, max_nfev=evaluations, ftol=1e-6, xtol=1e-8,
+                             gtol=1e-8)
+    progress(f"  {label}: {solution.nfev} trial sets, {solution.message} "
+             f"({time.perf_counter() - began:.0f} s)")
+    return np.clip(solution.x, low, high)
 
 
 def jacobian_stage(start: Parameters, progress: Callable = print,
                    free: tuple[FreeParameter, ...] | None = None,
-                   outer_steps: int = OUTER_STEPS,
-                   inner_evaluations: int = INNER_EVALUATIONS) -> Parameters:
+                   phases: tuple = PHASES) -> Parameters:
     """Stage J (see above) from ``start`` (its values are the prior; stage A is solved inside
-    every evaluation).  Each step: the characters assigned at the current set, then at most
-    ``inner_evaluations`` trial sets of least squares following those modes; the step is kept if
-    it lowers :func:`merit` (the characters re-assigned at its end), else halved (up to three
-    times).  It stops when a step gains less than 1e-4 of the merit, or after ``outer_steps``
-    steps.  Deterministic."""
+    every evaluation): for each of ``phases`` (trial sets, :class:`Weights`) scipy's bounded
+    trust-region-reflective least squares with a soft-L1 loss on the residuals of
+    :func:`_evaluate_j`.  The Jacobian at a set is that of the modes its own assignment gives
+    the characters (fixed within a step); a trial set is judged with the characters assigned
+    anew (a step that swaps them for the worse is rejected by the trust region's reduction
+    ratio, and the region shrinks).  Deterministic."""
     free = SEARCH_PARAMETERS if free is None else free
     low, high = _bounds(free)
-    x = np.clip(_to_x(start, free), low, high)
-    x_prior = x.copy()
+    x_prior = np.clip(_to_x(start, free), low, high)
+    x = x_prior.copy()
     began = time.perf_counter()
-    value, assignment = merit(x, start, free, x_prior)
-    progress(f"  stage J start: merit {value:.6g}")
-    for step in range(outer_steps):
-        solution = _least_squares_step(x, start, free, assignment, x_prior, (low, high),
-                                       inner_evaluations)
-        trial = np.clip(solution.x, low, high)
-        for _halving in range(4):
-            trial_value, trial_assignment = merit(trial, start, free, x_prior)
-            if trial_value < value:
-                break
-            trial = x + 0.5 * (trial - x)
-        gain = value - trial_value
-        progress(f"  stage J step {step + 1}: merit {trial_value:.6g} ({solution.nfev} trial sets, "
-                 f"{sum(1 for r in trial_assignment.roles if r < 0)} extra pair(s) below "
-                 f"{EXTRA_CUT} Hz, {time.perf_counter() - began:.0f} s)")
-        if gain <= 0:
-            break
-        x, value, assignment = trial, trial_value, trial_assignment
-        if gain < 1e-4 * value:
-            break
+    for number, (evaluations, weights) in enumerate(phases, start=1):
+        x = _phase(x, start, free, x_prior, weights, evaluations, progress,
+                   f"stage J, phase {number}", began)
     return _from_x(x, start, free)
 
 def calibrate(start: Parameters, progress: Callable = print,
-              outer_steps: int = OUTER_STEPS) -> tuple[Parameters, list[TargetRow]]:
+              phases: tuple = PHASES) -> tuple[Parameters, list[TargetRow]]:
     """Stage A fits the creep law and the gear ratio to the operating data (exactly, inside
     every evaluation); stage J (:func:`jacobian_stage`) fits the creep shape, the structure, the
     dampers and the motor slope to Table 1 by rank with its characters, the real parts, the
@@ -827,7 +782,7 @@ def calibrate(start: Parameters, progress: Callable = print,
     progress(f"  stage A: μ0 {stage_a['polach_mu0']:.5g}, A {stage_a['polach_A']:.5g}, "
              f"B {stage_a['polach_B']:.5g} s/m, p {stage_a['gear_ratio']:.5g}")
     fitted = fit_operating_data(with_constraints(jacobian_stage(stage_a, progress,
-                                                                 outer_steps=outer_steps)))
+                                                                 phases=phases)))
     notes = dict(start.notes)
     for f in FREE_PARAMETERS:
         notes[f.name] = (f"calibrated by `bogie calibrate` within [{f.low:g}, {f.high:g}] "
@@ -871,7 +826,7 @@ def format_table(rows: list[TargetRow], limit: float | None = None) -> str:
     return "\n".join(lines)
 
 
-def run(start_file=ESTIMATE_FILE, out_file=CALIBRATED_FILE, outer_steps: int = OUTER_STEPS,
+def run(start_file=ESTIMATE_FILE, out_file=CALIBRATED_FILE, phases: tuple = PHASES,
         progress: Callable = print) -> tuple[list[TargetRow], str]:
     """The ``bogie calibrate`` command: fit (with one BLAS thread, for a reproducible path) and
     write the calibrated set; returns its targets and their table."""
@@ -880,7 +835,7 @@ def run(start_file=ESTIMATE_FILE, out_file=CALIBRATED_FILE, outer_steps: int = O
     start = load_parameters(start_file)
     progress(f"calibrating {len(FREE_PARAMETERS)} parameters from {start_file} …")
     with threadpool_limits(1):
-        calibrated, rows = calibrate(start, progress, outer_steps)
+        calibrated, rows = calibrate(start, progress, phases)
         limit = stability_limit(build_model(calibrated), V_REF, calibrated["wheel_force"],
                                 calibrated["motor_slope"]).s0_limit
     table = format_table(rows, limit)

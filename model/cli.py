@@ -217,9 +217,11 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
     out = Path(args.out) if args.out else CALIBRATED_FILE
     if not out.parent.is_dir():
         raise UsageError(f"directory '{out.parent}' does not exist")
-    from .calibration import OUTER_STEPS
+    from .calibration import PHASES
 
-    rows, table = run(start, out, outer_steps=args.steps or OUTER_STEPS,
+    phases = PHASES if args.max_evaluations is None else tuple(
+        (min(count, args.max_evaluations), weights) for count, weights in PHASES)
+    rows, table = run(start, out, phases=phases,
                       progress=lambda text: print(text, file=sys.stderr, flush=True))
     emit(args, {"out": str(out), "targets": [
         {"name": row.name, "published": row.target, "achieved": row.achieved, "unit": row.unit,
@@ -272,9 +274,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("calibrate", help="fit the uncertain parameters to the published results")
     p.add_argument("--start", default=None, metavar="FILE", help="starting set (default: estimate.toml)")
     p.add_argument("--out", default=None, metavar="FILE", help="output (default: calibrated.toml)")
-    p.add_argument("--steps", type=positive_int("--steps"), default=None,
-                   help="least-squares steps (the characters re-assigned between steps) at most "
-                        "(default: the calibration's own, as for the bundled set)")
+    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=None,
+                   help="trial parameter sets of each least-squares phase at most (default: "
+                        "the calibration's own, as for the bundled set; smaller for a quick "
+                        "check)")
     p.add_argument("--json", action="store_true", help="machine-readable JSON output (progress "
                                                        "goes to stderr either way)")
     p.set_defaults(func=cmd_calibrate)
