@@ -324,15 +324,58 @@ def _rigid_motion(bodies: list[Body], dofs: DofMap, translation: np.ndarray,
     return q
 
 
+def assembled_matrices(parameters: Parameters) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(M, B, K) of a parameter set without the rest of the model (the complex-step
+    sensitivities need only these, once per parameter)."""
+    asm, _, _ = _assemble(parameters)
+    return asm.M, asm.B, asm.K
+
+
 def build_model(parameters: Parameters) -> BogieModel:
     """Assemble the constant matrices of the bogie for a parameter set."""
+    p = parameters
+    asm, dofs, positions = _assemble(p)
+    n = len(dofs)
+    dtype = asm.K.dtype
+
+    # healthy motor (ID2): torque depends on the rotor's speed relative to the stator
+    motor = np.zeros((n, n))
+    rotor2, stator2 = dofs.index("ID2.rotor.ry"), dofs.index("ID2.stator.ry")
+    motor[np.ix_([rotor2, stator2], [rotor2, stator2])] = [[1.0, -1.0], [-1.0, 1.0]]
+
+    # short circuit torque on ID1: M_C in the driving sense.  Forward running spins the wheels
+    # +ry and, through one external gear mesh, the rotor −ry: a driving torque is −ry on the rotor
+    # and its reaction +ry on the stator.
+    short_circuit = np.zeros(n)
+    short_circuit[dofs.index("ID1.rotor.ry")] = -1.0
+    short_circuit[dofs.index("ID1.stator.ry")] = 1.0
+
+    rigid = np.zeros((n, 4), dtype=dtype)
+    for column, prefix in enumerate(DRIVES):
+        for name in dofs.names:
+            if name.startswith(prefix) and name.endswith(".ry") and ".stator." not in name:
+                rigid[dofs.index(name), column] = 1.0
+        for part in ("rotor", "pinion"):
+            rigid[dofs.index(f"{prefix}.{part}.ry"), column] = -p["gear_ratio"]
+    # the whole vehicle: longitudinal translation, yaw about the vertical through the bogie centre
+    rigid[:, 2] = _rigid_motion(asm.bodies, dofs, np.array([1.0, 0.0, 0.0]), np.zeros(3))
+    rigid[:, 3] = _rigid_motion(asm.bodies, dofs, np.zeros(3), np.array([0.0, 0.0, 1.0]))
+
+    rims = {f"{prefix}.rim{k}": dofs.indices([f"{prefix}.rim{k}.{a}" for a in AXES6])
+            for prefix in DRIVES for k in RIM_NODES}
+    return BogieModel(p, dofs, asm.M, asm.K, asm.B, _parts(asm.mass_parts),
+                      _parts(asm.stiffness_parts), asm.connections, rims, motor, short_circuit,
+                      rigid, positions)
+
+
+def _assemble(parameters: Parameters) -> tuple[_Assembler, DofMap, dict[str, np.ndarray]]:
+    """Every body and element of the bogie added: (assembler, DOF map, drawn positions)."""
     p = parameters
     dofs = DofMap(dof_names())
     # complex values (a complex-step perturbation, model.sensitivity) give complex matrices
     dtype = complex if any(isinstance(value, complex) for value in p.values.values()) else float
     asm = _Assembler(dofs, dtype)
     positions: dict[str, np.ndarray] = {}
-    n = len(dofs)
 
     frame = asm.free("BF", (0.0, 0.0, p["frame_height"]))
     asm.add_mass("BF", frame, rigid_mass_matrix(
@@ -387,31 +430,4 @@ def build_model(parameters: Parameters) -> BogieModel:
                      channels=("force", "", ""))))
     positions["secondary.traction_link"] = link_point
 
-    # healthy motor (ID2): torque depends on the rotor's speed relative to the stator
-    motor = np.zeros((n, n))
-    rotor2, stator2 = dofs.index("ID2.rotor.ry"), dofs.index("ID2.stator.ry")
-    motor[np.ix_([rotor2, stator2], [rotor2, stator2])] = [[1.0, -1.0], [-1.0, 1.0]]
-
-    # short circuit torque on ID1: M_C in the driving sense.  Forward running spins the wheels
-    # +ry and, through one external gear mesh, the rotor −ry: a driving torque is −ry on the rotor
-    # and its reaction +ry on the stator.
-    short_circuit = np.zeros(n)
-    short_circuit[dofs.index("ID1.rotor.ry")] = -1.0
-    short_circuit[dofs.index("ID1.stator.ry")] = 1.0
-
-    rigid = np.zeros((n, 4), dtype=dtype)
-    for column, prefix in enumerate(DRIVES):
-        for name in dofs.names:
-            if name.startswith(prefix) and name.endswith(".ry") and ".stator." not in name:
-                rigid[dofs.index(name), column] = 1.0
-        for part in ("rotor", "pinion"):
-            rigid[dofs.index(f"{prefix}.{part}.ry"), column] = -p["gear_ratio"]
-    # the whole vehicle: longitudinal translation, yaw about the vertical through the bogie centre
-    rigid[:, 2] = _rigid_motion(asm.bodies, dofs, np.array([1.0, 0.0, 0.0]), np.zeros(3))
-    rigid[:, 3] = _rigid_motion(asm.bodies, dofs, np.zeros(3), np.array([0.0, 0.0, 1.0]))
-
-    rims = {f"{prefix}.rim{k}": dofs.indices([f"{prefix}.rim{k}.{a}" for a in AXES6])
-            for prefix in DRIVES for k in RIM_NODES}
-    return BogieModel(p, dofs, asm.M, asm.K, asm.B, _parts(asm.mass_parts),
-                      _parts(asm.stiffness_parts), asm.connections, rims, motor, short_circuit,
-                      rigid, positions)
+    return asm, dofs, positions

@@ -214,6 +214,17 @@ STRUCTURAL_PARAMETERS = (
 )
 SEARCH_PARAMETERS = CREEP_SHAPE_PARAMETERS + STRUCTURAL_PARAMETERS
 FREE_PARAMETERS = CREEP_PARAMETERS + SEARCH_PARAMETERS
+BOUND_TOLERANCE = 1e-3  # a value this close to a bound sits on it (relative; of the range if linear)
+
+
+def on_bound(free: FreeParameter, value: float) -> bool:
+    """Whether ``value`` sits on one of the calibration bounds of ``free``: within 0.1 % of it
+    (log-searched parameters), or within 0.1 % of the range (the others)."""
+    if free.log:
+        return min(abs(math.log(value / free.low)), abs(math.log(value / free.high))) \
+            <= BOUND_TOLERANCE
+    return min(abs(value - free.low), abs(value - free.high)) \
+        <= BOUND_TOLERANCE * (free.high - free.low)
 
 
 # a rigid body's principal inertias obey the triangle inequalities |I_x − I_y| <= I_z <= I_x + I_y

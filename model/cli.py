@@ -327,6 +327,10 @@ from .report_cli import register as _register_report  # noqa: E402
 
 EXTRA_COMMANDS.append(_register_report)
 
+from .parameters_cli import register as _register_parameters  # noqa: E402 - issue 27
+
+EXTRA_COMMANDS.append(_register_parameters)
+
 
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits

@@ -61,7 +61,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from .assembly import BogieModel, build_model
+from .assembly import BogieModel, assembled_matrices, build_model
 from .contact import PolachLaw, creep_block, kalker_creep_coefficients
 from .eigen import EigenResult, eigen_analysis
 from .modes import characterize
@@ -161,8 +161,8 @@ def structural_derivatives(model: BogieModel, progress=None,
         missing = [name for name in wanted if name not in done_names]
         for done, name in enumerate(missing):
             h = _step(p[name])
-            perturbed = build_model(complex_step_parameters(p, name, h))
-            derivative = _restrict(perturbed.M.imag / h, perturbed.B.imag / h, perturbed.K.imag / h)
+            M, B, K = assembled_matrices(complex_step_parameters(p, name, h))
+            derivative = _restrict(M.imag / h, B.imag / h, K.imag / h)
             if derivative is not None:
                 cache[name] = derivative
             done_names.add(name)
