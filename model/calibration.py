@@ -1,35 +1,33 @@
 """Calibration (model updating) of the uncertain parameters against the published results.
 
-The free parameters are searched on their logarithms, each within documented bounds
-(:data:`FREE_PARAMETERS`, with the reason for each bound: about x3 around the estimate and within
-what the part can physically be).  Targets, all at 120 km/h, N0 = 10^5 N (:func:`rank_cost`):
+The free parameters (:data:`FREE_PARAMETERS`) are searched each within documented bounds (the
+reason for each next to it: about x3 around the estimate and within what the part can physically
+be), on their logarithms (heights on their values).  Targets, all at 120 km/h, N0 = 10^5 N:
 
 * **Table 1 by rank**: the k-th complex pair by imaginary part at s0 = 0.005 against the
-  published k-th, k = 1…10, and it must have Table 2's k-th character (:data:`MODE_SIGNATURES`:
-  energy shares, directions and phases, optimal one-to-one assignment over the lowest
-  candidates).  A mode that sits at rank k with another character costs its rank's frequency
-  miss, the character-matched mode's own frequency miss and a fixed penalty;
-* the real parts of modes 1, 3, 4, 8, 9, 10 at s0 = 0.005 (soft; 30 % or 0.05 1/s), and of the
-  wheelset modes 7–10 at s0 = 0.014 (soft, weaker); mode 2's damping is *not* a target (it
-  cannot be reached with an eq.-19 creep block and physical inertias, see docs/validation.md);
+  published k-th, k = 1…10, with Table 2's k-th character (:data:`MODE_SIGNATURES`: energy
+  shares, directions and phases, optimal one-to-one assignment over the lowest candidates);
+* the real parts of modes 1, 3, 4, 8, 9, 10 at s0 = 0.005 (30 % or 0.05 1/s); mode 2's damping
+  is *not* a target (it cannot be reached with an eq.-19 creep block and physical inertias, see
+  docs/validation.md);
 * the 298.4 Hz driving-shaft mode (largest strain share of ID1's driving shaft);
-* at s0 = 0.014 two positive real eigenvalues, the larger against +7.031 1/s;
+* at s0 = 0.014 two positive real eigenvalues (+7.031, +0.062 1/s) and no more;
 * the operating data M(s0, v) = 12 800 N m at s0 = 0.005 and 0.014 and M_ad = 0.52·10⁵ N m,
   and the stability limit 0.0082: the creep law's (μ0, A, B) and the gear ratio p are solved
-  for them exactly (stage A, four equations, four unknowns) inside every evaluation, for the
-  creep shape (kA, kS, initial slope) the search proposes; the limit is the creep maximum unless
-  a flutter mode turns unstable first, which a check just below 0.0082 rules out.
+  for them (**stage A**, four equations, four unknowns) inside every evaluation, for the creep
+  shape (kA, kS, initial slope) the search proposes; the limit is the creep maximum unless a
+  flutter mode turns unstable first, which a check just below 0.0082 rules out.
 
-Search: compass (pattern) searches on the logarithms with a soft-L1 loss (the character
-assignment makes the cost jump where modes trade places, which stalls a gradient method): stage
-B1 places the ten characters (:func:`character_cost`), stage B2 minimises :func:`rank_cost`.  An
-evaluation of stage B2 costs one eigen-analysis with vectors at s0 = 0.005 (characters only for the lowest
-:data:`CANDIDATES` pairs), one without at 0.014 and one without just below the limit; the later
-ones are skipped as soon as the partial cost exceeds the best so far.  Stages C–F
-(:func:`rank_stages`) then move the modes of other characters out of the band below 12.6 Hz and
-put the ten in Table 1's order, ending on B2's cost with the ranking held
-(:func:`ranked_search_cost`).  Everything is deterministic (fixed move order and budgets):
-``bogie calibrate`` reproduces ``assets/parameters/calibrated.toml`` byte for byte.
+**Stage J** (:func:`jacobian_stage`, issue 27) fits the creep shape, the structure, the dampers
+and the motor slope: scipy's bounded trust-region-reflective least squares on residuals that are
+smooth functions of eigenvalues (the comment above :data:`EXTRA_CUT` lists them), with the
+Jacobian from the eigenvalue sensitivities of :mod:`model.sensitivity` (exact derivative
+matrices, ``dλ/dp = −yᴴ(λ²M′ + λB′ + K′)x / yᴴ(2λM + B)x``), checked against finite differences
+in the tests.  Its phases (:data:`PHASES`) fit the characters' frequencies first, then all
+targets.  Replacing the compass searches of stages B–F (26 min) it takes about a minute.
+Everything is deterministic (no random numbers, no time limits, one BLAS thread):
+``bogie calibrate`` reproduces ``assets/parameters/calibrated.toml`` byte for byte
+(``scripts/bench_calibration.py`` checks it).
 
 The published targets live here, as *targets* of the fit; the model never reads them.
 """
@@ -151,10 +149,11 @@ CREEP_SHAPE_PARAMETERS = (
     FreeParameter("creep_slope", 130.0, 3000.0, "Kalker's slope for this contact (~130) … 5x the "
                   "spec's starting fit (600)"),
 )
-# stage B: the structure, the dampers and the motor slope against Table 1.  Inertias and
+# stage J: the structure, the dampers and the motor slope against Table 1.  Inertias and
 # stiffnesses within about x3 of their estimate and within what the part can be; bounds that the
 # previous calibration sat on (frame roll inertia 5 000, stator pitch inertia 557 kg m^2) are
-# tightened to physical limits of a 3.5 t frame and a 2.6 t motor with gear housing
+# tightened to physical limits of the frame (4.9 t with its equipment) and a 2.6 t motor with
+# its gear housing
 STRUCTURAL_PARAMETERS = (
     FreeParameter("secondary_stiffness_z", 2e5, 1.8e6, "x3 around 0.6 MN/m (1.26 Hz with 28 t)"),
     FreeParameter("disc_clutch_torsional_stiffness", 2.3e4, 2.1e5, "x3 around 7e4 N m/rad"),
@@ -816,8 +815,8 @@ def evaluate(parameters: Parameters) -> list[TargetRow]:
     e = evaluate_by_rank(parameters)
     rows = []
     for k, target in enumerate(TABLE1_IM_HZ, start=1):
-        mark = "" if e.character_ok[k - 1] else " (other character!)"
-        rows.append(TargetRow(f"Im λ{k} by rank [{MODE_SIGNATURES[k - 1][0]}]{mark}", target,
+        mark = "" if e.character_ok[k - 1] else " OTHER CHARACTER:"  # before the long name
+        rows.append(TargetRow(f"Im λ{k} by rank{mark} [{MODE_SIGNATURES[k - 1][0]}]", target,
                               e.stable[k - 1].imag / (2 * np.pi), "Hz"))
     for k in RE_MODES:
         rows.append(TargetRow(f"Re λ{k} at s0=0.005", TABLE1_RE[k - 1],
