@@ -4,7 +4,8 @@ State ``u = [Δq; Δq̇]``, ``u̇ = A u`` with ``A = [[0, I], [−M⁻¹K, −M�
 internal coordinates of the Maxwell elements (yaw dampers) are first order, their velocities are
 not states (:mod:`model.linear_system`): ``u = [Δq; Δq̇_inertial]``.  The rigid-body
 zero eigenvalues are *identified*, not guessed: every vector ``r`` with ``K r = 0`` (the rigid spin
-of each whole drivetrain, known from the kinematics and checked against K) gives the exact
+of each whole drivetrain, the whole vehicle's translation and yaw, known from the kinematics and
+checked against K) gives the exact
 eigenpair ``(0, [r; 0])`` whatever the damping, and the invariant subspace they span is deflated
 before the eigenvalues of the rest are computed (:mod:`model.linear_system`).  The decomposition
 with vectors is shared with the short-circuit response through :func:`bogie_system`.
