@@ -160,6 +160,14 @@ def figure_peaks(parameters, out: Path) -> None:
     save(fig, out / "sensitivity_peaks.png")
 
 
+def _creep_maximum(law, v: float) -> float:
+    """The creep maximum s_max(v) [-], NaN where the law has none below s = 1."""
+    try:
+        return law.maximum(v)[0]
+    except ValueError:
+        return float("nan")
+
+
 def figure_uncertainty(model, parameters, path: Path, out: Path) -> None:
     data = json.loads(path.read_text(encoding="utf-8"))
     names = [p["name"] for p in data["parameters"]]
@@ -172,11 +180,12 @@ def figure_uncertainty(model, parameters, path: Path, out: Path) -> None:
         changed = {n: v for n, v in zip(names, row, strict=True)
                    if n.startswith("polach_") or n == "creep_slope"}
         law = creep_law(Parameters({**parameters.values, **changed}))
-        curves.append([law.maximum(v * KMH)[0] for v in speeds])
+        curves.append([_creep_maximum(law, v * KMH) for v in speeds])
     curves = np.array(curves)
-    nominal = [creep_law(parameters).maximum(v * KMH)[0] for v in speeds]
+    nominal = [_creep_maximum(creep_law(parameters), v * KMH) for v in speeds]
     fig, ax = plt.subplots(figsize=(8, 4.2), layout="constrained")
-    low, mid, high = np.percentile(curves, [5, 50, 95], axis=0)
+    # a sample whose law has no maximum below s = 1 at a speed has none there (NaN, left out)
+    low, mid, high = np.nanpercentile(curves, [5, 50, 95], axis=0)
     ax.fill_between(speeds, low, high, color="tab:blue", alpha=0.25,
                     label="5–95 % of the creep maximum over the prior samples")
     ax.plot(speeds, mid, color="tab:blue", lw=0.8, ls="--", label="median")

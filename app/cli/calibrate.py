@@ -1,6 +1,7 @@
 """``bogie calibrate``: fit the uncertain parameters to the published results
-(:mod:`model.studies.calibration`); progress on stdout, or on stderr with ``--json``.
-Bad input: one line on stderr, exit status 2.
+(:mod:`model.studies.calibration`: stage A, the creep law and gear ratio to the operating data;
+stage J, bounded least squares on the analytic Jacobian); progress on stderr, the table of the
+targets (or ``--json``) on stdout.  Bad input: one line on stderr, exit status 2.
 """
 
 from __future__ import annotations
@@ -8,20 +9,20 @@ from __future__ import annotations
 import argparse
 import sys
 
-from app.cli.options import UsageError, bounded, positive_int
+from app.cli.options import UsageError, positive_int
+from app.cli.output import emit
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("calibrate", help="fit the uncertain parameters to the published results")
     p.add_argument("--start", default=None, metavar="FILE", help="starting set (default: estimate.toml)")
     p.add_argument("--out", default=None, metavar="FILE", help="output (default: calibrated.toml)")
-    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=2400,
-                   help="trial parameter sets of stages B1 and B2 (the characters, then Table 1 "
-                        "by rank), each up to three eigen-analyses (default %(default)s)")
-    p.add_argument("--budget-scale", type=bounded("--budget-scale", "(0.001, 10]"),
-                   default=1.0, help="multiply the evaluation budgets of stages D-F (the ranking; "
-                                     "default %(default)s; smaller for a quick check)")
-    p.add_argument("--json", action="store_true", help="progress to stderr")
+    p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=None,
+                   help="trial parameter sets of each least-squares phase at most (default: "
+                        "the calibration's own, as for the bundled set; smaller for a quick "
+                        "check)")
+    p.add_argument("--json", action="store_true", help="machine-readable JSON output (progress "
+                                                       "goes to stderr either way)")
     p.set_defaults(func=cmd_calibrate)
 
 
@@ -29,11 +30,16 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
     from pathlib import Path
 
     from model.mechanics.parameters import CALIBRATED_FILE, ESTIMATE_FILE
-    from model.studies.calibration import run
+    from model.studies.calibration import PHASES, run
 
     start = Path(args.start) if args.start else ESTIMATE_FILE
     out = Path(args.out) if args.out else CALIBRATED_FILE
     if not out.parent.is_dir():
         raise UsageError(f"directory '{out.parent}' does not exist")
-    run(start, out, max_evaluations=args.max_evaluations, scale=args.budget_scale,
-        progress=lambda text: print(text, file=sys.stderr if args.json else sys.stdout, flush=True))
+    phases = PHASES if args.max_evaluations is None else tuple(
+        (min(count, args.max_evaluations), weights) for count, weights in PHASES)
+    rows, table = run(start, out, phases=phases,
+                      progress=lambda text: print(text, file=sys.stderr, flush=True))
+    emit(args, {"out": str(out), "targets": [
+        {"name": row.name, "published": row.target, "achieved": row.achieved, "unit": row.unit,
+         "error": row.error} for row in rows]}, table)

@@ -17,6 +17,7 @@ from app.cli import (
     calibrate,
     compare,
     loads,
+    parameters,
     report,
     response,
     sensitivity,
@@ -28,7 +29,7 @@ from model.mechanics.parameters import ParameterError
 
 COMMAND_GROUPS = (analysis.register, calibrate.register, analysis.register_export, serve.register,
                   response.register, sensitivity.register, antislip.register, study.register,
-                  compare.register, report.register, loads.register)
+                  compare.register, report.register, loads.register, parameters.register)
 
 
 def build_parser() -> BogieParser:

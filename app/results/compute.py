@@ -139,8 +139,8 @@ def _point_displacements_direct(model_, q: np.ndarray) -> dict[str, np.ndarray]:
     index = {name: i for i, name in enumerate(model_.dofs.names)}
     out: dict[str, np.ndarray] = {}
     for point, position in model_.positions.items():
-        if point == "CB":
-            out[point] = np.array([0.0, 0.0, q[index["CB.z"]].real])
+        if point == "CB":  # longitudinal and vertical (its yaw turns it about its own point)
+            out[point] = np.array([q[index["CB.x"]].real, 0.0, q[index["CB.z"]].real])
             continue
         owner, own = drawing_owner(model_, point)
         u = np.array([q[index[f"{owner}.{a}"]].real for a in ("x", "y", "z")])

@@ -57,6 +57,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
 from model.analysis.eigen import eigen_analysis, state_space
+from model.analysis.linear_system import massless_coordinates
 from model.mechanics.assembly import BogieModel
 from model.mechanics.operating_point import (
     OperatingPoint,
@@ -103,11 +104,17 @@ class Anchor:
 
 
 def update_vectors(model: BogieModel) -> tuple[np.ndarray, np.ndarray]:
-    """(U, V), 2n x 4 each: A(c) = A_ref + (c − c_ref) U Vᵀ [U: 1/kg …, V: 1]."""
+    """(U, V), N x 4 each: A(c) = A_ref + (c − c_ref) U Vᵀ [U: 1/kg …, V: 1].  The creep acts on
+    the rims only (inertial coordinates): U = −[0; M_ii⁻¹ G_i], V = [0; G_i] on the state
+    [Δq; Δq̇_inertial] (:mod:`model.analysis.linear_system`)."""
     n = model.n
     G = longitudinal_creep_pattern(model)
+    inertial = np.setdiff1d(np.arange(n), massless_coordinates(model.M))
+    if np.any(G[np.setdiff1d(np.arange(n), inertial)]):
+        raise ValueError("the creep acts on a massless coordinate")
     Minv = state_space(model).inverse_mass
-    return (np.vstack([np.zeros((n, 4)), -Minv @ G]), np.vstack([np.zeros((n, 4)), G]))
+    G_i = G[inertial]
+    return (np.vstack([np.zeros((n, 4)), -Minv @ G_i]), np.vstack([np.zeros((n, 4)), G_i]))
 
 
 def _clusters(poles: np.ndarray, extra: np.ndarray | float = 0.0):
@@ -270,10 +277,13 @@ class Continuation:
             poles = members[k, :sizes[k]]
             block = np.diag(a.poles[poles]) + dc * (a.Ut[poles] @ a.Vt[:, poles])
             values = np.linalg.eigvals(block)
-            for i in np.flatnonzero(groups[pole_of] == k):  # nearest block value to each root
-                best = int(np.argmin(np.abs(values - tracked.roots[i])))
-                result[i] = values[best]
-                values[best] = np.inf
+            # the block's values to the group's roots by an optimal assignment on distance (a
+            # greedy nearest choice in index order cascaded when two real poles of the group
+            # merged into a pair: each took its neighbour's value, the last one a far one)
+            roots = np.flatnonzero(groups[pole_of] == k)
+            rows, columns = linear_sum_assignment(
+                np.abs(tracked.roots[roots][:, None] - values[None, :]))
+            result[roots[rows]] = values[columns]
         return result
 
     def _groups(self, dc: float, mu: np.ndarray) -> np.ndarray:

@@ -1,8 +1,11 @@
 """Eigenvalues and stability of the linearized bogie (eqs. 21–22 in first-order form).
 
-State ``u = [Δq; Δq̇]``, ``u̇ = A u`` with ``A = [[0, I], [−M⁻¹K, −M⁻¹B_total]]``.  The rigid-body
+State ``u = [Δq; Δq̇]``, ``u̇ = A u`` with ``A = [[0, I], [−M⁻¹K, −M⁻¹B_total]]``; the massless
+internal coordinates of the Maxwell elements (yaw dampers) are first order, their velocities are
+not states (:mod:`model.analysis.linear_system`): ``u = [Δq; Δq̇_inertial]``.  The rigid-body
 zero eigenvalues are *identified*, not guessed: every vector ``r`` with ``K r = 0`` (the rigid spin
-of each whole drivetrain, known from the kinematics and checked against K) gives the exact
+of each whole drivetrain, the whole vehicle's translation and yaw, known from the kinematics and
+checked against K) gives the exact
 eigenpair ``(0, [r; 0])`` whatever the damping, and the invariant subspace they span is deflated
 before the eigenvalues of the rest are computed (:mod:`model.analysis.linear_system`).  The decomposition
 with vectors is shared with the short-circuit response through :func:`bogie_system`.
@@ -14,9 +17,8 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-import scipy.linalg as sla
 
-from model.analysis.linear_system import LinearSystem, SystemCache
+from model.analysis.linear_system import LinearSystem, SystemCache, inertial_inverse_mass
 from model.mechanics.assembly import BogieModel
 from model.mechanics.operating_point import OperatingPoint, damping_matrix
 
@@ -29,8 +31,8 @@ class StateSpace:
 
     @cached_property
     def inverse_mass(self) -> np.ndarray:
-        n = self.model.n
-        return sla.cho_solve(sla.cho_factor(self.model.M), np.eye(n))
+        """M⁻¹ on the inertial coordinates (the massless ones excluded) [1/kg, …]."""
+        return inertial_inverse_mass(self.model.M)
 
     def system(self, B_total: np.ndarray) -> LinearSystem:
         """The first-order form with damping ``B_total`` (input: M_C, as :func:`bogie_system`)."""
@@ -39,7 +41,7 @@ class StateSpace:
                             self.inverse_mass)
 
     def state_matrix(self, B_total: np.ndarray) -> np.ndarray:
-        """A (2n x 2n) with damping ``B_total`` [1/s and 1/s² blocks]."""
+        """A (N x N) with damping ``B_total`` [1/s and 1/s² blocks]."""
         return self.system(B_total).A
 
 
@@ -53,7 +55,7 @@ def state_space(model: BogieModel) -> StateSpace:
 
 
 def state_matrix(model: BogieModel, op: OperatingPoint) -> np.ndarray:
-    """A (2n x 2n) at an operating point [1/s and 1/s² blocks]."""
+    """A (N x N, state [Δq; Δq̇_inertial]) at an operating point [1/s and 1/s² blocks]."""
     return state_space(model).state_matrix(damping_matrix(model, op))
 
 
@@ -62,9 +64,10 @@ class EigenResult:
     """All eigenvalues at an operating point.  Re in 1/s; ``im_hz`` = Im/(2π) in Hz."""
 
     operating_point: OperatingPoint
-    eigenvalues: np.ndarray  # the 2n − n_rigid non-rigid eigenvalues [1/s], unsorted
-    vectors: np.ndarray | None  # state eigenvectors (2n x len(eigenvalues)), [Δq; Δq̇]
+    eigenvalues: np.ndarray  # the N − n_rigid non-rigid eigenvalues [1/s], unsorted
+    vectors: np.ndarray | None  # state eigenvectors (N x len(eigenvalues)), [Δq; Δq̇_inertial]
     n_rigid: int  # identified rigid-body zero eigenvalues
+    n_coordinates: int  # n: the first n rows of a state vector are Δq
 
     @property
     def complex_index(self) -> np.ndarray:
@@ -110,8 +113,7 @@ class EigenResult:
         """Displacement part Δq of eigenvector ``index``, scaled to unit largest entry."""
         if self.vectors is None:
             raise ValueError("eigenvectors were not computed")
-        n = self.vectors.shape[0] // 2
-        q = self.vectors[:n, index]
+        q = self.vectors[:self.n_coordinates, index]
         return q / q[np.argmax(np.abs(q))]
 
 
@@ -144,6 +146,6 @@ def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) 
         system = cache.peek(op) if cache is not None else None
         if system is None:
             system = bogie_system(model, op, cached=False)
-        return EigenResult(op, system.eigenvalues(), None, n_rigid)
+        return EigenResult(op, system.eigenvalues(), None, n_rigid, model.n)
     system = bogie_system(model, op)
-    return EigenResult(op, system.eigen[0], system.state_vectors(), n_rigid)
+    return EigenResult(op, system.eigen[0], system.state_vectors(), n_rigid, model.n)

@@ -1,12 +1,15 @@
 """Export of the linear system at an operating point as ``.npz`` (for other tools).
 
 Arrays: ``M``, ``B`` (all damping at the point: structural + b_M B_M + B_ad), ``K``, ``dofs``
-(names), ``dof_units``, ``f_mc`` (generalized force per unit short-circuit torque M_C [1 or 1/m…]),
+(names), ``dof_units``, ``massless`` (indices of the coordinates without mass: the yaw dampers'
+strokes, whose rows and columns of M are zero — they are first order, ``B_mm q̇_m + B_mi q̇_i +
+K_m q = 0``; a first-order form keeps their displacements but not their velocities as states,
+see :mod:`model.analysis.linear_system`), ``f_mc`` (generalized force per unit short-circuit torque M_C [1 or 1/m…]),
 ``motor_torque`` (M(s0, v) [N m]), ``C_q``, ``C_v``, ``outputs`` (names of y = C_q Δq + C_v Δq̇),
 ``output_units``, ``output_steady`` (pre-fault values), ``operating_point`` (s0 [-], v [m/s],
 N0 [N], b_M [N m s/rad]).  Strings are numpy unicode arrays: load with ``allow_pickle=False``.
 
-For an independent nonlinear integrator (the check of :mod:`model.analysis.nonlinear`):
+For an independent nonlinear integrator (issue 10, :mod:`model.analysis.nonlinear`):
 ``B_without_longitudinal_creep`` (n x n, B_nl: ``B`` without eq. 19's b11 terms),
 ``creep_velocity_map`` (contacts x n, rows H_i: ``Δs_i v = H_i Δq̇`` [m/s]), ``creep_force_map``
 (n x contacts, columns of G: a unit longitudinal creep force), ``contacts`` (rim names),
@@ -21,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from model.analysis.linear_system import massless_coordinates
 from model.mechanics.assembly import BogieModel
 from model.mechanics.operating_point import OperatingPoint, damping_matrix, motor_torque
 from model.mechanics.outputs import output_matrices
@@ -48,6 +52,7 @@ def export_system(model: BogieModel, op: OperatingPoint, path: str | Path) -> No
         M=model.M, B=damping_matrix(model, op), K=model.K,
         dofs=np.array(model.dofs.names, dtype=str),
         dof_units=np.array([model.dofs.unit(n) for n in model.dofs.names], dtype=str),
+        massless=massless_coordinates(model.M),
         f_mc=model.short_circuit_force,
         motor_torque=np.float64(motor_torque(model.parameters, op)),
         C_q=outputs.C_q, C_v=outputs.C_v,

@@ -11,6 +11,22 @@ invariant subspace they span is deflated with an orthogonal ``Q = [Q1 Q2]`` (Hou
 reflectors, applied in O(N²) instead of formed):
 
     Qᵀ A Q = [[0, A12], [0, A22]],   Q1 spans [R; 0].
+
+Massless coordinates (exact, no artificial mass).  A coordinate whose row and column of M are
+zero — the internal coordinate of a Maxwell element, a damper in series with a spring, whose
+inner node has no mass — is first order: its row of ``M q̈ + B q̇ + K q = f u`` reads
+``B_mm q̇_m + B_mi q̇_i + K_m q = f_m u`` (``B_mm`` invertible: the damper).  The state then holds
+every coordinate but only the velocities of the inertial ones, ``x = [q; v]``, ``v = q̇_i``
+(N = n + n_i states), and
+
+    q̇_i = v,     q̇_m = −B_mm⁻¹ (K_m q + B_mi v − f_m u),
+    M_ii v̇ = −K_i q − B_ii v − B_im q̇_m + f_i u.
+
+Without massless coordinates this is the form above.  The full velocity is ``q̇ = V x + …`` with
+``V`` = the first n rows of A (:attr:`LinearSystem.velocity_map`; plus ``B_mm⁻¹ f_m u`` if an
+input acts on a massless coordinate, which the bogie's inputs never do); a generalized force
+enters as :meth:`LinearSystem.input_map`.  A rigid-body mode ``r`` (its massless part included:
+``K r = 0``) gives the exact eigenpair ``(0, [r; 0])`` as before.
 """
 
 from __future__ import annotations
@@ -98,22 +114,41 @@ class Deflation:
 class LinearSystem:
     """``M q̈ + B q̇ + K q = f u(t)``, rigid modes ``K R = 0`` (R: n x r, r may be 0).
 
-    The pieces that depend only on the system (not on the input) are computed on first use and
-    kept.  ``inverse_mass`` may be given (it does not depend on the operating point).
+    Coordinates whose row of M is zero are massless (first order, see the module docstring);
+    M restricted to the others is symmetric positive definite.  The pieces that depend only on
+    the system (not on the input) are computed on first use and kept.  ``inverse_mass`` may be
+    given: the inverse of M restricted to the inertial coordinates (it does not depend on the
+    operating point).
     """
 
-    M: np.ndarray  # n x n, symmetric positive definite
-    B: np.ndarray  # n x n (any)
+    M: np.ndarray  # n x n, symmetric positive semi-definite (zero rows: massless coordinates)
+    B: np.ndarray  # n x n (any; invertible on the massless coordinates)
     K: np.ndarray  # n x n, symmetric, null space spanned exactly by R
     f: np.ndarray  # n, generalized force per unit input
     R: np.ndarray  # n x r rigid-body modes
-    inverse_mass: np.ndarray | None = None  # M⁻¹ if known
+    inverse_mass: np.ndarray | None = None  # M_ii⁻¹ (inertial coordinates) if known
     _cache: dict = field(default_factory=dict, repr=False)
     _lock: threading.RLock = field(default_factory=threading.RLock, repr=False)
 
     @property
     def n(self) -> int:
+        """Number of coordinates (inertial and massless)."""
         return self.M.shape[0]
+
+    @property
+    def massless(self) -> np.ndarray:
+        """Indices of the massless coordinates (rows of M that are exactly zero)."""
+        return self._get("massless", lambda: massless_coordinates(self.M))
+
+    @property
+    def inertial(self) -> np.ndarray:
+        """Indices of the coordinates with mass (their velocities are states)."""
+        return self._get("inertial", lambda: np.setdiff1d(np.arange(self.n), self.massless))
+
+    @property
+    def N(self) -> int:
+        """Number of states: every coordinate and the velocities of the inertial ones."""
+        return self.n + len(self.inertial)
 
     def _get(self, key, build):
         with self._lock:  # sessions of the dashboard share systems: build each piece once
@@ -123,34 +158,73 @@ class LinearSystem:
 
     @property
     def Minv(self) -> np.ndarray:
+        """M_ii⁻¹: inverse of the mass matrix on the inertial coordinates (n_i x n_i)."""
         def build():
             if self.inverse_mass is not None:
                 return self.inverse_mass
-            return sla.cho_solve(sla.cho_factor(self.M), np.eye(self.n))
+            return inertial_inverse_mass(self.M, self.inertial)
         return self._get("Minv", build)
 
     @property
-    def A(self) -> np.ndarray:
-        """State matrix (2n x 2n) [1/s, 1/s²]."""
+    def _massless_damping(self) -> tuple[np.ndarray, np.ndarray]:
+        """(B_mm⁻¹, B_im): the damping on the massless coordinates and its coupling."""
         def build():
-            n, Minv = self.n, self.Minv
-            A = np.zeros((2 * n, 2 * n))
-            A[:n, n:] = np.eye(n)
-            A[n:, :n] = -Minv @ self.K
-            A[n:, n:] = -Minv @ self.B
-            return A
+            m, i = self.massless, self.inertial
+            B_mm = self.B[np.ix_(m, m)]
+            try:
+                inverse = np.linalg.inv(B_mm) if len(m) else np.zeros((0, 0))
+            except np.linalg.LinAlgError:
+                raise np.linalg.LinAlgError("a massless coordinate has no damping: its "
+                                            "first-order equation is singular") from None
+            return inverse, self.B[np.ix_(i, m)]
+        return self._get("massless_damping", build)
+
+    @property
+    def A(self) -> np.ndarray:
+        """State matrix (N x N) [1/s, 1/s²] of the state ``[q; v]`` (module docstring)."""
+        def build():
+            inverse = self._massless_damping[0] if len(self.massless) else None
+            return first_order_matrix(self.Minv, self.B, self.K, self.inertial, self.massless,
+                                      inverse)
         return self._get("A", build)
 
     @property
+    def velocity_map(self) -> np.ndarray:
+        """V (n x N): the velocities of all coordinates ``q̇ = V x`` without input (the inputs of
+        the bogie never act on a massless coordinate) [1, 1/s]."""
+        return self._get("velocity_map", lambda: self.A[:self.n])
+
+    def input_map(self, F: np.ndarray) -> np.ndarray:
+        """State input ``b`` (N, or N x k) of generalized forces ``F`` (n, or n x k): ``ẋ = A x +
+        b u`` for the force ``F u``."""
+        F = np.asarray(F)
+        i, m, n = self.inertial, self.massless, self.n
+        out = np.zeros((self.N, *F.shape[1:]), dtype=np.result_type(F, float))
+        F_i = F[i]
+        if len(m):
+            inverse, B_im = self._massless_damping
+            out[m] = inverse @ F[m]
+            F_i = F_i - B_im @ out[m]
+        out[n:] = self.Minv @ F_i
+        return out
+
+    def state_output(self, C_q: np.ndarray, C_v: np.ndarray) -> np.ndarray:
+        """Output rows on the state (p x N) of ``y = C_q q + C_v q̇`` (C_q, C_v: p x n)."""
+        C_q, C_v = np.atleast_2d(C_q), np.atleast_2d(C_v)
+        out = C_v @ self.velocity_map
+        out[:, :self.n] += C_q
+        return out
+
+    @property
     def b(self) -> np.ndarray:
-        """Input vector [0; M⁻¹ f] (2n)."""
-        return self._get("b", lambda: np.concatenate([np.zeros(self.n), self.Minv @ self.f]))
+        """Input vector of ``f`` (N)."""
+        return self._get("b", lambda: self.input_map(self.f))
 
     @property
     def deflation(self) -> Deflation:
         """Q = [Q1 Q2] with Q1 spanning the rigid subspace [R; 0]."""
-        return self._get("deflation",
-                         lambda: Deflation(np.vstack([self.R, np.zeros_like(self.R)])))
+        return self._get("deflation", lambda: Deflation(
+            np.vstack([self.R, np.zeros((len(self.inertial), self.R.shape[1]))])))
 
     @property
     def reduced(self) -> tuple[np.ndarray, np.ndarray]:
@@ -221,22 +295,22 @@ class LinearSystem:
 
     def step_particular(self, u0: float) -> tuple[np.ndarray, np.ndarray]:
         """(α, β) with x_p = α + β t solving ẋ = A x + b u0 [state units]."""
-        n, R = self.n, self.R
+        n, R, i = self.n, self.R, self.inertial
         r = R.shape[1]
         fu = self.f * u0
         if r == 0:
             q = np.linalg.solve(self.K, fu)
-            return np.concatenate([q, np.zeros(n)]), np.zeros(2 * n)
-        c = np.linalg.solve(R.T @ self.B @ R, R.T @ fu)  # spin velocities of the drift
+            return np.concatenate([q, np.zeros(len(i))]), np.zeros(self.N)
+        c = np.linalg.solve(R.T @ self.B @ R, R.T @ fu)  # rigid-body velocities of the drift
         v = R @ c
         bordered = np.block([[self.K, R], [R.T, np.zeros((r, r))]])
         q = np.linalg.solve(bordered, np.concatenate([fu - self.B @ v, np.zeros(r)]))[:n]
-        return np.concatenate([q, v]), np.concatenate([v, np.zeros(n)])
+        return np.concatenate([q, v[i]]), np.concatenate([v, np.zeros(len(i))])
 
     def exponential_particular(self, a: complex, mu: complex) -> np.ndarray:
         """x_μ with x_p = Re(x_μ e^(μt)) solving ẋ = A x + b Re(a e^(μt))."""
         q = np.linalg.solve(mu * mu * self.M + mu * self.B + self.K, self.f * a)
-        return np.concatenate([q, mu * q])
+        return np.concatenate([q, mu * q[self.inertial]])
 
     def eigenvalues(self) -> np.ndarray:
         """The non-rigid eigenvalues only [1/s] (no vectors; uses them if already computed)."""
@@ -246,12 +320,48 @@ class LinearSystem:
 
     def state_vectors(self) -> np.ndarray:
         """Unit eigenvectors x = Q1 A12 y/λ + Q2 y of A for the eigenvalues of :attr:`eigen`
-        (2n x 2n − r)."""
+        (N x N − r)."""
         lam, Yb, scale = self.eigen
         Y = Yb * scale[:, None]
         A12 = self.reduced[0]
         X = self.deflation.apply(np.vstack([(A12 @ Y) / lam, Y]))
         return X / np.linalg.norm(X, axis=0)
+
+
+def first_order_matrix(Minv: np.ndarray, B: np.ndarray, K: np.ndarray, inertial: np.ndarray,
+                       massless: np.ndarray, massless_damping_inverse: np.ndarray | None = None
+                       ) -> np.ndarray:
+    """State matrix A (N x N, N = n + n_i) of ``M q̈ + B q̇ + K q = 0`` on the state
+    ``[q; q̇_inertial]`` (module docstring); ``Minv`` = M⁻¹ on the inertial coordinates,
+    ``massless_damping_inverse`` = B_mm⁻¹ if known."""
+    n, m, i = K.shape[0], massless, inertial
+    A = np.zeros((n + len(i), n + len(i)))
+    A[i, n + np.arange(len(i))] = 1.0
+    K_i, B_ii = K[i], B[np.ix_(i, i)]
+    if len(m):
+        inverse = (np.linalg.inv(B[np.ix_(m, m)]) if massless_damping_inverse is None
+                   else massless_damping_inverse)
+        A[m, :n] = -inverse @ K[m]
+        A[m, n:] = -inverse @ B[np.ix_(m, i)]
+        B_im = B[np.ix_(i, m)]
+        K_i = K_i + B_im @ A[m, :n]
+        B_ii = B_ii + B_im @ A[m, n:]
+    A[n:, :n] = -Minv @ K_i
+    A[n:, n:] = -Minv @ B_ii
+    return A
+
+
+def massless_coordinates(M: np.ndarray) -> np.ndarray:
+    """Indices of the coordinates whose row of M is exactly zero (no mass, first order)."""
+    return np.flatnonzero(~np.any(M != 0, axis=1))
+
+
+def inertial_inverse_mass(M: np.ndarray, inertial: np.ndarray | None = None) -> np.ndarray:
+    """Inverse of M restricted to the inertial coordinates (Cholesky; n_i x n_i)."""
+    if inertial is None:
+        inertial = np.setdiff1d(np.arange(M.shape[0]), massless_coordinates(M))
+    M_ii = M[np.ix_(inertial, inertial)]
+    return sla.cho_solve(sla.cho_factor(M_ii), np.eye(len(inertial)))
 
 
 class SystemCache:

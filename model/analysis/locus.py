@@ -44,6 +44,7 @@ import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
 from model.analysis.eigen import eigen_analysis
+from model.analysis.linear_system import first_order_matrix, massless_coordinates
 from model.contact.creep import creep_block
 from model.mechanics.assembly import BogieModel
 from model.mechanics.operating_point import OperatingPoint, creep_coefficients, damping_matrix
@@ -97,20 +98,40 @@ def _coefficients(model: BogieModel, op: OperatingPoint) -> np.ndarray:
 
 
 class _Reduced:
-    """Projected matrices of the sweep on a basis Φ."""
+    """Projected matrices of the sweep on a basis Φ.
+
+    The massless coordinates (the Maxwell elements' internal coordinates,
+    :mod:`model.analysis.linear_system`) are kept exactly: Φ = [Φ_i, E_m] with Φ_i an orthonormal basis
+    of the inertial parts of the given vectors and E_m the unit vectors of the massless
+    coordinates, so the reduced model has the full model's first-order structure (its reduced
+    mass is ``diag(I, 0)`` in the mass-normalized coordinates) and an eigenvector whose inertial
+    part lies in span(Φ_i) is reproduced exactly."""
 
     def __init__(self, model: BogieModel, op: OperatingPoint, patterns, vectors: list[np.ndarray]):
-        U, s, _ = np.linalg.svd(np.hstack(vectors), full_matrices=False)
-        Phi = U[:, s > 1e-12 * s[0]]
+        massless = massless_coordinates(model.M)
+        stacked = np.hstack(vectors)
+        stacked[massless] = 0.0
+        U, s, _ = np.linalg.svd(stacked, full_matrices=False)
+        Phi_i = U[:, s > 1e-12 * s[0]]
+        E_m = np.zeros((model.n, len(massless)))
+        E_m[massless, np.arange(len(massless))] = 1.0
+        Phi = np.hstack([Phi_i, E_m])
+        r_i = Phi_i.shape[1]
         self.Phi = Phi
+        self.inertial = np.arange(r_i)  # reduced coordinates with mass
+        self.massless = np.arange(r_i, Phi.shape[1])  # the massless coordinates, kept
         self.M_Phi = model.M @ Phi
         self.K_Phi = model.K @ Phi
         C0 = model.B + op.b_M * model.motor_pattern
         self.C0_Phi = C0 @ Phi
         self.P_Phi = [P @ Phi for P in patterns]
-        # mass-normalize the reduced coordinates: Φᵀ M Φ = L Lᵀ
-        L = np.linalg.cholesky(Phi.T @ self.M_Phi)
-        self.Linv = sla.solve_triangular(L, np.eye(len(L)), lower=True)
+        if any(np.any(P[massless]) or np.any(P[:, massless]) for P in patterns):
+            raise ValueError("a creep pattern acts on a massless coordinate")
+        # mass-normalize the inertial reduced coordinates: Φ_iᵀ M Φ_i = L Lᵀ (Linv: block
+        # diagonal with the identity on the massless ones)
+        L = np.linalg.cholesky(Phi_i.T @ self.M_Phi[:, :r_i])
+        self.Linv = np.eye(Phi.shape[1])
+        self.Linv[:r_i, :r_i] = sla.solve_triangular(L, np.eye(r_i), lower=True)
         project = lambda X: self.Linv @ (Phi.T @ X) @ self.Linv.T  # noqa: E731
         self.K_r = project(self.K_Phi)
         self.C0_r = project(self.C0_Phi)
@@ -120,14 +141,23 @@ class _Reduced:
     def size(self) -> int:
         return self.Phi.shape[1]
 
+    @property
+    def mass_diagonal(self) -> np.ndarray:
+        """The reduced (mass-normalized) mass matrix's diagonal: 1 inertial, 0 massless."""
+        d = np.zeros(self.size)
+        d[self.inertial] = 1.0
+        return d
+
+    def first_order(self, K: np.ndarray, C: np.ndarray) -> np.ndarray:
+        """The reduced state matrix (state: reduced coordinates, velocities of the inertial
+        ones; :func:`model.analysis.linear_system.first_order_matrix`)."""
+        return first_order_matrix(np.eye(len(self.inertial)), C, K, self.inertial, self.massless)
+
     def solve(self, c: np.ndarray):
         """Ritz values and displacement vectors (Φ coordinates, unit norm) at coefficients c."""
         r = self.size
         C = self.C0_r + sum(ck * Pk for ck, Pk in zip(c, self.P_r, strict=True))
-        A = np.zeros((2 * r, 2 * r))
-        A[:r, r:] = np.eye(r)
-        A[r:, :r] = -self.K_r
-        A[r:, r:] = -C
+        A = self.first_order(self.K_r, C)
         lam, V = np.linalg.eig(A)  # numpy releases the GIL: the points run on several threads
         X = self.Linv.T @ V[:r]  # back from mass-normalized to Φ coordinates
         X /= np.linalg.norm(X, axis=0)
@@ -222,12 +252,7 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     operating point ``op`` stay fixed.  ``workers`` threads solve the reduced eigenproblems
     (default 2, the cores of the target machine).  A real eigenvalue inside the disc that meets a
     real one outside it continues as one half of the new complex pair (the other half is not
-    tracked); pairs that start complex stay conjugate pairs.
-
-    Stages: the start of the sweep (both ends solved exactly, the reduction basis; kept for a
-    repeated sweep), the reduced solutions of the inner points (on worker threads), the tracking
-    point by point (Newton refinement or an exact solve where the reduced one is not accurate
-    enough), and keeping the start for the next call."""
+    tracked); pairs that start complex stay conjugate pairs."""
     if parameter not in ("s0", "v"):
         raise ValueError(f"parameter must be 's0' or 'v', got '{parameter}'")
     values = np.asarray(values, dtype=float)
@@ -235,83 +260,59 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
         raise ValueError("need at least two finite parameter values")
     points = [replace(op, **{parameter: float(x)}) for x in values]  # validates each point
     coefficients = np.array([_coefficients(model, p) for p in points])
+    patterns = creep_patterns(model)
     radius = 2 * np.pi * max_frequency_hz
-    key = _sweep_start_key(model, points[0], points[-1], radius)
-    start = _sweep_start(model, op, points, key, radius, workers)
-    inner_keys = [c.tobytes() for c in coefficients[1:-1]]
-    solution = _InnerSolutions(start, coefficients[1:-1], inner_keys, workers)
-    eigenvalues, errors, dense, refined = _track(model, points, coefficients, start, solution,
-                                                 radius, rtol)
-    _keep_sweep_start(key, start, inner_keys, solution.solved)
-    return RootLocus(parameter, values, eigenvalues, errors, dense, op, start.reduced.size,
-                     refined)
+    controlled = 1.5 * radius  # accuracy is enforced for branches inside this disc
+    n, n_points = model.n, len(values)
 
-
-def _exact(model: BogieModel, point: OperatingPoint) -> tuple[np.ndarray, np.ndarray]:
-    """All eigenvalues at ``point`` [1/s] and their displacement parts, unit norm."""
-    result = eigen_analysis(model, point)
-    q = result.vectors[:model.n]
-    return result.eigenvalues, q / np.linalg.norm(q, axis=0)
-
-
-def _sweep_start(model: BogieModel, op: OperatingPoint, points: list, key, radius: float,
-                 workers: int) -> _SweepStart:
-    """The exact end points and the reduction basis of a sweep: the kept ones of an earlier
-    sweep with the same ends, else computed (both ends at once: numpy releases the GIL)."""
-    with _SWEEP_STARTS_LOCK:
-        start = _SWEEP_STARTS.get(key)
-        if start is not None and start.model is model:
-            _SWEEP_STARTS.move_to_end(key)
-            return start
-    if workers > 1:
-        last_future = _solver_pool(workers).submit(_exact, model, points[-1])
-        first = _exact(model, points[0])
-        last = last_future.result()
-    else:
-        first, last = _exact(model, points[0]), _exact(model, points[-1])
+    def exact(i: int):
+        result = eigen_analysis(model, points[i])
+        q = result.vectors[:n]
+        return result.eigenvalues, q / np.linalg.norm(q, axis=0)
 
     def modes(lam, Q):
         chosen = Q[:, np.abs(lam) < radius]
         return [chosen.real, chosen.imag]
 
-    reduced = _Reduced(model, op, creep_patterns(model),
-                       [model.rigid_body_modes, *modes(*first), *modes(*last)])
-    return _SweepStart(model, first, last, reduced, {})
-
-
-class _InnerSolutions:
-    """The reduced solutions of a sweep's inner points, asked for in order.  They do not depend
-    on each other: they are solved on ``workers`` threads (numpy's LAPACK calls release the GIL)
-    while the caller tracks the points in order as the solutions come in (tracking after all the
-    solves left a core idle for ≈ 0.8 s of a 200-point sweep); a point the kept start has solved
-    already is not solved again."""
-
-    def __init__(self, start: _SweepStart, inner: np.ndarray, keys: list[bytes], workers: int):
-        self.start, self.keys = start, keys
-        missing = [i for i, k in enumerate(keys) if k not in start.solutions]
-        self.unsolved = set(missing)
-        if workers > 1:
-            self.found = _solver_pool(workers).map(start.reduced.solve, inner[missing])
+    key = _sweep_start_key(model, points[0], points[-1], radius)
+    with _SWEEP_STARTS_LOCK:
+        start = _SWEEP_STARTS.get(key)
+        if start is not None and start.model is model:
+            _SWEEP_STARTS.move_to_end(key)
         else:
-            self.found = (start.reduced.solve(c) for c in inner[missing])
-        self.solved: list[tuple[np.ndarray, np.ndarray]] = []
-
-    def __call__(self, i: int) -> tuple[np.ndarray, np.ndarray]:
-        """The reduced solution (eigenvalues, reduced vectors) of inner point i."""
-        self.solved.append(next(self.found) if i in self.unsolved
-                           else self.start.solutions[self.keys[i]])
-        return self.solved[i]
-
-
-def _track(model: BogieModel, points: list, coefficients: np.ndarray, start: _SweepStart,
-           solution: _InnerSolutions, radius: float, rtol: float):
-    """(eigenvalues, error estimates, dense flags, refined count) of the tracked branches along
-    the sweep: each point's reduced solution is matched to the previous point's branches; the
-    few branches that are not accurate enough are refined by Newton's method in the full model,
-    and a point with too many (or an ambiguous match) is solved exactly."""
+            start = None
+    if start is None:
+        # the two exact end points at once (they decide the basis; numpy releases the GIL)
+        if workers > 1:
+            last_future = _solver_pool(workers).submit(exact, n_points - 1)
+            first = exact(0)
+            last = last_future.result()
+        else:
+            first, last = exact(0), exact(n_points - 1)
+        reduced = _Reduced(model, op, patterns,
+                           [model.rigid_body_modes, *modes(*first), *modes(*last)])
+        start = _SweepStart(model, first, last, reduced, {})
     first, last, reduced = start.first, start.last, start.reduced
-    controlled = 1.5 * radius  # accuracy is enforced for branches inside this disc
-    n_points = len(points)
+    # the reduced eigenproblems of the inner points do not depend on each other: they are solved
+    # on ``workers`` threads (numpy's LAPACK calls release the GIL) while this thread tracks and
+    # checks the points in order as their solutions come in (tracking after all the solves left
+    # a core idle for ≈ 0.8 s of a 200-point sweep); a point the kept start has solved already
+    # is not solved again
+    inner = coefficients[1:-1]
+    keys = [c.tobytes() for c in inner]
+    missing = [i for i, k in enumerate(keys) if k not in start.solutions]
+    if workers > 1:
+        found = _solver_pool(workers).map(reduced.solve, inner[missing])  # in order, as solved
+    else:
+        found = (reduced.solve(c) for c in inner[missing])
+    unsolved = set(missing)
+    solutions: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def solution(i: int) -> tuple[np.ndarray, np.ndarray]:
+        """The reduced solution of inner point i (asked for in order)."""
+        solutions.append(next(found) if i in unsolved else start.solutions[keys[i]])
+        return solutions[i]
+
     tracked = np.flatnonzero(np.abs(first[0]) < radius)
     eigenvalues = np.zeros((n_points, len(tracked)), dtype=complex)
     errors = np.zeros((n_points, len(tracked)))
@@ -319,6 +320,7 @@ def _track(model: BogieModel, points: list, coefficients: np.ndarray, start: _Sw
     eigenvalues[0], dense[0] = first[0][tracked], True
     previous_values, previous_vectors = first[0][tracked], first[1][:, tracked]
     refined = 0
+
     for i in range(1, n_points):
         if i != n_points - 1:
             lam, X = solution(i - 1)
@@ -328,6 +330,7 @@ def _track(model: BogieModel, points: list, coefficients: np.ndarray, start: _Sw
             values_i, vectors_i = lam[chosen], X_full[:, chosen]
             failing = np.flatnonzero((estimate > rtol) & (np.abs(values_i) < controlled))
             if ok and len(failing) <= max(2, len(chosen) // 4):
+                # refine the few inaccurate branches by Newton's method in the full model
                 C = damping_matrix(model, points[i]) if len(failing) else None
                 for b in failing:
                     values_i[b], vectors_i[:, b], estimate[b] = _newton(
@@ -337,23 +340,18 @@ def _track(model: BogieModel, points: list, coefficients: np.ndarray, start: _Sw
                     eigenvalues[i], errors[i] = values_i, estimate
                     previous_values, previous_vectors = values_i, vectors_i
                     continue
-        lam, Q = last if i == n_points - 1 else _exact(model, points[i])  # dense: exact here
+        lam, Q = last if i == n_points - 1 else exact(i)  # dense: exact at this point
         chosen, _ = _assign(previous_vectors, previous_values, Q, lam)
         eigenvalues[i], dense[i] = lam[chosen], True
         previous_values, previous_vectors = lam[chosen], Q[:, chosen]
-    return eigenvalues, errors, dense, refined
-
-
-def _keep_sweep_start(key, start: _SweepStart, inner_keys: list[bytes], solved: list) -> None:
-    """Keep the sweep's start (and, for a short sweep, its reduced solutions) for the next one."""
     with _SWEEP_STARTS_LOCK:
-        if len(inner_keys) <= _SOLUTIONS_KEPT:
-            start = _SweepStart(start.model, start.first, start.last, start.reduced,
-                                dict(zip(inner_keys, solved, strict=True)))
+        if len(inner) <= _SOLUTIONS_KEPT:
+            start = _SweepStart(model, first, last, reduced, dict(zip(keys, solutions, strict=True)))
         _SWEEP_STARTS[key] = start
         _SWEEP_STARTS.move_to_end(key)
         while len(_SWEEP_STARTS) > _SWEEP_STARTS_KEPT:
             _SWEEP_STARTS.popitem(last=False)
+    return RootLocus(parameter, values, eigenvalues, errors, dense, op, reduced.size, refined)
 
 
 def _newton(M, C, K, lam: complex, x: np.ndarray, rtol: float, iterations: int = 6,
@@ -400,9 +398,24 @@ def _assign(previous_vectors, previous_values, vectors, values):
 
 
 def dense_generalized_eigenvalues(model: BogieModel, op: OperatingPoint) -> np.ndarray:
-    """All 2n eigenvalues of ``[λ N + P] u = 0`` (eqs. 21–22), dense QZ — the naive reference."""
+    """All finite eigenvalues of ``[λ N + P] u = 0`` (eqs. 21–22), dense QZ — the naive reference.
+
+    A massless coordinate (zero row of M, :mod:`model.analysis.linear_system`) would make the first block
+    row of eq. 22 vanish; there ``M̂`` (M with a unit entry on the massless diagonal) takes M's
+    place in N's first row and P, which keeps ``w = λ q`` for every coordinate and adds one
+    infinite eigenvalue per massless coordinate, dropped.  Without massless coordinates this is
+    eqs. 21–22 as published (2n eigenvalues)."""
     n = model.n
     Z = np.zeros((n, n))
-    N = np.block([[Z, model.M], [model.M, damping_matrix(model, op)]])
-    P = np.block([[-model.M, Z], [Z, model.K]])
-    return sla.eig(-P, N, right=False, check_finite=False)
+    M_hat = model.M.copy()
+    massless = massless_coordinates(model.M)
+    M_hat[massless, massless] = np.abs(np.diag(model.M)).max()
+    N = np.block([[Z, M_hat], [model.M, damping_matrix(model, op)]])
+    P = np.block([[-M_hat, Z], [Z, model.K]])
+    alpha, beta = sla.eig(-P, N, right=False, check_finite=False, homogeneous_eigvals=True)
+    if not len(massless):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return alpha / beta
+    order = np.argsort(np.abs(beta) / np.maximum(np.abs(alpha), 1e-300))
+    finite = np.sort(order[len(massless):])  # the n_m eigenvalues nearest to infinity dropped
+    return alpha[finite] / beta[finite]

@@ -25,7 +25,8 @@ COMPONENT_LABELS = {
 }
 # element group (stiffness part) -> what deforms
 STRAIN_LABELS = {
-    "secondary": "secondary suspension", "track": "track",
+    "secondary": "secondary suspension", "track": "track", "yaw_dampers": "yaw dampers",
+    "traction_link": "traction link", "anti_roll_bar": "anti-roll bar",
     **{f"ID{k}.{group}": f"{label} {k}" for k in (1, 2) for group, label in (
         ("driving_shaft", "twisting of driving shaft"), ("gear_mesh", "gearing deformation"),
         ("disc_clutch", "twisting of disc clutch"), ("claw_clutch", "claw clutch"),

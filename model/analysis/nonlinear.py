@@ -219,7 +219,8 @@ class NonlinearResult:
     torque_reduction: np.ndarray  # change of ID2's motor torque by the protection [N m]
     contact_velocity: np.ndarray | None = None  # N x contacts: H Δq̇ [m/s] (for checks)
     remainder_force: np.ndarray | None = None  # N x contacts: r(H Δq̇) [N]
-    states: np.ndarray | None = None  # N x 2n: [Δq; Δq̇] without the rigid angles, if asked
+    states: np.ndarray | None = None  # samples x N: [Δq; Δq̇_inertial] without the rigid angles,
+    # if asked
 
     def perturbation(self, name: str) -> np.ndarray:
         """Δy(t) = total − pre-fault value [unit of the output]."""
@@ -243,7 +244,7 @@ class _Setup:
     W: np.ndarray  # channels x m: [H; slope row] Δq̇ = Re(W ζ) (4 contacts + ID2's slope torque)
     D1: np.ndarray  # channels x channels: Re(W P1)
     lam: np.ndarray  # kept eigenvalues [1/s]
-    modal_to_state: np.ndarray  # 2n x m: x = Re(X ζ) (rigid angles left out)
+    modal_to_state: np.ndarray  # N x m: x = Re(X ζ) (rigid angles left out)
 
 
 def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
@@ -252,22 +253,16 @@ def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
     cached = system._cache.get(key)
     if cached is not None:
         return cached
-    n = model.n
     lam, Y, _, _, scale = system.modal
     deflation = system.deflation
     r = system.R.shape[1]
     keep = lam.imag >= 0
     weight = np.where(lam.imag > 0, 2.0, 1.0)[keep]
-    Minv = system.Minv
     G = creep_force_map(model)
     f_m2 = motor2_force(model)
     # inputs: M_C, ΔM_2, the creep remainders, ID2's motor torque again (the channel through
     # which the protection scales the motor's slope torque b_M Δω)
-    inputs = np.zeros((2 * n, 3 + G.shape[1]))
-    inputs[n:, 0] = Minv @ model.short_circuit_force
-    inputs[n:, 1] = Minv @ f_m2
-    inputs[n:, 2:-1] = Minv @ G
-    inputs[n:, -1] = Minv @ f_m2
+    inputs = system.input_map(np.column_stack([model.short_circuit_force, f_m2, G, f_m2]))
     rhs = deflation.apply_transpose(inputs)[r:] / scale[:, None]
     beta = system.solve_eigenvectors(rhs)[keep]  # m x (2 + contacts)
     lam_k = lam[keep]
@@ -281,7 +276,7 @@ def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
     H = creep_velocity_map(model)
     rotor2 = model.dofs.index("ID2.rotor.ry")
     slope_row = op.b_M * model.motor_pattern[rotor2]  # ID2's slope torque change = row · Δq̇
-    W = np.vstack([H, slope_row]) @ X[n:]
+    W = np.vstack([H, slope_row]) @ (system.velocity_map @ X)
     P1 = beta[:, 2:] * w1[:, None]
     setup = _Setup(E=E, w0=w0, w1=w1, beta_mc=beta[:, 0], P0=beta[:, 2:] * w0[:, None], P1=P1,
                    p0_2=beta[:, 1] * w0, p1_2=beta[:, 1] * w1, W=np.ascontiguousarray(W),
@@ -312,7 +307,8 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     :func:`model.mechanics.outputs.output_matrices` (default all); ``strength`` [N m]: a design strength
     reported as limit "strength" for the disc clutch, claw clutch and (referred by p) driving
     shaft torques; ``substeps``: integration steps per output sample (step h = 1/(fs·substeps));
-    ``keep_states``: also return the states [Δq; Δq̇] at the samples (memory N x 2n);
+    ``keep_states``: also return the states [Δq; Δq̇_inertial] at the samples (memory samples x N,
+    N states: :class:`model.analysis.linear_system.LinearSystem`);
     ``excitation_scale``: M_C(t) (step and oscillation) multiplied by this factor (checks of the
     small-amplitude limit; the result's ``M_C`` is the scaled torque).
     """
@@ -341,7 +337,6 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
                                  f"({', '.join(matrices.names[:3])}, …)")
     h = 1.0 / (fs * substeps)
     setup = _setup(model, op, h)
-    n = model.n
     p = model.parameters
     law = creep_law(p, op.N0)
     coefficients = creep_coefficients(p, op)
@@ -383,8 +378,9 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     iterations = np.zeros(1, dtype=np.int64)
     # outputs: y = Re(V ζ) for the loads; the creep forces from z
     loads = [name for name in names if not name.endswith(("creep_force", "adhesion_moment"))]
-    C = np.array([np.concatenate([matrices.C_q[matrices.index(nm)], matrices.C_v[matrices.index(nm)]])
-                  for nm in loads]).reshape(len(loads), 2 * n)
+    system = bogie_system(model, op)
+    rows = [matrices.index(nm) for nm in loads]
+    C = system.state_output(matrices.C_q[rows], matrices.C_v[rows]).reshape(len(loads), system.N)
     V = C @ setup.modal_to_state  # loads x m
     if keep_states:  # the states x = Re(X ζ) as further outputs of the loop
         V = np.vstack([V, setup.modal_to_state])

@@ -255,7 +255,7 @@ def _expm_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu
                   n_points: int, dt: float) -> tuple[np.ndarray, int]:
     """Perturbation outputs by the exact discretization of the state augmented with the
     generator of the input: y_k = C Φ^k z0, Φ = expm(F dt); (y, number of valid points)."""
-    n2 = 2 * system.n
+    n2 = system.N
     sigma, omega = -mu.real, mu.imag
     F = np.zeros((n2 + 3, n2 + 3))
     F[:n2, :n2] = system.A
@@ -288,7 +288,8 @@ def _expm_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu
 def solve_linear(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu: complex,
                  n_points: int, dt: float, method: str = "auto",
                  info: dict | None = None) -> tuple[np.ndarray, str, float]:
-    """Perturbation outputs ``C [q; q̇]`` (n_points x p) of ``M q̈ + B q̇ + K q = f u(t)``,
+    """Perturbation outputs ``C x`` (n_points x p; x = [q; q̇], the velocities of massless
+    coordinates left out, :class:`model.analysis.linear_system.LinearSystem`) of ``M q̈ + B q̇ + K q = f u(t)``,
     ``u = u0 + Re(a e^(μt))`` for t ≥ 0, at rest at t = 0, on the grid t_k = k dt.
 
     Returns (y, method used, error estimate relative to max|y| per output; NaN for "expm").
@@ -425,27 +426,29 @@ def time_grid_points(t_end, fs, error: type[ResponseError] = ResponseError) -> i
 
 def output_rows(model: BogieModel, op: OperatingPoint, outputs: list[str] | None = None
                 ) -> tuple[list[str], np.ndarray, dict[str, str], dict[str, float]]:
-    """(names, C, units, steady) of the requested outputs: ``C`` (p x 2n) maps the state
-    ``[Δq; Δq̇]`` to the perturbations, ``steady[name]`` is the pre-fault value [unit] (outputs of
-    :func:`model.mechanics.outputs.output_matrices`, default all of them, or DOF names); an unknown name
-    raises :class:`ResponseError`."""
+    """(names, C, units, steady) of the requested outputs: ``C`` (p x N) maps the state
+    ``[Δq; Δq̇]`` (the velocities of massless coordinates left out:
+    :class:`model.analysis.linear_system.LinearSystem`) to the perturbations,
+    ``steady[name]`` is the pre-fault value [unit] (outputs of
+    :func:`model.mechanics.outputs.output_matrices`, default all of them, or DOF names); an
+    unknown name raises :class:`ResponseError`."""
     matrices = output_matrices(model, op)
     names = list(matrices.names) if outputs is None else list(outputs)
     if not names:
         raise ResponseError("no outputs requested")
-    n = model.n
+    system = bogie_system(model, op)
     rows, units, steady = [], {}, {}
     q0 = None
     for name in names:
         if name in matrices.names:
             i = matrices.index(name)
-            rows.append(np.concatenate([matrices.C_q[i], matrices.C_v[i]]))
+            rows.append(system.state_output(matrices.C_q[i], matrices.C_v[i])[0])
             units[name], steady[name] = matrices.units[i], float(matrices.steady[i])
         elif name in model.dofs.names:
             if q0 is None:
                 q0 = static_deflection(model, op)
             i = model.dofs.index(name)
-            row = np.zeros(2 * n)
+            row = np.zeros(system.N)
             row[i] = 1.0
             rows.append(row)
             units[name], steady[name] = model.dofs.unit(name), float(q0[i])

@@ -33,11 +33,13 @@ What is *not* returned as a number (and said instead):
   the twin symmetry); such modes are flagged and their derivatives are NaN.
 
 Stability limit.  At ``s0*`` the critical eigenvalue has ``Re λc = 0``, so
-``ds0*/dp = −Re(∂λc/∂p)/Re(∂λc/∂s0)``.  When the critical eigenvalue is the divergence of ID1's
-drivetrain spin, its crossing is where ``rᴴ B r = 0`` for the rigid spin ``r``: only the
-longitudinal creep damping ``b11 ∝ ∂μ/∂s`` acts on ``r`` (all structural damping is
-stiffness-proportional or acts on translations, ``b_M`` acts on ID2 only), so ``s0*`` is the
-creep maximum ``∂μ/∂s = 0`` and the formula is 0/0 there (λc meets the rigid zero).  Then
+``ds0*/dp = −Re(∂λc/∂p)/Re(∂λc/∂s0)``.  When the critical eigenvalue is the divergence of a
+rigid-body motion's velocity — ID1's drivetrain spin together with the vehicle's longitudinal
+translation (the slip of wheelset 1) — its crossing is where ``rᴴ B r = 0`` for that rigid
+motion ``r``: only the longitudinal creep damping ``b11 ∝ ∂μ/∂s`` acts on it (all structural
+damping is stiffness-proportional or acts between bodies, ``b_M`` acts on ID2 only, the lateral
+creep on the yaw), so ``s0*`` is the creep maximum ``∂μ/∂s = 0`` and the formula is 0/0 there
+(λc meets the rigid zero).  Then
 ``ds0*/dp = −(∂μ′/∂p)/(∂μ′/∂s)`` (implicit function theorem, complex step through Polach's law)
 and is exactly zero for every structural parameter — reported as such, with the numbers.
 
@@ -63,7 +65,7 @@ from model.analysis.eigen import EigenResult, eigen_analysis
 from model.analysis.modes import characterize
 from model.analysis.stability import stability_limit
 from model.contact.creep import PolachLaw, creep_block, kalker_creep_coefficients
-from model.mechanics.assembly import BogieModel, build_model
+from model.mechanics.assembly import BogieModel, assembled_matrices, build_model
 from model.mechanics.operating_point import OperatingPoint, damping_matrix
 from model.mechanics.parameters import SCHEMA, Parameters
 
@@ -71,7 +73,7 @@ MODE_COUNT = 10  # the ten lowest complex pairs, as the rest of the tool reports
 COMPLEX_STEP = 1e-20  # relative imaginary step of the complex-step derivatives
 KALKER_STEP = 1e-4  # relative central-difference step of Kalker's coefficients f_ij
 NEAR_REPEATED = 1e-6  # relative gap |λ − λ_j|/|λ| below which a mode counts as a twin
-RIGID_SPIN_MAC = 0.99  # a real mode this close to a drivetrain's rigid spin is that spin
+RIGID_SPIN_MAC = 0.99  # a real mode this close to the rigid-body subspace is a rigid motion's velocity
 # a limit this close to the creep maximum (relative), set by ID1's spin, *is* the creep maximum:
 # root finders stop within their tolerance of it (the dashboard's 1e-6 absolute, Brent's 1e-7)
 CREEP_MAXIMUM_RTOL = 1e-3
@@ -143,27 +145,30 @@ def _step(value: float) -> float:
 _derivative_lock = threading.Lock()
 
 
-def structural_derivatives(model: BogieModel, progress=None) -> dict[str, MatrixDerivative]:
+def structural_derivatives(model: BogieModel, progress=None,
+                           names: Iterable[str] | None = None) -> dict[str, MatrixDerivative]:
     """∂(M, B, K)/∂p of the constant assembly for every parameter that enters it (complex step
-    through :func:`model.mechanics.assembly.build_model`; one complex assembly per parameter).  Cached on
-    the model: they depend on the parameter set only.  ``progress(done, total)`` if given."""
+    through :func:`model.mechanics.assembly.build_model`; one complex assembly per parameter), or for those
+    of ``names`` only (the calibration's free parameters).  Cached on the model per parameter:
+    they depend on the parameter set only.  ``progress(done, total)`` if given.  A parameter
+    that does not enter the assembly has no entry."""
     with _derivative_lock:
-        cached = model.__dict__.get("_structural_derivatives")
-        if cached is not None:
-            return cached
+        cache = model.__dict__.setdefault("_structural_derivatives", {})
+        done_names = model.__dict__.setdefault("_structural_derivatives_done", set())
         p = model.parameters
-        names = [name for name in SCHEMA if name not in NOT_IN_ASSEMBLY]
-        derivatives: dict[str, MatrixDerivative] = {}
-        for done, name in enumerate(names):
+        wanted = [name for name in (SCHEMA if names is None else names)
+                  if name not in NOT_IN_ASSEMBLY]
+        missing = [name for name in wanted if name not in done_names]
+        for done, name in enumerate(missing):
             h = _step(p[name])
-            perturbed = build_model(complex_step_parameters(p, name, h))
-            derivative = _restrict(perturbed.M.imag / h, perturbed.B.imag / h, perturbed.K.imag / h)
+            M, B, K = assembled_matrices(complex_step_parameters(p, name, h))
+            derivative = _restrict(M.imag / h, B.imag / h, K.imag / h)
             if derivative is not None:
-                derivatives[name] = derivative
+                cache[name] = derivative
+            done_names.add(name)
             if progress is not None:
-                progress(done + 1, len(names))
-        model.__dict__["_structural_derivatives"] = derivatives
-        return derivatives
+                progress(done + 1, len(missing))
+        return {name: cache[name] for name in wanted if name in cache}
 
 
 def _law(values: Mapping, N0) -> PolachLaw:
@@ -423,7 +428,7 @@ def eigen_sensitivities(model: BogieModel, op: OperatingPoint, indices: Iterable
                      f"{NEAR_REPEATED:g}): a twin of the two drives; its derivatives are not "
                      "meaningful and are NaN")
 
-    structural = structural_derivatives(model)
+    structural = structural_derivatives(model, names=wanted)
     names = tuple(wanted) + tuple(OPERATING_PARAMETERS)
     units = tuple(SCHEMA[name][0] for name in wanted) + tuple(OPERATING_PARAMETERS.values())
     values = np.array([model.parameters[name] for name in wanted]
@@ -477,7 +482,8 @@ class LimitSensitivity:
     N0: float  # [N]
     b_M: float  # [N m s/rad]
     s0_limit: float  # s0* [-]
-    mechanism: str  # "creep maximum" (ID1 drivetrain spin), "flutter" or "divergence"
+    mechanism: str  # "creep maximum" (a rigid-body velocity: ID1's spin, the translation),
+    # "flutter" or "divergence"
     critical_eigenvalue: complex  # λc at s0* [1/s]
     creep_maximum: float  # creepage of the creep maximum at v [-]
     dmu_ds_at_limit: float  # ∂μ/∂s at s0* [-]
@@ -494,9 +500,19 @@ class LimitSensitivity:
 
 
 def _rigid_spin_mac(model: BogieModel, q: np.ndarray) -> np.ndarray:
-    """MAC of a displacement vector with each drivetrain's rigid spin [-]."""
+    """MAC of a displacement vector with each rigid-body mode (the drivetrains' spins, the
+    vehicle's translation and yaw) [-]."""
     R = model.rigid_body_modes.real
     return np.abs(R.T @ q) ** 2 / (np.sum(R * R, axis=0) * np.real(np.vdot(q, q)))
+
+
+def _rigid_subspace_share(model: BogieModel, q: np.ndarray) -> float:
+    """‖P_R q‖² / ‖q‖² with P_R the orthogonal projector onto the rigid-body modes [-]: 1 for a
+    velocity mode of the rigid-body motions (e.g. ID1's spin together with the vehicle's
+    translation, the slip of wheelset 1 that crosses zero at the creep maximum)."""
+    Q, _ = np.linalg.qr(model.rigid_body_modes.real)
+    projection = Q.T @ q
+    return float(np.real(np.vdot(projection, projection)) / np.real(np.vdot(q, q)))
 
 
 def limit_sensitivity(model: BogieModel, v: float, N0: float, b_M: float,
@@ -531,13 +547,13 @@ def limit_sensitivity(model: BogieModel, v: float, N0: float, b_M: float,
     else:
         lam_c = complex(nearest)
     q, _ = null_vectors(model, B_total, lam_c, guess)
-    spin = lam_c.imag == 0 and _rigid_spin_mac(model, q)[0] > RIGID_SPIN_MAC
+    spin = lam_c.imag == 0 and _rigid_subspace_share(model, q) > RIGID_SPIN_MAC
     if not (spin and at_maximum) and result is None:
         result = eigen_analysis(model, op, vectors=False)
         critical = int(np.argmax(result.eigenvalues.real))
         lam_c = complex(result.eigenvalues[critical])
         q, _ = null_vectors(model, B_total, lam_c, guess)
-        spin = lam_c.imag == 0 and _rigid_spin_mac(model, q)[0] > RIGID_SPIN_MAC
+        spin = lam_c.imag == 0 and _rigid_subspace_share(model, q) > RIGID_SPIN_MAC
     names = (*tuple(wanted), "v", "N0", "b_M")
     units = (*tuple(SCHEMA[name][0] for name in wanted), "m/s", "N", "N m s/rad")
     values = np.array([model.parameters[name] for name in wanted] + [v, N0, b_M])
@@ -558,8 +574,10 @@ def limit_sensitivity(model: BogieModel, v: float, N0: float, b_M: float,
                                 for name in wanted] + [partial["v"], partial["N0"], partial["b_M"]])
         note = (f"s0* = {s0_limit:.7f} is the creep maximum (s_max = {s_max:.7f}, ∂μ/∂s(s0*) = "
                 f"{dmu:.2e}): the critical eigenvalue λc = {lam_c.real:.2e} 1/s is the divergence "
-                f"of ID1's drivetrain spin (MAC with the rigid spin "
-                f"{_rigid_spin_mac(model, q)[0]:.4f}); only the creep law moves it, "
+                f"of a rigid-body motion's velocity (ID1's drivetrain spin with the vehicle's "
+                f"translation: MAC with the rigid-body modes "
+                f"{', '.join(f'{x:.3f}' for x in _rigid_spin_mac(model, q))}, share of their "
+                f"span {_rigid_subspace_share(model, q):.4f}); only the creep law moves it, "
                 "ds0*/dp = −(∂μ′/∂p)/(∂μ′/∂s); every structural parameter: exactly 0")
         return LimitSensitivity(v, N0, b_M, s0_limit, "creep maximum", lam_c, s_max, dmu, names,
                                 units, values, derivatives, note)

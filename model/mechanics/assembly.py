@@ -6,15 +6,22 @@ the vertical axis through the bogie centre (positions and geometric directions m
 assembled once; an operating point only adds the motor slope ``B_M`` and the creep blocks
 ``B_ad`` (see :mod:`model.mechanics.operating_point`).
 
-DOF layout (193 coordinates; the study had 189 without stating its breakdown):
+DOF layout (197 coordinates; the study had 189 without stating its breakdown):
 
 * per drive ``IDk`` (93): ``rotor.ry``, ``pinion.ry``, ``gear.ry`` (spins in the gear housing;
   they translate and tilt with the stator), ``stator.{x,y,z,rx,ry,rz}``, hollow shaft beam nodes
   ``hs5…hs9`` (6 each; disc clutch at 5, claw clutch at 9), axle beam nodes ``ax10…ax16``
   (6 each; claw clutch at 10, journals 11 and 15, wheels 12 and 14, centre 13, under the gear 16),
   wheel rims ``rim12``, ``rim14`` (6 each);
-* ``BF.{x,y,z,rx,ry,rz}`` bogie frame, ``CB.z`` half car body (vertical only: its other motions
-  are restrained by the whole locomotive and are not part of the study's table of modes).
+* ``BF.{x,y,z,rx,ry,rz}`` bogie frame; ``CB.x``, ``CB.z``, ``CB.rz`` half car body (longitudinal,
+  vertical, yaw about the vertical through the bogie centre; its lateral, roll and pitch are held
+  by the rest of the locomotive); ``secondary.yaw_damper_{left,right}.stroke`` the massless inner
+  coordinates of the two yaw dampers (Maxwell elements: damper in series with its end bushes).
+
+Rigid-body modes (``K r = 0``, from the kinematics): the spin of each drivetrain (rotor at −p times
+the wheel) and, since nothing in this model holds the vehicle to the track longitudinally or in
+yaw but the creep (a damping), the longitudinal translation and the yaw about the bogie centre of
+the whole vehicle (car body, frame, drives) — four in all.
 """
 
 from __future__ import annotations
@@ -26,7 +33,7 @@ import numpy as np
 
 from model.mechanics.beam import TubeSection, beam_global_matrices
 from model.mechanics.bodies import Body, carried_body, free_body, rigid_mass_matrix
-from model.mechanics.connections import Spring, SpringDamper, axis_springs
+from model.mechanics.connections import MaxwellDamper, Spring, SpringDamper, axis_springs
 from model.mechanics.dofs import AXES6, DofMap
 from model.mechanics.parameters import Parameters
 
@@ -35,6 +42,8 @@ AXLE_NODES = (10, 11, 12, 13, 14, 15, 16)
 RIM_NODES = (12, 14)
 DRIVES = ("ID1", "ID2")
 CENTRAL_SYMMETRY = np.diag([-1.0, -1.0, 1.0])  # drive 2 = drive 1 turned 180° about z
+CAR_BODY_AXES = ("x", "z", "rz")  # the half car body's coordinates
+YAW_DAMPERS = ("secondary.yaw_damper_left", "secondary.yaw_damper_right")  # +y, −y side
 
 
 def dof_names() -> tuple[str, ...]:
@@ -51,7 +60,8 @@ def dof_names() -> tuple[str, ...]:
             names += [f"{prefix}.rim{node}.{a}" for a in AXES6]
         return names
 
-    return tuple(drive("ID1") + [f"BF.{a}" for a in AXES6] + ["CB.z"] + drive("ID2"))
+    return tuple(drive("ID1") + [f"BF.{a}" for a in AXES6] + [f"CB.{a}" for a in CAR_BODY_AXES]
+                 + [f"{damper}.stroke" for damper in YAW_DAMPERS] + drive("ID2"))
 
 
 @dataclass(frozen=True)
@@ -73,11 +83,12 @@ class BogieModel:
     B: np.ndarray  # structural damping (incl. track), without B_M and B_ad [N s/m, …]
     mass_parts: dict[str, Part]  # component name -> its share of M (kinetic energy bookkeeping)
     stiffness_parts: dict[str, Part]  # element group -> its share of K (strain energy)
-    connections: list[SpringDamper]  # every connection, for output quantities
+    connections: list[SpringDamper | MaxwellDamper]  # every connection, for output quantities
     rims: dict[str, np.ndarray]  # "ID1.rim12" -> indices of [x, y, z, rx, ry, rz]
     motor_pattern: np.ndarray  # n x n: B_M for b_M = 1 (ID2 rotor–stator, relative form)
     short_circuit_force: np.ndarray  # generalized force per unit M_C on ID1 (rotor, stator)
-    rigid_body_modes: np.ndarray  # n x 2: rigid spin of each whole drivetrain (K r = 0)
+    rigid_body_modes: np.ndarray  # n x 4: rigid spin of each whole drivetrain, longitudinal
+    # translation and yaw of the whole vehicle (K r = 0)
     positions: dict[str, np.ndarray] = field(default_factory=dict)  # part -> reference point [m]
 
     @property
@@ -85,43 +96,69 @@ class BogieModel:
         return len(self.dofs)
 
 
+def _support(W: np.ndarray) -> np.ndarray:
+    """Indices of the columns of W that are not zero (the coordinates a body's map touches)."""
+    return np.flatnonzero(np.any(W != 0, axis=0))
+
+
 class _Assembler:
+    """Adds each contribution on the coordinates it touches (a contribution is a few of the
+    ~200 coordinates: dense n x n products made an assembly 3-4x slower, and the complex-step
+    sensitivities assemble once per parameter)."""
+
     def __init__(self, dofs: DofMap, dtype=float):
         self.dofs = dofs
         n = len(dofs)
         self.M = np.zeros((n, n), dtype=dtype)
         self.K = np.zeros((n, n), dtype=dtype)
         self.B = np.zeros((n, n), dtype=dtype)
-        self.mass_parts: dict[str, np.ndarray] = {}
-        self.stiffness_parts: dict[str, np.ndarray] = {}
-        self.connections: list[SpringDamper] = []
+        # name -> contributions (index, matrix) of each component (M) and element group (K)
+        self.mass_parts: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
+        self.stiffness_parts: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
+        self.connections: list[SpringDamper | MaxwellDamper] = []
+        self.bodies: list[Body] = []  # free bodies and beam nodes (rigid-body modes)
 
-    def _add_part(self, store: dict, name: str, matrix: np.ndarray) -> None:
-        store[name] = store.get(name, 0.0) + matrix
+    @staticmethod
+    def _add_part(store: dict, name: str, index: np.ndarray, matrix: np.ndarray) -> None:
+        store.setdefault(name, []).append((index, matrix))
+
+    def free(self, name: str, origin, axes=AXES6) -> Body:
+        """A free body owning ``name.<axis>`` (kept for the rigid-body modes)."""
+        body = free_body(name, origin, self.dofs, axes)
+        self.bodies.append(body)
+        return body
 
     def add_mass(self, component: str, body: Body, M6: np.ndarray) -> None:
-        contribution = body.W.T @ M6 @ body.W
-        self.M += contribution
-        self._add_part(self.mass_parts, component, contribution)
+        index = _support(body.W)
+        W = body.W[:, index]
+        contribution = W.T @ M6 @ W
+        contribution = 0.5 * (contribution + contribution.T)  # exactly symmetric
+        self.M[np.ix_(index, index)] += contribution
+        self._add_part(self.mass_parts, component, index, contribution)
 
     def add_beam(self, group: str, component: str, node_a: Body, node_b: Body,
                  section: TubeSection, p: Parameters) -> None:
         K12, M12 = beam_global_matrices(node_a.origin, node_b.origin, section, p["young_modulus"],
                                         p["poisson_ratio"], p["steel_density"])
         G = np.vstack([node_a.W, node_b.W])
+        index = _support(G)
+        G = G[:, index]
         K = G.T @ K12 @ G
         M = G.T @ M12 @ G
-        self.K += K
-        self.B += p["shaft_loss_time"] * K
-        self.M += M
-        self._add_part(self.stiffness_parts, group, K)
-        self._add_part(self.mass_parts, component, M)
+        K, M = 0.5 * (K + K.T), 0.5 * (M + M.T)  # exactly symmetric
+        block = np.ix_(index, index)
+        self.K[block] += K
+        self.B[block] += p["shaft_loss_time"] * K
+        self.M[block] += M
+        self._add_part(self.stiffness_parts, group, index, K)
+        self._add_part(self.mass_parts, component, index, M)
 
-    def add_connection(self, connection: SpringDamper) -> None:
-        K, B = connection.matrices()
-        self.K += K
-        self.B += B
-        self._add_part(self.stiffness_parts, connection.group, K)
+    def add_connection(self, connection: SpringDamper | MaxwellDamper) -> None:
+        index, K, B = connection.local_matrices()
+        block = np.ix_(index, index)
+        self.K[block] += K
+        self.B[block] += B
+        self._add_part(self.stiffness_parts, connection.group, index, K)
         self.connections.append(connection)
 
     def add_ground_spring(self, group: str, index: int, stiffness: float, damping: float,
@@ -129,19 +166,24 @@ class _Assembler:
         self.K[index, index] += stiffness
         self.B[index, index] += damping
         self.M[index, index] += mass
-        k = np.zeros_like(self.K)
-        k[index, index] = stiffness
-        self._add_part(self.stiffness_parts, group, k)
-        m = np.zeros_like(self.M)
-        m[index, index] = mass
-        self._add_part(self.mass_parts, component, m)
+        at = np.array([index])
+        self._add_part(self.stiffness_parts, group, at, np.array([[stiffness]]))
+        self._add_part(self.mass_parts, component, at, np.array([[mass]]))
 
 
-def _parts(store: dict[str, np.ndarray]) -> dict[str, Part]:
+def _parts(store: dict[str, list[tuple[np.ndarray, np.ndarray]]]) -> dict[str, Part]:
+    """Each name's contributions summed on the union of their coordinates, without the rows and
+    columns that stay zero."""
     parts = {}
-    for name, matrix in store.items():
-        index = np.flatnonzero(np.any(matrix != 0, axis=0) | np.any(matrix != 0, axis=1))
-        parts[name] = Part(index, matrix[np.ix_(index, index)].copy())
+    for name, items in store.items():
+        union = np.unique(np.concatenate([index for index, _ in items]))
+        dtype = np.result_type(*[matrix for _, matrix in items])
+        matrix = np.zeros((len(union), len(union)), dtype=dtype)
+        for index, contribution in items:
+            position = np.searchsorted(union, index)
+            matrix[np.ix_(position, position)] += contribution
+        keep = np.any(matrix != 0, axis=0) | np.any(matrix != 0, axis=1)
+        parts[name] = Part(union[keep], matrix[np.ix_(keep, keep)].copy())
     return parts
 
 
@@ -158,8 +200,8 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
     y_gear, y_claw = p["gear_lateral_position"], p["claw_clutch_lateral_position"]
     x_motor = axle_x - (r_gear + r_pinion)  # motor axis towards the bogie centre
 
-    stator = free_body(f"{prefix}.stator", pos(x_motor + p["stator_offset_x"], 0.0,
-                                               p["stator_offset_z"]), dofs)
+    stator = asm.free(f"{prefix}.stator", pos(x_motor + p["stator_offset_x"], 0.0,
+                                              p["stator_offset_z"]))
     rotor = carried_body(f"{prefix}.rotor", pos(x_motor, 0.0, 0.0), stator, dofs)
     pinion = carried_body(f"{prefix}.pinion", pos(x_motor, y_gear, 0.0), stator, dofs)
     gear = carried_body(f"{prefix}.gear", pos(axle_x, y_gear, 0.0), stator, dofs)
@@ -173,11 +215,11 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
 
     # hollow shaft and axle beam nodes
     hs_y = np.linspace(y_gear, y_claw, len(HOLLOW_SHAFT_NODES))
-    hs = {k: free_body(f"{prefix}.hs{k}", pos(axle_x, y, 0.0), dofs)
+    hs = {k: asm.free(f"{prefix}.hs{k}", pos(axle_x, y, 0.0))
           for k, y in zip(HOLLOW_SHAFT_NODES, hs_y, strict=True)}
     c, j = p["contact_half_distance"], p["journal_half_distance"]
     axle_y = {11: -j, 12: -c, 10: y_claw, 13: 0.0, 16: y_gear, 14: c, 15: j}
-    ax = {k: free_body(f"{prefix}.ax{k}", pos(axle_x, y, 0.0), dofs) for k, y in axle_y.items()}
+    ax = {k: asm.free(f"{prefix}.ax{k}", pos(axle_x, y, 0.0)) for k, y in axle_y.items()}
     hollow = TubeSection(p["hollow_shaft_outer_radius"], p["hollow_shaft_inner_radius"])
     for k1, k2 in pairwise(HOLLOW_SHAFT_NODES):
         asm.add_beam(f"{prefix}.hollow_shaft", f"{prefix}.hollow_shaft", hs[k1], hs[k2], hollow, p)
@@ -195,7 +237,7 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
     # rims (elastic wheels) and track
     rims = {}
     for k in RIM_NODES:
-        rim = free_body(f"{prefix}.rim{k}", ax[k].origin, dofs)
+        rim = asm.free(f"{prefix}.rim{k}", ax[k].origin)
         rims[k] = rim
         Jr = p["rim_diametral_inertia"]
         asm.add_mass(rim.name, rim, rigid_mass_matrix(p["rim_mass"], (Jr, p["rim_polar_inertia"], Jr)))
@@ -264,21 +306,85 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
     return bodies
 
 
+def _rigid_motion(bodies: list[Body], dofs: DofMap, translation: np.ndarray,
+                  rotation: np.ndarray) -> np.ndarray:
+    """q of a rigid motion of every free body (displacement ``translation + rotation × r`` at a
+    body's reference point r, rotation ``rotation``): carried bodies follow their carriers with
+    no spin of their own; the yaw dampers' strokes stay zero (both ends move alike)."""
+    q = np.zeros(len(dofs))
+    for body in bodies:
+        motion = np.concatenate([translation + np.cross(rotation, np.real(body.origin)), rotation])
+        for k, axis in enumerate(AXES6):
+            name = f"{body.name}.{axis}"
+            if name in dofs._index:  # type: ignore[attr-defined]
+                q[dofs.index(name)] = motion[k]
+            elif abs(motion[k]) > 0:
+                raise ValueError(f"a rigid motion moves {body.name} along {axis}, which it does "
+                                 "not own")
+    return q
+
+
+def assembled_matrices(parameters: Parameters) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(M, B, K) of a parameter set without the rest of the model (the complex-step
+    sensitivities need only these, once per parameter)."""
+    asm, _, _ = _assemble(parameters)
+    return asm.M, asm.B, asm.K
+
+
 def build_model(parameters: Parameters) -> BogieModel:
     """Assemble the constant matrices of the bogie for a parameter set."""
+    p = parameters
+    asm, dofs, positions = _assemble(p)
+    n = len(dofs)
+    dtype = asm.K.dtype
+
+    # healthy motor (ID2): torque depends on the rotor's speed relative to the stator
+    motor = np.zeros((n, n))
+    rotor2, stator2 = dofs.index("ID2.rotor.ry"), dofs.index("ID2.stator.ry")
+    motor[np.ix_([rotor2, stator2], [rotor2, stator2])] = [[1.0, -1.0], [-1.0, 1.0]]
+
+    # short circuit torque on ID1: M_C in the driving sense.  Forward running spins the wheels
+    # +ry and, through one external gear mesh, the rotor −ry: a driving torque is −ry on the rotor
+    # and its reaction +ry on the stator.
+    short_circuit = np.zeros(n)
+    short_circuit[dofs.index("ID1.rotor.ry")] = -1.0
+    short_circuit[dofs.index("ID1.stator.ry")] = 1.0
+
+    rigid = np.zeros((n, 4), dtype=dtype)
+    for column, prefix in enumerate(DRIVES):
+        for name in dofs.names:
+            if name.startswith(prefix) and name.endswith(".ry") and ".stator." not in name:
+                rigid[dofs.index(name), column] = 1.0
+        for part in ("rotor", "pinion"):
+            rigid[dofs.index(f"{prefix}.{part}.ry"), column] = -p["gear_ratio"]
+    # the whole vehicle: longitudinal translation, yaw about the vertical through the bogie centre
+    rigid[:, 2] = _rigid_motion(asm.bodies, dofs, np.array([1.0, 0.0, 0.0]), np.zeros(3))
+    rigid[:, 3] = _rigid_motion(asm.bodies, dofs, np.zeros(3), np.array([0.0, 0.0, 1.0]))
+
+    rims = {f"{prefix}.rim{k}": dofs.indices([f"{prefix}.rim{k}.{a}" for a in AXES6])
+            for prefix in DRIVES for k in RIM_NODES}
+    return BogieModel(p, dofs, asm.M, asm.K, asm.B, _parts(asm.mass_parts),
+                      _parts(asm.stiffness_parts), asm.connections, rims, motor, short_circuit,
+                      rigid, positions)
+
+
+def _assemble(parameters: Parameters) -> tuple[_Assembler, DofMap, dict[str, np.ndarray]]:
+    """Every body and element of the bogie added: (assembler, DOF map, drawn positions)."""
     p = parameters
     dofs = DofMap(dof_names())
     # complex values (a complex-step perturbation, model.analysis.sensitivity) give complex matrices
     dtype = complex if any(isinstance(value, complex) for value in p.values.values()) else float
     asm = _Assembler(dofs, dtype)
     positions: dict[str, np.ndarray] = {}
-    n = len(dofs)
 
-    frame = free_body("BF", (0.0, 0.0, p["frame_height"]), dofs)
+    frame = asm.free("BF", (0.0, 0.0, p["frame_height"]))
     asm.add_mass("BF", frame, rigid_mass_matrix(
         p["frame_mass"], (p["frame_inertia_x"], p["frame_inertia_y"], p["frame_inertia_z"])))
-    car_body = free_body("CB", (0.0, 0.0, p["secondary_height"] + 1.0), dofs, axes=("z",))
-    asm.add_mass("CB", car_body, np.diag([0, 0, p["car_body_mass"], 0, 0, 0]))
+    # the half car body: longitudinal, vertical and yaw about the vertical through the bogie
+    # centre (its reference point lies on that axis)
+    car_body = asm.free("CB", (0.0, 0.0, p["secondary_height"] + 1.0), axes=CAR_BODY_AXES)
+    m_cb = p["car_body_mass"]
+    asm.add_mass("CB", car_body, np.diag([m_cb, 0, m_cb, 0, 0, p["car_body_yaw_inertia"]]))
     positions["BF"], positions["CB"] = frame.origin, car_body.origin
 
     half_base = p["wheelbase"] / 2
@@ -299,33 +405,29 @@ def build_model(parameters: Parameters) -> BogieModel:
         asm.add_connection(SpringDamper(
             "secondary.lateral_damper", "secondary", frame, car_body, np.array([0.0, side * sy, sh]),
             axis_springs((0, 0, 0), (0, p["secondary_damping_y"], 0))))
-        asm.add_connection(SpringDamper(
-            "secondary.yaw_damper", "secondary", frame, car_body,
-            np.array([0.0, side * p["yaw_damper_half_base_y"], p["yaw_damper_height"]]),
-            axis_springs((0, 0, 0), (p["yaw_damping"], 0, 0))))
+    # yaw dampers: longitudinal dampers between frame and car body, each in series with its
+    # rubber end bushes (a Maxwell element with a massless inner coordinate, the damper's stroke)
+    k_bush = p["yaw_damper_series_stiffness"]
+    for damper, side in zip(YAW_DAMPERS, (1.0, -1.0), strict=True):
+        point = np.array([0.0, side * p["yaw_damper_half_base_y"], p["yaw_damper_height"]])
+        asm.add_connection(MaxwellDamper(
+            damper, "yaw_dampers", frame, car_body, point, np.array([1.0, 0.0, 0.0]), k_bush,
+            p["yaw_damping"], dofs.index(f"{damper}.stroke"),
+            spring_damping=p["rubber_loss_time"] * k_bush))
+        positions[damper] = point
+    # anti-roll bar: a torsion bar between frame and car body, stiff in their relative roll (the
+    # half car body does not roll: it acts on the frame's roll alone)
+    k_roll = p["anti_roll_bar_stiffness"]
+    asm.add_connection(SpringDamper(
+        "secondary.anti_roll_bar", "anti_roll_bar", frame, car_body, np.array([0.0, 0.0, sh]),
+        axis_springs((k_roll, 0, 0), (p["shaft_loss_time"] * k_roll, 0, 0), rotational=True)))
+    # traction linkage: frame to car body on the bogie's centre line, longitudinal
+    k_link = p["traction_link_stiffness"]
+    link_point = np.array([0.0, 0.0, p["traction_link_height"]])
+    asm.add_connection(SpringDamper(
+        "secondary.traction_link", "traction_link", frame, car_body, link_point,
+        axis_springs((k_link, 0, 0), (p["rubber_loss_time"] * k_link, 0, 0),
+                     channels=("force", "", ""))))
+    positions["secondary.traction_link"] = link_point
 
-    # healthy motor (ID2): torque depends on the rotor's speed relative to the stator
-    motor = np.zeros((n, n))
-    rotor2, stator2 = dofs.index("ID2.rotor.ry"), dofs.index("ID2.stator.ry")
-    motor[np.ix_([rotor2, stator2], [rotor2, stator2])] = [[1.0, -1.0], [-1.0, 1.0]]
-
-    # short circuit torque on ID1: M_C in the driving sense.  Forward running spins the wheels
-    # +ry and, through one external gear mesh, the rotor −ry: a driving torque is −ry on the rotor
-    # and its reaction +ry on the stator.
-    short_circuit = np.zeros(n)
-    short_circuit[dofs.index("ID1.rotor.ry")] = -1.0
-    short_circuit[dofs.index("ID1.stator.ry")] = 1.0
-
-    rigid = np.zeros((n, 2), dtype=dtype)
-    for column, prefix in enumerate(DRIVES):
-        for name in dofs.names:
-            if name.startswith(prefix) and name.endswith(".ry") and ".stator." not in name:
-                rigid[dofs.index(name), column] = 1.0
-        for part in ("rotor", "pinion"):
-            rigid[dofs.index(f"{prefix}.{part}.ry"), column] = -p["gear_ratio"]
-
-    rims = {f"{prefix}.rim{k}": dofs.indices([f"{prefix}.rim{k}.{a}" for a in AXES6])
-            for prefix in DRIVES for k in RIM_NODES}
-    return BogieModel(p, dofs, asm.M, asm.K, asm.B, _parts(asm.mass_parts),
-                      _parts(asm.stiffness_parts), asm.connections, rims, motor, short_circuit,
-                      rigid, positions)
+    return asm, dofs, positions

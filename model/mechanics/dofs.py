@@ -5,7 +5,9 @@ Axes (vehicle-fixed, right-handed): ``x`` longitudinal in the running direction,
 height of the axle centres.  A 6-DOF body or beam node has the coordinates ``x, y, z`` (small
 translations of its reference point [m]) and ``rx, ry, rz`` (small rotations about axes parallel
 to x, y, z [rad]: roll, pitch/spin, yaw).  A name is ``<subsystem>.<part>.<coordinate>``, e.g.
-``ID1.rotor.ry``, ``ID2.rim14.z``, ``BF.rz``, ``CB.z``.
+``ID1.rotor.ry``, ``ID2.rim14.z``, ``BF.rz``, ``CB.z``.  The massless inner coordinate of a
+Maxwell element (a yaw damper with its end bushes) is its damper's elongation
+``<element>.stroke`` [m], e.g. ``secondary.yaw_damper_left.stroke``.
 
 The published study writes a wheel rim's coordinates as ``[u, v, w, φ, ϑ, ψ]`` =
 ``[y, z, x, ry, rz, rx]`` here (see :data:`PAPER_RIM_ORDER`).
@@ -18,7 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 AXES6 = ("x", "y", "z", "rx", "ry", "rz")
-UNITS = {"x": "m", "y": "m", "z": "m", "rx": "rad", "ry": "rad", "rz": "rad"}
+UNITS = {"x": "m", "y": "m", "z": "m", "rx": "rad", "ry": "rad", "rz": "rad",
+         "stroke": "m"}  # stroke: a Maxwell element's damper elongation (massless coordinate)
 PAPER_RIM_ORDER = ("y", "z", "x", "ry", "rz", "rx")  # the study's [u, v, w, φ, ϑ, ψ]
 
 

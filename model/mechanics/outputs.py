@@ -48,14 +48,11 @@ def output_matrices(model: BogieModel, op: OperatingPoint) -> OutputMatrices:
     """All named outputs of both drives at ``op``."""
     names, units, rows_q, rows_v = [], [], [], []
     for connection in model.connections:
-        for spring in connection.springs:
-            if not spring.channel:
-                continue
-            g = connection.relative(spring)
-            names.append(f"{connection.name}.{spring.channel}")
-            units.append("N m" if spring.rotational else "N")
-            rows_q.append(spring.stiffness * g)
-            rows_v.append(spring.damping * g)
+        for name, unit, row_q, row_v in connection.channels():
+            names.append(name)
+            units.append(unit)
+            rows_q.append(row_q)
+            rows_v.append(row_v)
     coefficients = creep_coefficients(model.parameters, op)
     G = longitudinal_creep_pattern(model)  # columns e_x − r0 e_ry per rim, in model.rims order
     r0 = model.parameters["wheel_radius"]
@@ -88,7 +85,8 @@ def output_matrices(model: BogieModel, op: OperatingPoint) -> OutputMatrices:
 
 def static_load(model: BogieModel, op: OperatingPoint) -> np.ndarray:
     """Generalized forces of steady traction: both motors' torque M(s0, v) (with reactions on the
-    stators) and the creep forces μ N0 at the four contact points [N, N m]."""
+    stators), the creep forces μ N0 at the four contact points and the train's resistance at the
+    car body that balances them [N, N m]."""
     torque = motor_torque(model.parameters, op)
     f = np.zeros(model.n)
     f += torque * model.short_circuit_force  # drive 1: the motor torque in its driving sense
@@ -98,14 +96,19 @@ def static_load(model: BogieModel, op: OperatingPoint) -> np.ndarray:
     mu = creep_coefficients(model.parameters, op).mu
     G = longitudinal_creep_pattern(model)
     f += mu * op.N0 * G.sum(axis=1)  # T in +x at each contact point: f = T (e_x − r0 e_ry)
+    # the train's resistance at the car body (drawbar pull): in the steady state it equals the
+    # tractive effort, which the traction link passes from the frame to the car body
+    f[model.dofs.index("CB.x")] -= mu * op.N0 * G.shape[1]
     return f
 
 
 def static_deflection(model: BogieModel, op: OperatingPoint) -> np.ndarray:
-    """Static deflection under steady traction, orthogonal to the rigid spins [m, rad].
+    """Static deflection under steady traction, orthogonal to the rigid-body modes [m, rad].
 
     The load is self-equilibrated about each drivetrain's spin (motor torque × p = creep moment)
-    when the motor torque is M(s0, v) of eq. 7, so K q0 = f0 has a solution.
+    when the motor torque is M(s0, v) of eq. 7, and along the vehicle's translation and yaw (the
+    drawbar pull balances the creep forces, which have no moment about the bogie centre), so
+    K q0 = f0 has a solution.
     """
     f = static_load(model, op)
     R = model.rigid_body_modes

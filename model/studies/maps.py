@@ -352,15 +352,16 @@ class _LineModel:
         # the rest, A22(c) = base + Σ c_k D_k (2r − n_rigid unknowns), only.
         rigid = sla.solve_triangular(red.Linv.T, red.Phi.T @ model.rigid_body_modes,
                                      lower=False, check_finite=False)
-        deflation = Deflation(np.vstack([rigid, np.zeros_like(rigid)]))
+        r_i = len(red.inertial)  # the reduced state: r coordinates, r_i velocities
+        deflation = Deflation(np.vstack([rigid, np.zeros((r_i, rigid.shape[1]))]))
         n_rigid = rigid.shape[1]
 
         def first_order(K, C):
-            A = np.zeros((2 * r, 2 * r))
-            A[:r, r:] = np.eye(r) if K is not None else 0.0
-            if K is not None:
-                A[r:, :r] = -K
-            A[r:, r:] = -C
+            if K is None:  # a creep pattern (inertial coordinates only): its part of A
+                A = np.zeros((r + r_i, r + r_i))
+                A[r:, r:] = -C[np.ix_(red.inertial, red.inertial)]
+            else:
+                A = red.first_order(K, C)
             return deflation.project(A)[n_rigid:, n_rigid:]
 
         self._base = first_order(red.K_r, red.C0_r)
@@ -375,7 +376,8 @@ class _LineModel:
 
     def _ritz_vectors(self, lam: np.ndarray, C: np.ndarray) -> np.ndarray:
         """Unit displacement vectors (Φ coordinates) of Ritz values ``lam`` of the reduced
-        quadratic problem ``(λ² I + λ C + K_r) y = 0`` by one step of inverse iteration each."""
+        quadratic problem ``(λ² diag(I, 0) + λ C + K_r) y = 0`` (the massless reduced
+        coordinates last) by one step of inverse iteration each."""
         red, r = self.reduced, self.reduced.size
         X = np.zeros((r, len(lam)), dtype=complex)
         real = lam.imag == 0  # real Ritz values: real arithmetic (a quarter of the work)
@@ -385,7 +387,8 @@ class _LineModel:
             shift = values * (1 + 1e-13)  # never an exactly singular matrix
             T = np.multiply.outer(shift, C)
             T += red.K_r
-            T.reshape(len(shift), -1)[:, ::r + 1] += (shift * shift)[:, None]
+            T.reshape(len(shift), -1)[:, ::r + 1] += np.multiply.outer(shift * shift,
+                                                                       red.mass_diagonal)
             start = np.broadcast_to(self._start, (len(shift), r))[..., None]
             X[:, group] = np.linalg.solve(T, start)[..., 0].T
         X = red.Linv.T @ X

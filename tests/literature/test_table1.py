@@ -38,6 +38,7 @@ from model.studies.calibration import (
     ADHESION_MOMENT,
     DIVERGENCE_RATES,
     DRIVING_SHAFT_HZ,
+    FREE_PARAMETERS,
     MOTOR_TORQUE,
     RE_MODES,
     STABILITY_LIMIT,
@@ -45,8 +46,10 @@ from model.studies.calibration import (
     TABLE1_RE,
     TABLE1_UNSTABLE,
     V_REF,
+    constraint_values,
     driving_shaft_mode,
     match_table1_modes,
+    on_bound,
     wheelset_yaw_fraction,
 )
 
@@ -54,29 +57,38 @@ IM_TOLERANCE = 0.05  # [-] relative, by rank
 RE_TOLERANCE, RE_ABSOLUTE = 0.30, 0.05  # [-] relative; [1/s] where |Re_published| < 0.2 1/s
 
 # documented misses of the calibrated set (see docs/validation.md); value achieved in the reason
-MISSED_IM: dict[int, str] = {}  # all ten ranks within 5 % (largest: rank 10, -4.1 %)
+MISSED_IM: dict[int, str] = {}  # all ten ranks within 5 % (largest: rank 9, -4.6 %)
 MISSED_CHARACTER: dict[int, str] = {
-    7: "rank 7 (8.846 Hz) is the longitudinal-pitch mode led by wheelset 1, Table 2's 8th "
-       "character: the two wheelsets' longitudinal-pitch modes are in the other order",
-    8: "rank 8 (9.323 Hz) is the longitudinal-pitch mode led by wheelset 2, Table 2's 7th "
-       "character (7 and 8 swapped)",
+    3: "rank 3 (5.207 Hz) is the frame's bounce with both TMs, Table 2's 4th character; the "
+       "frame's pitch (Table 2's 3rd) is at 5.489 Hz: the two published 0.4 % apart are in the "
+       "other order (their coupling through the car body's longitudinal motion keeps them apart)",
+    4: "rank 4 (5.489 Hz) is the frame's pitch with the TMs and the car body's longitudinal "
+       "motion, Table 2's 3rd character (3 and 4 swapped)",
+    10: "rank 10 (12.485 Hz) is the frame's longitudinal-roll with both TMs; wheelset 1's "
+        "longitudinal-yaw mode (Table 2's 10th) is the 12th pair, at 12.864 Hz (+2.3 %)",
 }
 MISSED_RE: dict[int, str] = {
-    3: "Re of the frame's pitch with the gears -1.361 1/s (published -0.199): the yaw dampers "
-       "(1 MN s/m at 0.53 m height, against a car body held still in x and yaw) damp the pitch",
-    9: "Re of wheelset 2's longitudinal-yaw mode -9.02 1/s (published -3.958, +128 %)",
-    10: "Re of wheelset 1's longitudinal-yaw mode -11.23 1/s (published -4.010, +180 %)",
+    3: "Re of the frame's pitch (Table 2's 3rd character) -1.051 1/s (published -0.199): the "
+       "yaw dampers at 0.60 m height stroke with the pitch through their end bushes",
+    4: "Re of the frame's bounce -0.361 1/s (published -0.056; 0.05 1/s allowed): rubber loss "
+       "and the dampers' minimum leave more damping than the study's 0.16 %",
+    9: "Re of wheelset 2's longitudinal-yaw mode -15.70 1/s (published -3.958, +297 %): the "
+       "creep slope ∂μ/∂s(0.005) = 11.5 of the calibrated creep shape",
+    10: "Re of wheelset 1's longitudinal-yaw mode -14.66 1/s (published -4.010, +266 %), as 9",
 }
-MISSED_TWO_DIVERGENCES = ("one positive real eigenvalue, +13.06 1/s (published +7.031 and "
-                          "+0.062): b_M = 11 010 N m s/rad (p² b_M = 1.7e5 N m s) holds ID2's "
-                          "spin against its creep (2 r0² |b11| = 5.0e3 N m s); with b_M low "
-                          "enough for both spins to diverge, ID2's rotor mode turns into a "
-                          "damped pair at 0.5-3 Hz and shifts Table 1 by one rank")
-MISSED_PATTERN = ("unstable among the first ten at s0 = 0.014: pairs 2, 3, 8, 9, 10 (published "
-                  "3, 7, 8, 9, 10): ID1's rotor mode (+10.56 1/s at 2.09 Hz) and the frame's "
-                  "pitch-drivetrain pair (+4.21 at 3.36 Hz) flutter, and the wheelsets' modes at "
-                  "9.48 / 9.92 / 11.91 Hz (+2.68 / +0.59 / +0.56 1/s); rank 7 (8.44 Hz) is "
-                  "damped (-1.39 1/s)")
+MISSED_RE_COUNT = ("2 of the 6 real parts within the acceptance (modes 1 and 8; 3, 4, 9, 10 "
+                   "missed by 5-14x the acceptance, see MISSED_RE): target at least 5")
+MISSED_TWO_DIVERGENCES = ("two positive real eigenvalues, +33.27 and +31.11 1/s (published "
+                          "+7.031 and +0.062): both drivetrains' spins diverge on the calibrated "
+                          "creep's falling slope (∂μ/∂s(0.014) = -3.64, b11 = -1.09e4 N s/m; "
+                          "b_M = 1.14e3 N m s/rad cannot hold ID2's); the larger is 4.7x the "
+                          "published")
+MISSED_PATTERN = ("unstable among the first ten at s0 = 0.014: pairs 1, 3, 9, 10 (published 3, "
+                  "7, 8, 9, 10): the vehicle's longitudinal motion against ID2's disc clutch "
+                  "(+1.99 1/s at 0.006 Hz), ID1's rotor-frame pitch pair (+2.96 at 2.86 Hz) and "
+                  "the wheelsets' yaw modes (+3.83 at 9.77 Hz, +2.54 at 11.61 Hz); the "
+                  "wheelsets' longitudinal modes stay damped (-2.01 at 8.43 Hz, -1.73 at 9.24 Hz)")
+
 
 @pytest.fixture(scope="module")
 def calibrated():
@@ -161,20 +173,48 @@ def test_wheelset_modes_told_apart_by_journal_phase(calibrated):
 
 
 def test_calibrated_inertias_are_physical(calibrated):
-    """A rigid body's principal inertias obey I_z <= I_x + I_y (calibration.with_constraints);
-    the 3.5 t frame's roll inertia cannot exceed all its mass at the frame's outer edges
-    (m · 1.1² m² ≈ 4 200 kg m²), and Polach's kS <= kA."""
+    """A rigid body's principal inertias obey |I_x − I_y| <= I_z <= I_x + I_y
+    (calibration.constraint_values); the frame's roll inertia cannot exceed all its mass at the
+    frame's outer edges (m · 1.1² m²), its pitch inertia all its mass at the ends (m · 1.75² m²);
+    Polach's kS <= kA."""
     parameters = calibrated[0]
-    assert parameters["frame_inertia_z"] <= (parameters["frame_inertia_x"]
-                                             + parameters["frame_inertia_y"]) * (1 + 1e-12)
+    assert np.all(constraint_values(parameters) <= 1e-12)
     assert parameters["frame_inertia_x"] <= parameters["frame_mass"] * 1.1**2
+    assert parameters["frame_inertia_y"] <= parameters["frame_mass"] * 1.75**2
     assert parameters["polach_kS"] <= parameters["polach_kA"]
+
+
+def test_calibrated_values_inside_their_bounds_at_most_two_on_one(calibrated):
+    """Every calibrated parameter within the range its source allows (its calibration bounds,
+    calibration.FREE_PARAMETERS, each with its reason), and at most two on a bound (within
+    0.1 %, calibration.on_bound): the issue's target; a set that fits by bending its data sits
+    on many."""
+    parameters = calibrated[0]
+    for f in FREE_PARAMETERS:
+        assert f.low - 1e-12 * abs(f.low) <= parameters[f.name] <= f.high + 1e-12 * abs(f.high)
+    on = [f.name for f in FREE_PARAMETERS if on_bound(f, parameters[f.name])]
+    assert len(on) <= 2, on
+
+
+@pytest.mark.xfail(bool(MISSED_RE_COUNT), strict=True, reason="documented miss: " + MISSED_RE_COUNT)
+def test_at_least_five_of_six_real_parts(calibrated):
+    """The issue's target on the real parts of modes 1, 3, 4, 8, 9, 10 (each with the
+    tolerance of test_table1_real_part)."""
+    _, _, result, matched = calibrated
+    met = 0
+    for k in RE_MODES:
+        published, achieved = TABLE1_RE[k - 1], result.eigenvalues[matched[k - 1]].real
+        tolerance = RE_ABSOLUTE if abs(published) < 0.2 else RE_TOLERANCE * abs(published)
+        met += abs(achieved - published) <= tolerance
+    assert met >= 5
 
 
 def test_stable_at_small_creepage(calibrated):
     _, _, result, _ = calibrated
     assert result.stable
-    assert result.n_rigid == 2  # the two drivetrain spins, as the study's two ~0 eigenvalues
+    # the two drivetrain spins (the study's two ~0 eigenvalues) and, since the car body moves
+    # longitudinally and in yaw, the whole vehicle's translation and yaw
+    assert result.n_rigid == 4
 
 
 def test_unstable_at_large_creepage(unstable):

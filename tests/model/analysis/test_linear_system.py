@@ -130,3 +130,93 @@ def test_concurrent_solves_with_the_cached_factors_are_exact():
     for thread in threads:
         thread.join()
     assert not wrong, f"{len(wrong)} wrong solutions, first {wrong[:3]}"
+
+
+# --- massless coordinates (Maxwell elements, issue 27) ------------------------------------------
+
+def _maxwell_sdof(m=3.0, k1=4.0e3, k2=9.0e3, c=150.0) -> LinearSystem:
+    """A mass on a spring k1 to ground and a Maxwell element (damper c in series with a spring
+    k2) to ground; coordinates [x, d], d the damper's elongation (massless):
+    M = diag(m, 0), K = [[k1 + k2, −k2], [−k2, k2]], B = diag(0, c)."""
+    M = np.diag([m, 0.0])
+    K = np.array([[k1 + k2, -k2], [-k2, k2]])
+    B = np.diag([0.0, c])
+    return LinearSystem(M, B, K, np.array([1.0, 0.0]), np.zeros((2, 0)))
+
+
+def test_massless_coordinate_state_matrix_has_the_characteristic_polynomial_roots():
+    """det(λ²M + λB + K) = (mλ² + k1 + k2)(cλ + k2) − k2² is a cubic: three eigenvalues, the
+    state [x, d, ẋ] (no velocity of the massless d)."""
+    m, k1, k2, c = 3.0, 4.0e3, 9.0e3, 150.0
+    system = _maxwell_sdof(m, k1, k2, c)
+    assert system.N == 3
+    np.testing.assert_array_equal(system.massless, [1])
+    lam = np.linalg.eigvals(system.A)
+    roots = np.roots([m * c, m * k2, c * (k1 + k2), k1 * k2])
+    np.testing.assert_allclose(np.sort_complex(lam), np.sort_complex(roots), rtol=1e-12)
+    assert np.all(lam.real < 0)  # the damper dissipates
+
+
+def test_massless_velocity_and_input_maps():
+    """q̇ = V x: ḋ = (k2/c)(x − d) for the Maxwell element; a force on x enters v̇ as f/m."""
+    m, k1, k2, c = 3.0, 4.0e3, 9.0e3, 150.0
+    system = _maxwell_sdof(m, k1, k2, c)
+    x, d, v = 0.3, -0.1, 2.0
+    np.testing.assert_allclose(system.velocity_map @ [x, d, v], [v, k2 / c * (x - d)])
+    np.testing.assert_allclose(system.input_map(np.array([5.0, 0.0])), [0.0, 0.0, 5.0 / m])
+    C = system.state_output(np.array([[0.0, 0.0]]), np.array([[0.0, c]]))  # damper force c ḋ
+    np.testing.assert_allclose(C @ [x, d, v], [k2 * (x - d)])  # = the series spring's force
+
+
+def test_massless_response_matches_a_direct_integration():
+    """Response of the Maxwell single-DOF system to a step and a damped sinusoid: the modal
+    closed form and the exact discretization against an independent integration of the
+    hand-written first-order equations (scipy's DOP853 at rtol 1e-11)."""
+    from scipy.integrate import solve_ivp
+
+    from model.analysis.response import solve_linear
+
+    m, k1, k2, c = 3.0, 4.0e3, 9.0e3, 150.0
+    system = _maxwell_sdof(m, k1, k2, c)
+    u0, a, mu = -2.0, 3.0 * np.exp(0.3j), complex(-6.0, 2 * np.pi * 7.0)
+    t = np.arange(801) * 1e-3
+
+    def rhs(time, s):
+        x, d, v = s
+        u = u0 + (a * np.exp(mu * time)).real
+        return [v, k2 / c * (x - d), (u - (k1 + k2) * x + k2 * d) / m]
+
+    exact = solve_ivp(rhs, (0, t[-1]), [0.0, 0.0, 0.0], method="DOP853", t_eval=t, rtol=1e-11,
+                      atol=1e-14).y.T
+    for method in ("modal", "expm"):
+        y, used, _ = solve_linear(system, np.eye(3), u0, a, mu, len(t), 1e-3, method)
+        assert used == method
+        assert np.abs(y - exact).max() < 1e-7 * np.abs(exact).max()
+
+
+def test_massless_coordinate_with_a_rigid_body_mode():
+    """Two masses joined by a spring k1 and a Maxwell element (k, c): the common translation
+    (d unchanged) is the rigid-body mode, deflated exactly; the relative motion has the cubic of
+    the single-DOF test with the reduced mass, the translation's velocity a zero eigenvalue (no
+    damping acts on it).  A force on one mass makes the centre of mass accelerate as F/(m1+m2)."""
+    from model.analysis.response import solve_linear
+
+    m1, m2, k1, k, c = 2.0, 5.0, 3.0e3, 8.0e3, 90.0
+    h = np.array([-1.0, 1.0, -1.0])  # the Maxwell spring's elongation x2 − x1 − d
+    g = np.array([-1.0, 1.0, 0.0])
+    M, B = np.diag([m1, m2, 0.0]), np.diag([0.0, 0.0, c])
+    R = np.array([[1.0], [1.0], [0.0]])
+    system = LinearSystem(M, B, k * np.outer(h, h) + k1 * np.outer(g, g),
+                          np.array([1.0, 0.0, 0.0]), R)
+    np.testing.assert_allclose(system.A @ np.concatenate([R[:, 0], [0.0, 0.0]]), 0.0, atol=1e-12)
+    lam = system.eigen[0]
+    assert len(lam) == system.N - 1  # the rigid zero deflated
+    mu = m1 * m2 / (m1 + m2)
+    roots = np.roots([mu * c, mu * k, c * (k1 + k), k1 * k])
+    np.testing.assert_allclose(np.sort_complex(lam), np.sort_complex(np.append(roots, 0.0)),
+                               atol=1e-9 * np.abs(roots).max())
+    t = np.arange(601) * 1e-3
+    y, _, _ = solve_linear(system, np.eye(system.N), 1.0, 0.0j, complex(-1.0, 1.0), len(t),
+                           1e-3, "expm")
+    centre = (m1 * y[:, 0] + m2 * y[:, 1]) / (m1 + m2)
+    np.testing.assert_allclose(centre, t**2 / (2 * (m1 + m2)), rtol=1e-9, atol=1e-15)

@@ -32,26 +32,52 @@ def bogie():
     return parameters, build_model(parameters)
 
 
+def first_order_by_hand(M, B, K, f, massless):
+    """(A, b, V) of M q̈ + B q̇ + K q = f u with the ``massless`` coordinates (zero rows of M:
+    the yaw dampers' strokes) first order, written out here again: the state is [q; v] with v
+    the velocities of the other coordinates i; the massless rows m give
+    q̇_m = −B_mm⁻¹ (K_m q + B_mi v) (no input acts on them, checked), and then
+    M_ii v̇ = −K_i q − B_ii v − B_im q̇_m + f_i u.  V maps the state to every velocity q̇."""
+    n = M.shape[0]
+    m = np.asarray(massless, dtype=int)
+    i = np.setdiff1d(np.arange(n), m)
+    assert not np.any(M[m])
+    assert not np.any(f[m])
+    E = np.zeros((len(m), n + len(i)))  # q̇_m = E [q; v]
+    Bmm_inv = np.linalg.inv(B[np.ix_(m, m)])
+    E[:, :n] = -Bmm_inv @ K[m]
+    E[:, n:] = -Bmm_inv @ B[np.ix_(m, i)]
+    V = np.zeros((n, n + len(i)))  # q̇ = V [q; v]
+    V[i, n + np.arange(len(i))] = 1.0
+    V[m] = E
+    Minv = np.linalg.inv(M[np.ix_(i, i)])
+    A = np.vstack([V, -Minv @ (np.hstack([K[i], np.zeros((len(i), len(i)))])
+                               + B[i] @ V)])
+    b = np.concatenate([np.zeros(n), Minv @ f[i]])
+    return A, b, V
+
+
 def exported_reference(path, excitation: ShortCircuit, shift: float, t_end: float, fs: float):
     """Δy on t = k/fs from the exported arrays by exact stepping of the augmented state."""
     data = np.load(path, allow_pickle=False)
     M, B, K, f = data["M"], data["B"], data["K"], data["f_mc"]
-    n = M.shape[0]
-    Minv = np.linalg.inv(M)
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ B]])
-    b = np.concatenate([np.zeros(n), Minv @ f])
+    A, b, V = first_order_by_hand(M, B, K, f, data["massless"])
+    N = A.shape[0]
     w, sigma = 2 * np.pi * excitation.f, excitation.D * 2 * np.pi * excitation.f
-    F = np.zeros((2 * n + 3, 2 * n + 3))
-    F[:2 * n, :2 * n] = A
-    F[:2 * n, 2 * n] = -float(data["motor_torque"]) * b  # −M(s0, v) H(t)
-    F[:2 * n, 2 * n + 1] = -excitation.M0 * b  # −M0 e^(−σt) sin(ω(t − Δt))
-    F[2 * n + 1:, 2 * n + 1:] = [[-sigma, w], [-w, -sigma]]  # d/dt [s, c]
-    z = np.zeros(2 * n + 3)
-    z[2 * n:] = [1.0, math.sin(-w * shift), math.cos(-w * shift)]
+    F = np.zeros((N + 3, N + 3))
+    F[:N, :N] = A
+    F[:N, N] = -float(data["motor_torque"]) * b  # −M(s0, v) H(t)
+    F[:N, N + 1] = -excitation.M0 * b  # −M0 e^(−σt) sin(ω(t − Δt))
+    F[N + 1:, N + 1:] = [[-sigma, w], [-w, -sigma]]  # d/dt [s, c]
+    z = np.zeros(N + 3)
+    z[N:] = [1.0, math.sin(-w * shift), math.cos(-w * shift)]
     Phi = sla.expm(F / fs)
-    C = np.hstack([data["C_q"], data["C_v"], np.zeros((data["C_q"].shape[0], 3))])
+    n = M.shape[0]
+    C_state = data["C_v"] @ V
+    C_state[:, :n] += data["C_q"]
+    C = np.hstack([C_state, np.zeros((data["C_q"].shape[0], 3))])
     steps = round(t_end * fs) + 1
-    Z = np.empty((steps, 2 * n + 3))
+    Z = np.empty((steps, N + 3))
     for k in range(steps):
         Z[k] = z
         z = Phi @ z

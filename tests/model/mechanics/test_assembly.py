@@ -21,14 +21,16 @@ from model import (
     output_matrices,
 )
 from model.analysis.eigen import state_space
-from model.mechanics.assembly import DRIVES, dof_names
+from model.analysis.linear_system import massless_coordinates
+from model.mechanics.assembly import DRIVES, YAW_DAMPERS, dof_names
 from model.mechanics.dofs import AXES6, DofMap
 from model.mechanics.operating_point import creep_coefficients, creep_damping
 from model.mechanics.outputs import static_load
 from model.mechanics.parameters import CALIBRATED_FILE, ESTIMATE_FILE
 
 EPS = np.finfo(float).eps
-N_DOF = 193
+N_DOF = 197
+N_RIGID = 4  # the two drivetrain spins, the vehicle's longitudinal translation and yaw
 
 # sign of each coordinate under the central symmetry (180° about z): x, y → −x, −y; z → z; the
 # rotations are axial vectors of a proper rotation and transform alike: rx, ry → −; rz → +.
@@ -73,15 +75,18 @@ def test_dof_count_and_names(calibrated):
     assert len(names) == N_DOF == calibrated.n == len(dof_names())
     assert len(set(names)) == len(names)
     axes = "|".join(AXES6)
-    pattern = re.compile(rf"^(ID[12]\.[a-z]+[0-9]*|BF|CB)\.({axes})$")
+    pattern = re.compile(rf"^((ID[12]\.[a-z]+[0-9]*|BF|CB)\.({axes})"
+                         rf"|secondary\.yaw_damper_(left|right)\.stroke)$")
     bad = [name for name in names if not pattern.match(name)]
     assert not bad, f"names not <subsystem>.<part>.<axis> (BF/CB: <body>.<axis>): {bad}"
     # q = [q_ID1, q_BFCB, q_ID2] (eq. 1), the two drives with the same layout
     first = [name.split(".", 1)[0] for name in names]
-    assert first == ["ID1"] * 93 + ["BF"] * 6 + ["CB"] + ["ID2"] * 93
-    assert [n[4:] for n in names[:93]] == [n[4:] for n in names[100:]]
+    assert first == ["ID1"] * 93 + ["BF"] * 6 + ["CB"] * 3 + ["secondary"] * 2 + ["ID2"] * 93
+    assert [n[4:] for n in names[:93]] == [n[4:] for n in names[104:]]
+    assert [n for n in names if n.startswith("CB.")] == ["CB.x", "CB.z", "CB.rz"]
     for name in names:
-        assert calibrated.dofs.unit(name) == ("m" if name.rsplit(".", 1)[1] in "xyz" else "rad")
+        axis = name.rsplit(".", 1)[1]
+        assert calibrated.dofs.unit(name) == ("m" if axis in ("x", "y", "z", "stroke") else "rad")
 
 
 def test_rims_index_their_own_coordinates(calibrated):
@@ -94,26 +99,33 @@ def test_rims_index_their_own_coordinates(calibrated):
 # matrices
 
 
-def test_mass_matrix_symmetric_positive_definite(model):
+def test_mass_matrix_symmetric_positive_definite_but_on_the_yaw_dampers_strokes(model):
+    """M is symmetric positive definite on every coordinate but the two yaw dampers' strokes,
+    the massless inner nodes of the Maxwell elements, whose rows and columns are exactly zero."""
     M = model.M
     # W^T M6 W products round differently above and below the diagonal: allow a few ulps of ||M||
     assert np.allclose(M, M.T, rtol=0, atol=10 * EPS * np.abs(M).max())
-    sla.cholesky(0.5 * (M + M.T))  # raises LinAlgError unless positive definite
-    assert np.all(np.diag(M) > 0)
+    massless = massless_coordinates(M)
+    assert [model.dofs.names[i] for i in massless] == [f"{d}.stroke" for d in YAW_DAMPERS]
+    inertial = np.setdiff1d(np.arange(model.n), massless)
+    sla.cholesky(0.5 * (M + M.T)[np.ix_(inertial, inertial)])  # LinAlgError unless PD
+    assert np.all(np.diag(M)[inertial] > 0)
+    assert not np.any(M[:, massless])
 
 
-def test_stiffness_symmetric_psd_with_exactly_two_zero_eigenvalues(model):
+def test_stiffness_symmetric_psd_with_exactly_four_zero_eigenvalues(model):
     """Eigenvalues of the unit-diagonal scaled K: a backward-stable solver gives the true zeros
     as O(n eps ||K_s||) ≈ 1e-13; we call |λ| < 100 n eps ||K_s|| (≈ 1e-11) zero.  The softest
-    real stiffness (soft secondary suspension of the car body) sits near 1e-7 for the estimate
-    and the calibrated set, four decades above, so the count is not a tolerance artefact."""
+    real stiffness (soft secondary suspension) sits many decades above, so the count is not a
+    tolerance artefact.  Four zeros: the drivetrain spins and the whole vehicle's longitudinal
+    translation and yaw."""
     K = model.K
     assert np.array_equal(K, K.T)
     w = np.linalg.eigvalsh(_scaled(K))
     tol = 100 * model.n * EPS * np.abs(w).max()
     assert w.min() > -tol
-    assert np.count_nonzero(np.abs(w) < tol) == 2
-    assert w[2] > 100 * tol
+    assert np.count_nonzero(np.abs(w) < tol) == N_RIGID
+    assert w[N_RIGID] > 100 * tol
 
 
 def test_damping_symmetric_psd(model):
@@ -125,7 +137,7 @@ def test_damping_symmetric_psd(model):
 
 def test_rigid_body_modes_are_the_null_space_of_k(model):
     R = model.rigid_body_modes
-    assert R.shape == (model.n, 2)
+    assert R.shape == (model.n, N_RIGID)
     K = model.K
     residual = np.linalg.norm(K @ R, axis=0)
     assert np.all(residual <= 1e3 * EPS * np.linalg.norm(K, 2) * np.linalg.norm(R, axis=0))
@@ -134,6 +146,17 @@ def test_rigid_body_modes_are_the_null_space_of_k(model):
         touched = {model.dofs.names[i] for i in np.flatnonzero(R[:, column])}
         assert touched
         assert all(name.startswith(prefix) and name.endswith(".ry") for name in touched)
+    names = model.dofs.names
+    translation, yaw = R[:, 2], R[:, 3]
+    # the translation: every x coordinate 1, nothing else (no spin: the wheels slide)
+    assert all(translation[i] == (1.0 if n.endswith(".x") else 0.0) for i, n in enumerate(names))
+    # the yaw about the vertical through the bogie centre: rz = 1 everywhere, x = −y0, y = x0
+    assert all(yaw[i] == 1.0 for i, n in enumerate(names) if n.endswith(".rz"))
+    ax11 = model.positions["ID1.ax11"]
+    assert yaw[model.dofs.index("ID1.ax11.x")] == pytest.approx(-ax11[1])
+    assert yaw[model.dofs.index("ID1.ax11.y")] == pytest.approx(ax11[0])
+    for damper in YAW_DAMPERS:  # both ends of a yaw damper move alike: no stroke
+        assert R[model.dofs.index(f"{damper}.stroke")].tolist() == [0.0] * N_RIGID
 
 
 def test_parts_add_up_to_the_matrices(model):
@@ -158,7 +181,8 @@ def test_rigid_translation_carries_the_total_mass(model):
                  + 2 * p["axle_box_mass"] + 2 * p["rim_mass"])
     horizontal = 2 * per_drive + p["frame_mass"]
     vertical = horizontal + p["car_body_mass"] + 4 * p["track_mass"]
-    for axis, expected in (("x", horizontal), ("y", horizontal), ("z", vertical)):
+    longitudinal = horizontal + p["car_body_mass"]  # the half car body moves in x, not in y
+    for axis, expected in (("x", longitudinal), ("y", horizontal), ("z", vertical)):
         q = np.array([1.0 if name.endswith("." + axis) else 0.0 for name in model.dofs.names])
         assert q @ model.M @ q == pytest.approx(expected, rel=1e-12), axis
 
@@ -198,10 +222,16 @@ def test_drive_2_mirrors_drive_1(model):
     """Drive 2 is built from drive 1's description through the geometry transform
     diag(−1, −1, 1) of positions and directions.  In coordinates that means M₂₂ = R M₁₁ R (same
     for K, B) with R the sign map of the central symmetry, and the couplings to the frame
-    K₂,BF = R K₁,BF R_BF; the frame/car-body block itself is invariant (R_BF K R_BF = K)."""
+    K₂,BF = R K₁,BF R_BF; the frame/car-body block itself is invariant (R_BF K R_BF = K).  On
+    the frame and car body R_BF is the sign map; the yaw dampers swap sides, and a damper's
+    stroke (its elongation along +x) changes sign with the direction: d_left ↔ −d_right."""
     i1, i2, R = _symmetry_map(model)
-    frame = [model.dofs.index(f"BF.{a}") for a in AXES6] + [model.dofs.index("CB.z")]
-    R_frame = np.diag([SYMMETRY_SIGN[a] for a in AXES6] + [1.0])
+    frame = ([model.dofs.index(f"BF.{a}") for a in AXES6]
+             + [model.dofs.index(f"CB.{a}") for a in ("x", "z", "rz")]
+             + [model.dofs.index(f"{d}.stroke") for d in YAW_DAMPERS])
+    R_frame = np.diag([SYMMETRY_SIGN[a] for a in AXES6]
+                      + [SYMMETRY_SIGN[a] for a in ("x", "z", "rz")] + [0.0, 0.0])
+    R_frame[-2:, -2:] = [[0.0, -1.0], [-1.0, 0.0]]
     for label, matrix in (("M", model.M), ("K", model.K), ("B", model.B)):
         scale = np.abs(matrix).max()
         d1, d2 = matrix[np.ix_(i1, i1)], matrix[np.ix_(i2, i2)]
@@ -272,14 +302,18 @@ def test_short_circuit_force_is_internal_and_drives_drivetrain_1(model):
     for name in touched:
         motor_as_one_body[model.dofs.index(name)] = 1.0
     assert f @ motor_as_one_body == 0.0
-    r1, r2 = model.rigid_body_modes.T
+    r1, r2, translation, yaw = model.rigid_body_modes.T
     assert f @ r1 == pytest.approx(p, rel=1e-14)
     assert f @ r2 == 0.0
+    assert f @ translation == 0.0
+    assert f @ yaw == 0.0
 
 
 def test_static_traction_load_is_self_equilibrated(model):
     """Eq. 7: the motor torque M = 2 μ N0 r0 / p balances the creep moment 2 μ N0 r0 on each
-    drivetrain's rigid spin, so K q0 = f0 is solvable (f0 ⟂ null space of K)."""
+    drivetrain's rigid spin, the drawbar pull the creep forces along the vehicle's translation,
+    and the creep forces have no moment about the bogie centre, so K q0 = f0 is solvable
+    (f0 ⟂ null space of K)."""
     for s0 in (0.005, 0.014):
         op = default_operating_point(model.parameters, s0=s0, v_kmh=120.0)
         f0 = static_load(model, op)
@@ -287,40 +321,75 @@ def test_static_traction_load_is_self_equilibrated(model):
             assert abs(f0 @ r) <= 1e-12 * np.linalg.norm(f0) * np.linalg.norm(r)
 
 
-def test_eigen_analysis_identifies_the_two_rigid_spins(calibrated):
+def test_eigen_analysis_identifies_the_four_rigid_body_modes(calibrated):
     op = default_operating_point(calibrated.parameters)
     result = eigen_analysis(calibrated, op, vectors=False)
-    assert result.n_rigid == 2
-    assert result.eigenvalues.size == 2 * calibrated.n - 2
+    assert result.n_rigid == N_RIGID
+    # states: every coordinate and the velocities of the inertial ones (not of the 2 strokes)
+    assert result.eigenvalues.size == 2 * calibrated.n - 2 - N_RIGID
 
 
 # ------------------------------------------------------------------------------------------------
 # energy
 
 
-def _energy(model, x):
-    n = model.n
-    q, v = x[:n], x[n:]
-    return 0.5 * v @ model.M @ v + 0.5 * q @ model.K @ q
+def _energy_matrix(model) -> np.ndarray:
+    """P with E = ½ xᵀ P x = ½ vᵀ M_ii v + ½ qᵀ K q on the state x = [q; v] (v: velocities of the
+    inertial coordinates)."""
+    inertial = np.setdiff1d(np.arange(model.n), massless_coordinates(model.M))
+    return sla.block_diag(model.K, model.M[np.ix_(inertial, inertial)])
 
 
 def _trajectory(model, B, dt=1e-3, steps=20, seed=0):
-    """Exact free response x(k dt) = expm(A dt)^k x0 of M q̈ + B q̇ + K q = 0 from a random state."""
-    A = state_space(model).state_matrix(B)
-    step = sla.expm(A * dt)
-    x = np.random.default_rng(seed).normal(size=2 * model.n)
-    energies = [_energy(model, x)]
+    """Exact free response x(k dt) = expm(A dt)^k x0 of M q̈ + B q̇ + K q = 0 from a random state;
+    the energies ½ xᵀ P x along it."""
+    system = state_space(model).system(B)
+    step = sla.expm(system.A * dt)
+    P = _energy_matrix(model)
+    x = np.random.default_rng(seed).normal(size=system.N)
+    energies = [0.5 * x @ P @ x]
     for _ in range(steps):
         x = step @ x
-        energies.append(_energy(model, x))
+        energies.append(0.5 * x @ P @ x)
     return np.array(energies)
 
 
-def test_undamped_free_vibration_conserves_energy(calibrated):
-    """B = 0, no creep, no motor: E = ½ q̇ᵀMq̇ + ½ qᵀKq is constant.  expm is accurate to about
-    eps ||A dt||; the measured drift is ~3e-13, we allow 1e-10."""
-    energies = _trajectory(calibrated, np.zeros_like(calibrated.M))
-    assert np.allclose(energies, energies[0], rtol=1e-10, atol=0)
+def _maxwell_only(model) -> np.ndarray:
+    """The damping of the yaw dampers alone (c on their strokes): without it a stroke has no
+    equation of motion (its inner node is massless)."""
+    B = np.zeros_like(model.M)
+    for damper in YAW_DAMPERS:
+        i = model.dofs.index(f"{damper}.stroke")
+        B[i, i] = model.parameters["yaw_damping"]
+    return B
+
+
+@pytest.mark.parametrize("damping", ["yaw dampers only", "structural"])
+def test_energy_balance_is_exact(calibrated, damping):
+    """dE/dt = −q̇ᵀ B q̇ with q̇ = V x the velocities of all coordinates (the strokes' from their
+    first-order equations): as a matrix identity, sym(P A) = −Vᵀ B V.  With only the yaw
+    dampers' c, everything else conserves energy and the loss is c ḋ² of each damper; with the
+    structural damping (incl. the end bushes' rubber loss) it is the whole q̇ᵀ B q̇.  Tolerance
+    relative to ‖P A‖: rounding of the 392-state products."""
+    B = _maxwell_only(calibrated) if damping == "yaw dampers only" else calibrated.B
+    system = state_space(calibrated).system(B)
+    PA = _energy_matrix(calibrated) @ system.A
+    V = system.velocity_map
+    lhs = 0.5 * (PA + PA.T)
+    rhs = -V.T @ B @ V
+    assert np.abs(lhs - rhs).max() <= 1e-9 * np.abs(PA).max()
+    if damping == "yaw dampers only":  # only the strokes' velocities dissipate
+        strokes = [calibrated.dofs.index(f"{d}.stroke") for d in YAW_DAMPERS]
+        expected = -sum(calibrated.parameters["yaw_damping"] * np.outer(V[i], V[i])
+                        for i in strokes)
+        assert np.abs(rhs - expected).max() <= 1e-12 * np.abs(expected).max()
+
+
+def test_maxwell_dampers_alone_dissipate_monotonically(calibrated):
+    """With the yaw dampers as the only damping the energy never grows, and falls."""
+    energies = _trajectory(calibrated, _maxwell_only(calibrated))
+    assert np.all(np.diff(energies) <= 1e-12 * energies[0])
+    assert energies[-1] < energies[0]
 
 
 def test_structural_damping_dissipates_monotonically(calibrated):

@@ -14,7 +14,7 @@ import scipy.linalg as sla
 
 from model.mechanics.beam import TubeSection, beam_global_matrices, beam_local_matrices, local_frame
 from model.mechanics.bodies import carried_body, free_body, point_map, rigid_mass_matrix, skew
-from model.mechanics.connections import Spring, SpringDamper, axis_springs
+from model.mechanics.connections import MaxwellDamper, Spring, SpringDamper, axis_springs
 from model.mechanics.dofs import AXES6, DofMap
 
 # A steel tube of the size of the hollow shaft (independent of the parameter files).
@@ -295,3 +295,77 @@ def test_rigid_mass_matrix():
     M = rigid_mass_matrix(10.0, (1.0, 2.0, 3.0))
     assert np.array_equal(np.diag(M), [10, 10, 10, 1, 2, 3])
     assert np.count_nonzero(M - np.diag(np.diag(M))) == 0
+
+
+# --- the Maxwell element (yaw damper with end bushes, issue 27) ----------------------------------
+
+def _maxwell(k=8.0e6, c=4.0e5, c_s=1.6e3):
+    names = [f"{body}.{a}" for body in ("A", "B") for a in AXES6] + ["D.stroke"]
+    dofs = DofMap(tuple(names))
+    a = free_body("A", (0.1, -0.4, 0.3), dofs)
+    b = free_body("B", (1.2, 0.5, -0.2), dofs)
+    direction = np.array([0.6, 0.0, 0.8])
+    damper = MaxwellDamper("D", "D", a, b, np.array([0.5, 1.3, 0.4]), direction, k, c,
+                           dofs.index("D.stroke"), spring_damping=c_s)
+    return dofs, a, b, damper
+
+
+def test_maxwell_element_matrices_symmetric_psd_rigid_motion_free():
+    """K = k h hᵀ, B = c_s h hᵀ + c e_d e_dᵀ (h: the series spring's elongation δ − d): both
+    symmetric PSD; a rigid motion of both bodies with the stroke held stores no energy and
+    dissipates nothing; rank 1 (K) and 2 (B)."""
+    dofs, a, b, damper = _maxwell()
+    K, B = damper.matrices()
+    for matrix in (K, B):
+        assert np.array_equal(matrix, matrix.T)
+        assert np.linalg.eigvalsh(matrix).min() >= -1e-12 * np.abs(matrix).max()
+    rng = np.random.default_rng(8)
+    for _ in range(5):
+        q = _rigid_motion(dofs, (a, b), rng.normal(size=3), rng.normal(size=3))
+        assert np.linalg.norm(K @ q) <= 1e-12 * np.abs(K).max() * np.linalg.norm(q)
+        assert np.linalg.norm(B @ q) <= 1e-12 * np.abs(B).max() * np.linalg.norm(q)
+    assert np.linalg.matrix_rank(K) == 1
+    assert np.linalg.matrix_rank(B) == 2
+
+
+def test_maxwell_element_energy_dissipation_and_force():
+    """Energy ½ k (δ − d)², dissipated power c ḋ² + c_s (δ̇ − ḋ)² ≥ 0, force k (δ − d) +
+    c_s (δ̇ − ḋ), with δ computed by hand from u + θ × r."""
+    k, c, c_s = 8.0e6, 4.0e5, 1.6e3
+    dofs, a, b, damper = _maxwell(k, c, c_s)
+    K, B = damper.matrices()
+    rng = np.random.default_rng(9)
+    q, qdot = rng.normal(size=(2, len(dofs)))
+
+    def delta(x):
+        point_b = x[6:9] + np.cross(x[9:12], damper.position - b.origin)
+        point_a = x[0:3] + np.cross(x[3:6], damper.position - a.origin)
+        return damper.direction @ (point_b - point_a)
+
+    d, d_dot = q[-1], qdot[-1]
+    assert 0.5 * q @ K @ q == pytest.approx(0.5 * k * (delta(q) - d) ** 2, rel=1e-12)
+    power = c * d_dot**2 + c_s * (delta(qdot) - d_dot) ** 2
+    assert qdot @ B @ qdot == pytest.approx(power, rel=1e-12)
+    [(name, unit, row_q, row_v)] = damper.channels()
+    assert (name, unit) == ("D.force", "N")
+    force = row_q @ q + row_v @ qdot
+    assert force == pytest.approx(k * (delta(q) - d) + c_s * (delta(qdot) - d_dot), rel=1e-12)
+
+
+def test_maxwell_element_dynamic_stiffness():
+    """A harmonic relative displacement δ of unit amplitude: the stroke's equation condensed
+    gives F/δ = k iωc/(k + iωc) (c_s = 0) — a damper c at low frequency, the spring k at high."""
+    k, c = 8.0e6, 4.0e5
+    dofs, _a, _b, damper = _maxwell(k, c, 0.0)
+    K, B = damper.matrices()
+    i = dofs.index("D.stroke")
+    g = damper.relative()
+    for omega in (0.1, k / c, 1e4):
+        # harmonic δ of unit amplitude: q = g-direction motion of B (least-norm), d from its row
+        q = np.linalg.pinv(g[None, :]) @ np.array([1.0])
+        q[i] = 0.0
+        d = -(K[i] @ q) / (K[i, i] + 1j * omega * B[i, i])  # the stroke's row: (k + iωc) d = k δ
+        q = q.astype(complex)
+        q[i] = d
+        force = damper.channels()[0][2] @ q
+        assert force == pytest.approx(k * 1j * omega * c / (k + 1j * omega * c), rel=1e-10)

@@ -1,0 +1,63 @@
+"""Benchmark of the calibration (issue 27): ``bogie calibrate`` against one eigen-analysis call.
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/bench_calibration.py [--repeats 3]
+        [--reference assets/parameters/calibrated.toml] [--json FILE]
+
+In one run, as separate processes (what a user runs; the interpreter's start-up counted in both):
+
+* reference: ``bogie eigen --s0 0.005 --json`` (the calibrated set; median of ``--repeats``);
+* ``bogie calibrate --out TMP`` from the estimate (once: it takes a minute or two), wall time;
+* the ratio of the two (the issue's target: at most 150);
+* reproduction: whether the written set equals ``--reference`` byte for byte (the bundled set
+  is the output of this very command).
+
+Wall clock; the machine may be shared, so the ratio is taken within one run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import filecmp
+import json
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+BOGIE = [sys.executable, "-m", "model"]
+
+
+def timed(argv: list[str]) -> float:
+    began = time.perf_counter()
+    subprocess.run([*BOGIE, *argv], check=True, cwd=ROOT, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL, env={"OPENBLAS_NUM_THREADS": "1", "PATH": ""})
+    return time.perf_counter() - began
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--reference", default=str(ROOT / "assets/parameters/calibrated.toml"))
+    parser.add_argument("--json", default=None, help="write the numbers to this file")
+    args = parser.parse_args()
+    eigen = statistics.median(timed(["eigen", "--s0", "0.005", "--json"])
+                              for _ in range(args.repeats))
+    with tempfile.TemporaryDirectory() as folder:
+        out = Path(folder) / "calibrated.toml"
+        calibrate = timed(["calibrate", "--out", str(out)])
+        same = filecmp.cmp(out, args.reference, shallow=False)
+    result = {"eigen_call_s": eigen, "calibrate_s": calibrate, "ratio": calibrate / eigen,
+              "reproduces_reference": same, "reference": args.reference}
+    print(f"bogie eigen --s0 0.005 --json: {eigen:.2f} s (median of {args.repeats})")
+    print(f"bogie calibrate:               {calibrate:.1f} s")
+    print(f"ratio: {calibrate / eigen:.0f} (target <= 150)")
+    print(f"written set equals {args.reference}: {'yes' if same else 'NO'}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(result, indent=1), encoding="utf-8")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,87 @@
+"""``bogie parameters`` (issue 27): the set as a table with the calibration's bounds."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from app.cli.main import main
+from model.mechanics.parameters import ESTIMATE_FILE, SCHEMA, load_parameters
+from model.studies.calibration import FREE_PARAMETERS, FreeParameter, on_bound
+
+
+def run(argv: list[str], capsys) -> tuple[int, str, str]:
+    try:
+        code = main(argv)
+    except SystemExit as exit_:
+        code = exit_.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_json_rows_are_the_set_with_the_calibration_bounds(capsys):
+    code, out, err = run(["parameters", "--json"], capsys)
+    assert code == 0, err
+    rows = json.loads(out)["parameters"]
+    assert [row["name"] for row in rows] == list(SCHEMA)
+    parameters = load_parameters()
+    free = {f.name: f for f in FREE_PARAMETERS}
+    for row in rows:
+        assert set(row) == {"name", "value", "unit", "note", "lower", "upper", "on_bound"}
+        assert row["value"] == parameters[row["name"]]
+        assert row["unit"] == SCHEMA[row["name"]][0]
+        assert row["note"] == parameters.notes[row["name"]]
+        f = free.get(row["name"])
+        if f is None:
+            assert (row["lower"], row["upper"], row["on_bound"]) == (None, None, None)
+        else:
+            assert (row["lower"], row["upper"]) == (f.low, f.high)
+            assert row["on_bound"] is on_bound(f, row["value"])
+    assert sum(row["lower"] is not None for row in rows) == len(FREE_PARAMETERS)
+
+
+def test_table_of_another_file(capsys):
+    code, out, err = run(["parameters", "--params", str(ESTIMATE_FILE)], capsys)
+    assert code == 0, err
+    lines = out.splitlines()
+    assert str(ESTIMATE_FILE) in lines[0]
+    assert "on bound" in lines[2]
+    row = next(line for line in lines if line.startswith("primary_stiffness_x "))
+    for text in ("N/m", "1.7e+06", "1.5e+07"):
+        assert text in row
+    assert len(lines) == 3 + len(SCHEMA)
+
+
+def test_on_bound_within_a_tenth_of_a_percent():
+    f = FreeParameter("x", 2.0, 8.0, "test")
+    assert on_bound(f, 2.0)
+    assert on_bound(f, 8.0 * (1 - 5e-4))
+    assert not on_bound(f, 2.0 * 1.002)
+    linear = FreeParameter("h", -0.4, 0.6, "test", log=False)
+    assert on_bound(linear, 0.5995)
+    assert not on_bound(linear, 0.0)
+
+
+@pytest.mark.parametrize(("arguments", "mention"), [
+    pytest.param(["--params", "/no/such/set.toml"], "does not exist", id="missing file"),
+    pytest.param(["--params", "{bad}"], "does not exist", id="odd name"),
+    pytest.param(["--colour"], "unrecognized", id="unknown option"),
+])
+def test_bad_input_one_line_exit_2(capsys, arguments, mention):
+    code, out, err = run(["parameters", *arguments], capsys)
+    assert code == 2
+    assert out == ""
+    assert err.count("\n") == 1
+    assert "Traceback" not in err
+    assert mention in err
+
+
+def test_a_file_that_is_not_a_parameter_set(capsys, tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('wheel_radius = { value = "big", unit = "m" }\n', encoding="utf-8")
+    code, out, err = run(["parameters", "--params", str(bad)], capsys)
+    assert code == 2
+    assert out == ""
+    assert err.count("\n") == 1
+    assert "wheel_radius" in err
