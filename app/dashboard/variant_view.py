@@ -37,6 +37,7 @@ from app.results.variants import (
 )
 from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest, ignore_outcome
 from model.mechanics.parameters import SCHEMA, ParameterError
+from model.studies.calibration import parameter_rows
 
 LIMIT_SPEEDS_KMH = (40.0, 80.0, 120.0, 160.0, 200.0)  # speeds of the s0*(v) comparison [km/h]
 CHANGED = 0.005  # relative difference highlighted in the comparison table
@@ -107,6 +108,19 @@ def comparison_html(base: Side, variant: Side, v_kmh: float) -> str:
             "<th>variant</th><th>variant − baseline</th></tr>" + "".join(rows) + "</table>")
 
 
+def bounds_html(rows) -> str:
+    """The calibrated parameters of a set with their bounds and whether the value sits on one
+    (the rows of :func:`model.studies.calibration.parameter_rows`; SI units)."""
+    lines = "".join(
+        f"<tr><td class='text'>{html.escape(r['name'])}</td><td>{r['value']:.4g}</td>"
+        f"<td>{r['lower']:.4g} … {r['upper']:.4g}</td><td class='text'>{html.escape(r['unit'])}"
+        f"</td><td class='{'bad' if r['on_bound'] else ''}'>{'yes' if r['on_bound'] else 'no'}"
+        "</td></tr>" for r in rows)
+    return ("<b>Fitted by bogie calibrate</b> (bogie parameters lists them too)"
+            '<table class="bogie"><tr><th class="text">parameter</th><th>value</th><th>bounds</th>'
+            '<th class="text">unit</th><th>on a bound</th></tr>' + lines + "</table>")
+
+
 class VariantView(pn.viewable.Viewer):
     """Editor and comparison for one dashboard (one per session)."""
 
@@ -117,20 +131,32 @@ class VariantView(pn.viewable.Viewer):
         self.base_name = dashboard.params_path
         self.base = compute.parameters(self.base_name, "calibrated")
         self.inputs: dict[str, pn.widgets.FloatInput] = {}
+        # the calibration's bounds of the baseline's fitted parameters (as bogie parameters)
+        self.bounds = {row["name"]: row for row in parameter_rows(self.base)
+                       if row["lower"] is not None}
         cards = []
         for index, (group, names) in enumerate(EDITABLE.items()):
             widgets = []
             for name in names:
                 unit, description, (low, high, _) = SCHEMA[name]
                 low, high = review_range(self.base, name)
+                fitted = self.bounds.get(name)
                 widget = pn.widgets.FloatInput(
-                    label=f"{name} [{unit}]", value=self.base[name], width=280,
+                    label=f"{name} [{unit}]" + (" (on a calibration bound)"
+                                                if fitted and fitted["on_bound"] else ""),
+                    value=self.base[name], width=280,
                     description=f"{description}; allowed {low:.4g} … {high:.4g} {unit}; "
-                                f"baseline {self.base[name]:.6g} {unit}",
+                                f"baseline {self.base[name]:.6g} {unit}"
+                                + (f"; calibrated within {fitted['lower']:.4g} … "
+                                   f"{fitted['upper']:.4g} {unit}" if fitted else ""),
                     css_classes=[f"var-{name}"])
                 self.inputs[name] = widget
                 widgets.append(widget)
             cards.append(pn.Card(*widgets, title=group, collapsed=index > 0, width=310))
+        cards.append(pn.Card(pn.pane.HTML(bounds_html(self.bounds.values()),
+                                          css_classes=["variant-bounds"]),
+                             title="Calibration bounds of the baseline", collapsed=True,
+                             width=310))
         apply = pn.widgets.Button(label="Apply variant", color="primary",
                                   css_classes=["var-apply"], width=150)
         # with the session's document lock: a new variant may clear the s0*(v) sources, and a
