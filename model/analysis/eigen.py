@@ -22,6 +22,20 @@ from model.analysis.linear_system import LinearSystem, SystemCache, inertial_inv
 from model.mechanics.assembly import BogieModel
 from model.mechanics.operating_point import OperatingPoint, damping_matrix
 
+# a real eigenvalue this close to zero (relative to the largest |λ|, ~3e5 1/s) is zero to
+# rounding: at b_M = 0 the vehicle rolling freely (translation with every wheel rolling: no slip,
+# no motor slope) has no damping at all, and its velocity's eigenvalue comes out as ±1e-12 1/s
+NEUTRAL_RTOL = 1e-12
+
+
+def non_neutral(eigenvalues: np.ndarray) -> np.ndarray:
+    """Mask of the eigenvalues that are not zero to rounding (:data:`NEUTRAL_RTOL`).  A neutral
+    eigenvalue is treated like the deflated rigid-body zeros: neither growth nor decay."""
+    lam = np.asarray(eigenvalues)
+    if lam.size == 0:
+        return np.ones(0, dtype=bool)
+    return np.abs(lam) > NEUTRAL_RTOL * np.abs(lam).max()
+
 
 @dataclass
 class StateSpace:
@@ -93,7 +107,8 @@ class EigenResult:
 
     @property
     def max_real_part(self) -> float:
-        return float(self.eigenvalues.real.max())
+        """Largest real part of the eigenvalues that are not neutral (:func:`non_neutral`)."""
+        return float(self.eigenvalues[non_neutral(self.eigenvalues)].real.max())
 
     @property
     def flutter(self) -> int:
@@ -102,8 +117,12 @@ class EigenResult:
 
     @property
     def divergence(self) -> int:
-        """Number of positive real eigenvalues."""
-        return int(np.count_nonzero(self.real > 0))
+        """Number of positive real eigenvalues (a real eigenvalue zero to rounding, |λ| <=
+        :data:`NEUTRAL_RTOL` max|λ|, is neutral: a rigid-body motion's velocity without any
+        damping, e.g. the vehicle rolling freely at b_M = 0)."""
+        values = self.real
+        tolerance = NEUTRAL_RTOL * np.abs(self.eigenvalues).max()
+        return int(np.count_nonzero(values > tolerance))
 
     @property
     def stable(self) -> bool:

@@ -80,7 +80,7 @@ import scipy.linalg as sla
 from scipy.optimize import brentq
 
 from model.analysis.continuation import LineContinuation
-from model.analysis.eigen import eigen_analysis
+from model.analysis.eigen import eigen_analysis, non_neutral
 from model.analysis.linear_system import Deflation
 from model.analysis.locus import (
     _coefficients,
@@ -117,8 +117,10 @@ CREEP_RESPONSE_SHIFT = -1.0  # σ [1/s] of the basis's low-frequency creep-respo
 
 def spectrum_summary(eigenvalues: np.ndarray) -> tuple[float, int, int]:
     """(largest real part [1/s], unstable complex pairs, positive real eigenvalues) of a set of
-    eigenvalues closed under conjugation (a pair counted once)."""
+    eigenvalues closed under conjugation (a pair counted once).  A real eigenvalue zero to
+    rounding (:func:`model.analysis.eigen.non_neutral`) is neutral: neither growth nor a divergence."""
     lam = np.asarray(eigenvalues)
+    lam = lam[non_neutral(lam)]
     is_real = np.abs(lam.imag) <= IMAG_TOL * np.abs(lam)
     unstable = lam.real > 0
     return (float(lam.real.max()), int(np.count_nonzero(unstable & ~is_real & (lam.imag > 0))),

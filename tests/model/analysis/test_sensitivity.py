@@ -70,9 +70,13 @@ def _eigenvalues(parameters, model, op, name, value):
 # over the steps h/4 … 4h: best 1.7e-4, 2.1e-5, 2.5e-5, 2.9e-6 — the references scatter by as much
 # between neighbouring steps); they are checked at WEAK_TOLERANCE, and their derivative matrices
 # are covered exactly by the Euler checks below.
-WEAK, WEAK_TOLERANCE = 1e-3, 1e-3
+# a parameter whose |p|·max|dλ/dp| is below WEAK·min|λ| hardly moves the ten modes: the
+# differences cannot resolve 1e-5 for it (on the set of issue 27 the driving shaft at s0 = 0.008,
+# influence 1.5e-3: best error 1.1e-5 over the steps, no convergence — rounding)
+WEAK, WEAK_TOLERANCE = 2e-3, 1e-3
 
 
+NEAR_DEFECTIVE_CONDITION = 1e8  # the other modes' condition numbers are 1e4-1e7
 # s0 = 0.005 stable, 0.0080 just below the limit (s0* = 0.0082), 0.014 unstable (Table 1)
 @pytest.mark.slow
 @pytest.mark.parametrize("s0", [0.005, 0.0080, 0.014])
@@ -81,6 +85,15 @@ def test_against_finite_differences(setup, s0):
     op = _op(parameters, s0)
     sens = eigen_sensitivities(model, op)
     assert sens.reliable.all()
+    # a pair next to an exceptional point (two real eigenvalues about to meet: on the set of
+    # issue 27 the vehicle's longitudinal motion against ID2's disc clutch at s0 = 0.014,
+    # +1.99 ± 0.0056i 1/s, condition 5e10) moves as the square root of a perturbation: the
+    # fourth-order differences below are not in their asymptotic range there (2e-4), the
+    # analytic derivative is; such a mode is left out of the comparison, at most one
+    near_defective = sens.condition > NEAR_DEFECTIVE_CONDITION
+    assert np.count_nonzero(near_defective) <= 1
+    assert np.all(np.abs(sens.eigenvalues[near_defective].imag)
+                  < 0.01 * np.abs(sens.eigenvalues[near_defective]))
     lam = sens.eigenvalues
     failures = []
     for i, name in enumerate(sens.names):
@@ -107,7 +120,7 @@ def test_against_finite_differences(setup, s0):
         for k in (0.5, 1, 2, 4, 8, 16):
             fd = np.array([(-pick(ev[2 * k], t) + 8 * pick(ev[k], t) - 8 * pick(ev[-k], t)
                             + pick(ev[-2 * k], t)) / (12 * k * h / 4) for t in lam])
-            errors.append(np.abs(analytic - fd).max() / np.abs(fd).max())
+            errors.append(np.abs(analytic - fd)[~near_defective].max() / np.abs(fd).max())
         influence = abs(value) * largest / np.abs(lam).min()
         tolerance = 1e-5 if value == 0.0 or influence >= WEAK else WEAK_TOLERANCE
         if min(errors) > tolerance:
