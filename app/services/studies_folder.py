@@ -1,10 +1,12 @@
 """The server's studies folder: the only place a browser's study names lead to.
 
-A reviewer picks finished map stores and uncertainty results **by name from a list** the server
-made of this folder; new studies get names the server chooses.  A name is accepted only if it is
-in the list made afresh at the moment of use; a name with a path separator, a NUL byte, more than
-:data:`MAX_NAME` characters, a leading dot, or an entry that is a symbolic link, resolves outside
-the folder or (a store) holds a symbolic link anywhere inside, is not in the list.  Every refusal
+A reviewer picks finished map stores, design-load envelope stores and uncertainty results **by
+name from a list** the server made of this folder (a store is an envelope when its attributes
+say so, a map otherwise); new studies get names the server chooses.  A name is accepted only if
+it is in the list made afresh at the moment of use; a name with a path separator, a NUL byte,
+more than :data:`MAX_NAME` characters, a leading dot, or an entry that is a symbolic link,
+resolves outside the folder or (a store) holds a symbolic link anywhere inside, is not in the
+list.  Every refusal
 raises :class:`StudyNameRefused` with one message, the same whether or not something of that name
 exists anywhere (no file oracle), and no message names a server path.
 """
@@ -21,9 +23,11 @@ from pathlib import Path
 MAX_NAME = 200  # characters of a name in the list (longer: not listed, refused)
 KINDS = {
     "map": (".zarr", "a stability-map store"),
+    "envelope": (".zarr", "a design-load envelope store"),
     "uncertainty": (".json", "an uncertainty result"),
 }
 MAX_RESULT_BYTES = 50_000_000  # an uncertainty result larger than this is not listed (not read)
+MAX_INDEX_BYTES = 1_000_000  # a store's zarr.json larger than this is not read (not listed)
 
 
 class StudyNameRefused(ValueError):
@@ -53,6 +57,30 @@ def _has_link(root: Path) -> bool:
     return False
 
 
+def _store_study(path: Path) -> str | None:
+    """The ``study`` attribute of the Zarr store at ``path`` (checked: a folder without links
+    holding a regular ``zarr.json``), None if it has none or cannot be read."""
+    import json
+
+    try:
+        fd = os.open(path / "zarr.json", os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    except OSError:
+        return None
+    try:
+        with os.fdopen(fd, "rb") as index:
+            text = index.read(MAX_INDEX_BYTES + 1)
+    except OSError:
+        return None
+    if len(text) > MAX_INDEX_BYTES:
+        return None
+    try:
+        attributes = json.loads(text).get("attributes", {})
+    except (ValueError, AttributeError):
+        return None
+    study = attributes.get("study") if isinstance(attributes, dict) else None
+    return study if isinstance(study, str) else None
+
+
 class StudiesFolder:
     """The operator's studies folder (created if missing)."""
 
@@ -78,7 +106,7 @@ class StudiesFolder:
             mode = os.lstat(path).st_mode
         except OSError:
             return None
-        if kind == "map":
+        if kind in ("map", "envelope"):
             if not stat.S_ISDIR(mode) or _has_link(path):
                 return None
             try:
@@ -86,6 +114,10 @@ class StudiesFolder:
             except OSError:
                 return None
             if not stat.S_ISREG(marker):
+                return None
+            # an envelope store is listed as such, every other store as a map (the map view
+            # says when a store is not one)
+            if (_store_study(path) == "envelope") != (kind == "envelope"):
                 return None
         elif not stat.S_ISREG(mode) or os.lstat(path).st_size > MAX_RESULT_BYTES:
             return None
