@@ -43,20 +43,23 @@ class WorstCasePlot:
             shared_x = shared_x or fig.x_range
             source = ColumnDataSource({"t": [], "upper": [], "lower": [], "at_dt": []},
                                       name=f"worst-case-{drive}")
+            band = "min … max over every Δt"  # one legend entry: the band and its edges
             fig.varea("t", "lower", "upper", source=source, fill_color=BAND, fill_alpha=0.45,
-                      legend_label="between min and max over every Δt")
-            fig.line("t", "upper", source=source, color=EDGE, line_width=1.2,
-                     legend_label="max / min over every Δt")
-            fig.line("t", "lower", source=source, color=EDGE, line_width=1.2,
-                     legend_label="max / min over every Δt")
+                      legend_label=band)
+            fig.line("t", "upper", source=source, color=EDGE, line_width=1.2, legend_label=band)
+            fig.line("t", "lower", source=source, color=EDGE, line_width=1.2, legend_label=band)
             fig.line("t", "at_dt", source=source, color=AT_DT, line_width=1.0, alpha=0.8,
-                     legend_label="history at the Response tab's Δt (linear)")
+                     legend_label="at the Response tab's Δt (linear)")
             nonlinear = ColumnDataSource({"t": [], "y": []}, name=f"worst-case-nonlinear-{drive}")
             fig.line("t", "y", source=nonlinear, color=NONLINEAR, line_width=1.0, alpha=0.8,
-                     legend_label="nonlinear creep (Response tab)")
-            fig.legend.location = "top_right"
-            fig.legend.click_policy = "hide"
-            fig.legend.label_text_font_size = "10px"
+                     legend_label="nonlinear creep")
+            # under the plot: inside, it hid the curves that span the whole horizon
+            legend = fig.legend[0]
+            legend.orientation = "horizontal"
+            legend.click_policy = "hide"
+            legend.label_text_font_size = "10px"
+            fig.add_layout(legend, "below")
+            fig.height = 360
             self.figures[drive], self.sources[drive], self.nonlinear[drive] = fig, source, nonlinear
 
     def update(self, worst: WorstCaseView, part: str, nonlinear: ResponseView | None = None
@@ -73,9 +76,9 @@ class WorstCasePlot:
             elif len(self.nonlinear[drive].data["t"]):
                 self.nonlinear[drive].data = {"t": [], "y": []}
             fig = self.figures[drive]
-            cut = (f" — linear growth (unstable), shown to {worst.plot_cut:.3f} s"
+            cut = (f" (linear growth: to {worst.plot_cut:.3f} s)"
                    if worst.plot_cut is not None else "")
-            fig.title.text = f"{drive}: {PART_LABELS[part]} over every fault instant{cut}"
+            fig.title.text = f"{drive} {PART_LABELS[part]}, every fault instant{cut}"
             fig.yaxis.axis_label = quantity_label(part, worst.units[name])
 
     @property
@@ -130,6 +133,7 @@ class RainflowMatrixPlot:
                       color_mapper=mapper)
             fig.add_layout(ColorBar(color_mapper=mapper, title="cycles [-]"), "right")
             fig.add_tools(HoverTool(tooltips=[("cycles", "@image")]))
+            fig.xaxis.ticker.desired_num_ticks = 4
             self.figures[drive], self.sources[drive], self.mappers[drive] = fig, source, mapper
 
     def update(self, spectra: SpectraView, part: str) -> None:
@@ -173,10 +177,9 @@ class EnvelopeMapPlot:
         self.figure.add_tools(HoverTool(tooltips=[("peak", "@image{0,0.[000]}")]))
         self.points = ColumnDataSource({"x": [], "y": []})
         self.figure.scatter("x", "y", source=self.points, color="white", size=3, alpha=0.6)
-        self.extreme = ColumnDataSource({"x": [], "y": []})
+        self.extreme = ColumnDataSource({"x": [], "y": []})  # the title says what the star is
         self.figure.scatter("x", "y", source=self.extreme, marker="star", size=16,
-                            color="#d62728", line_color="white", legend_label="extreme")
-        self.figure.legend.location = "top_right"
+                            color="white", line_color="black")
 
     def update(self, x: np.ndarray, y: np.ndarray, z: np.ndarray, x_label: str, y_label: str,
                title: str, value_label: str, largest: bool = True) -> None:
@@ -213,7 +216,7 @@ class EnvelopeMapPlot:
             self.extreme.data = {"x": [x[i]], "y": [y[j]]}
         else:
             self.extreme.data = {"x": [], "y": []}
-        self.figure.title.text = title
+        self.figure.title.text = f"{title} (★: the {'largest' if largest else 'smallest'})"
         self.figure.xaxis.axis_label = x_label
         self.figure.yaxis.axis_label = y_label
         self.colorbar.title = value_label
