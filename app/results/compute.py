@@ -454,17 +454,18 @@ def _growth_stop(t: np.ndarray, outputs: dict[str, np.ndarray], M_ad: float) -> 
     return int(beyond[0]) + 1 if len(beyond) else len(t)
 
 
-def history_view(r, history: str, cut_growth: bool) -> ResponseView:
+def history_view(r, history: str, cut_growth: bool,
+                 plotted: tuple[str, ...] = HISTORY_OUTPUTS) -> ResponseView:
     """A linear (:class:`model.analysis.response.ResponseResult`) or nonlinear
     (:class:`model.analysis.nonlinear.NonlinearResult`) response of HISTORY_OUTPUTS as the
     dashboard and the report show it: the full histories, their peaks and limit crossings (one
-    rule for both: :mod:`model.analysis.load_peaks`), the decimated plot series (``cut_growth``:
-    they end where a torque grows beyond GROWTH_CUT x M_ad)."""
+    rule for both: :mod:`model.analysis.load_peaks`), the decimated plot series of ``plotted``
+    and M_C (``cut_growth``: they end where a torque grows beyond GROWTH_CUT x M_ad)."""
     outputs = {name: np.asarray(r.outputs[name]) for name in HISTORY_OUTPUTS}
     M_ad = float(r.limits["M_ad"])
     stop = _growth_stop(r.t, outputs, M_ad) if cut_growth else len(r.t)
     plot = {}
-    for name, y in [*outputs.items(), ("M_C", r.M_C)]:
+    for name, y in [*((n, outputs[n]) for n in plotted), ("M_C", r.M_C)]:
         td, (yd,) = decimate(r.t[:stop], [y[:stop]])
         plot[name] = (td.astype(np.float32), yd.astype(np.float32))
     return ResponseView(
@@ -504,7 +505,8 @@ def response_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN:
     op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
     r = short_circuit_response(m, op, excitation(M0_kNm, f, D, dt_ms), t_end=float(t_end),
                                fs=sampling_rate(f), outputs=list(HISTORY_OUTPUTS))
-    return history_view(r, LINEAR_HISTORY, cut_growth=True)
+    # the Response tab's plots (the Design loads tab draws the drive parts of its own result)
+    return history_view(r, LINEAR_HISTORY, cut_growth=True, plotted=RESPONSE_OUTPUTS)
 
 
 # --- the nonlinear creep model ----------------------------------------------------------------------
@@ -563,6 +565,7 @@ def nonlinear_histories(params_path: str, rail: str, s0: float, v_kmh: float, N0
                    (r.utilisation[rim][::stride] * r.mu_max).astype(np.float32))
              for rim, s in r.creepage.items()}
     return NonlinearHistories(
+        # every drive part plotted: the Design loads tab overlays the nonlinear history
         response=history_view(r, anti_slip_description(anti_slip), cut_growth=False),
         paths=paths, detection_time=r.detection_time, action_time=r.action_time,
         max_creepage=float(max(s.max() for s in r.creepage.values())),
