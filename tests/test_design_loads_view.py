@@ -268,6 +268,37 @@ def test_a_grid_envelope_from_the_tab_equals_the_models(dash):
         shown["ID2.gear_mesh.force"].max, rel=1e-12)
 
 
+def test_a_grid_of_a_variant_links_to_the_variant(dash):
+    """The grid is computed with the dashboard's set, its variant included, and its links open
+    that variant; opened with another set on screen, the table says so and links to the bundled
+    set."""
+    from model.mechanics.parameters import parameter_hash
+
+    grid = dash.design_loads.grid
+    with param.parameterized.discard_events(dash):  # no recomputation of the dashboard needed
+        dash.variant = "gear_ratio:4.5"
+    try:
+        _small(grid, x=2, y=1)
+        study, parameters = grid.study()
+        assert study.scenarios == 4
+        assert parameter_hash(parameters) == parameter_hash(
+            compute.parameters(dash.set_key, "calibrated"))
+        assert parameters["gear_ratio"] == 4.5
+        grid.start()
+        grid.wait(600)
+        grid.poll()
+        assert grid.outcome == "done", grid.status.object
+        name = grid.ticket.name
+        assert grid.data.attrs["parameters_hash"] == parameter_hash(parameters)
+        assert "variant=gear_ratio:4.5" in grid.table.object
+    finally:
+        with param.parameterized.discard_events(dash):
+            dash.variant = ""
+    grid.open(name)  # the dashboard now shows the bundled set
+    assert "variant=" not in grid.table.object
+    assert "computed with another parameter set than the dashboard" in grid.table.object
+
+
 def test_bad_grids_are_refused_with_a_notice(dash):
     from app.services.studies_folder import refusal
 

@@ -312,10 +312,11 @@ class EnvelopeGrid:
         grid[x_axis] = self._axis_values(x_axis, self.range_x.value, counts[0])
         grid[y_axis] = self._axis_values(y_axis, self.range_y.value, counts[1])
         si = {axis: tuple(float(x) for x in grid[axis] * AXES[axis][3]) for axis in AXES}
-        parameters = compute.parameters(d.params_path, d.rail)
-        model = compute.model(d.params_path, d.rail)
+        # the dashboard's set (its variant included); the study applies the rail's creep law
+        parameters = compute.parameters(d.set_key, "calibrated")
+        model = compute.model(d.set_key, d.rail)
         creep = "nonlinear" if nonlinear else "linear"
-        first = compute.operating_point(d.params_path, d.rail, grid["s0"][0], grid["v"][0],
+        first = compute.operating_point(d.set_key, d.rail, grid["s0"][0], grid["v"][0],
                                         grid["N0"][0], grid["b_M"][0])
         outputs, units = resolve_outputs(model, first, list(compute.DRIVE_PARTS), creep)
         protection = {}
@@ -481,6 +482,23 @@ class EnvelopeGrid:
             + (" — with linear creep, the growth of unstable points" if data.study.creep ==
                "linear" else "") + "; hover shows their values.</div>")
 
+    def _link_variant(self, data: EnvelopeData) -> str | None:
+        """The variant the links carry so that they open the store's parameter set: that of
+        the study started here, the dashboard's or none (the bundled set); None if it is neither
+        (another parameter file)."""
+        from model.mechanics.parameters import parameter_hash
+
+        stored = data.attrs.get("parameters_hash")
+        base = self.dashboard.params_path
+        for variant in dict.fromkeys((self._variant, self.dashboard.variant, "")):
+            key = f"{base}|{variant}" if variant else base
+            try:
+                if parameter_hash(compute.parameters(key, "calibrated")) == stored:
+                    return variant
+            except ValueError:  # a variant that no longer applies
+                continue
+        return None
+
     def show_table(self) -> None:
         """The table per drive part: max and min, the scenario of each, links that open it."""
         data = self.data
@@ -488,23 +506,20 @@ class EnvelopeGrid:
         if result is None:
             self.table.object = "<i>no scenario finished yet</i>"
             return
-        from model.mechanics.parameters import parameter_hash
-
-        same_set = data.attrs.get("parameters_hash") == parameter_hash(
-            compute.parameters(self.dashboard.params_path, data.study.rail[0]))
-        variant = self._variant if same_set else ""
+        variant = self._link_variant(data)
         rows = []
         for o in result.outputs:
             cells = []
             for value, at in ((o.max, o.max_at), (o.min, o.min_at)):
-                query = scenario_query(at, data.study.t_end, variant)
+                query = scenario_query(at, data.study.t_end, variant or "")
                 phase = fit_phase(at["phase_s"], 1.0 / at["f"])
                 where = (f"s0 = {at['s0']:.5g}, v = {at['v_kmh']:.4g} km/h, N0 = "
                          f"{at['n0'] / 1e3:.4g} kN, b_M = {at['bm']:.5g}, M0 = "
                          f"{at['m0'] / 1e3:.4g} kN m, f = {at['f']:.4g} Hz, D = "
                          f"{at['decay']:.4g}, Δt = {at['phase_s']:.6f} s, t = {at['time_s']:.4f} s")
                 if phase is None:
-                    where += " (Δt outside the dashboard's ±10 ms: the link takes the root)"
+                    where += (" (Δt outside the dashboard's ±10 ms: the link leaves Δt "
+                              "automatic, the first continuity root)")
                 cells.append(f"<td><b>{format_load(value)}</b></td><td class='text'>{html.escape(where)}"
                              f" <a href='?{html.escape(query)}' target='_blank'>open</a></td>")
             drive, part = o.name.split(".", 1)
@@ -514,15 +529,19 @@ class EnvelopeGrid:
                  f"({data.finished}/{data.total} chunks), fault instants: {data.study.fault}, "
                  f"{data.study.creep} creep"]
         if data.study.creep != "linear":
+            protection = "/".join(data.study.anti_slip) + (
+                f", delay {'/'.join(f'{x:g}' for x in data.study.anti_slip_delay)} s"
+                if "on" in data.study.anti_slip else "")
             notes.append("the links open the operating point and the short circuit; switch the "
-                         f"creep model to {data.study.creep} (anti-slip "
-                         f"{'/'.join(data.study.anti_slip)}) to see the same history")
+                         f"creep model to {data.study.creep} (anti-slip {protection}) to see the "
+                         "same history")
         if result.truncated:
             notes.append(f"{result.truncated} scenario(s) grew beyond 1e250 (unstable, linear): "
                          "their peaks end where the time grid was cut")
-        if not same_set:
-            notes.append("computed with another parameter set than the dashboard's: the links "
-                         "open the scenario with the dashboard's set")
+        if variant is None:
+            notes.append("computed with another parameter set than the dashboard's (bundled or "
+                         f"with its variant; hash {str(data.attrs.get('parameters_hash'))[:12]}…): "
+                         "the links open the scenario with the bundled set")
         self.table.object = (
             '<table class="bogie envelope"><tr><th class="text">drive part</th><th>max</th>'
             '<th class="text">scenario of the max</th><th>min</th>'
