@@ -135,6 +135,7 @@ class DesignLoadsView:
         key = (*state.point, state.M0, state.f, state.D, state.dt, state.t_end)
         self._wanted_worst = key
         if self.worst is not None and self.worst.key == key:
+            self._apply_worst(key, self.worst)  # back to the point shown: its note again
             return
         self.worst_note.object = "<i>computing the worst case over every fault instant…</i>"
         self._compute(self._worst_requests, compute.worst_case_result, key,
@@ -150,6 +151,7 @@ class DesignLoadsView:
             self._redraw_worst()
         self._wanted_spectra = key
         if self.spectra is not None and self._spectra_key == key:
+            self._apply_spectra(key, self.spectra)
             return
         self.spectra_note.object = "<i>counting the cycles…</i>"
         self._compute(self._spectra_requests, compute.spectra_result, key,

@@ -232,11 +232,6 @@ class NonlinearView:
         s = self._state if state is None else state
         return (*s.point, s.M0, s.f, s.D, s.dt, s.t_end, self.valid)
 
-    def history_key(self, state) -> tuple | None:
-        """The cache key of the nonlinear history of ``state``
-        (:func:`app.results.compute.nonlinear_histories`), None with linear creep."""
-        return self._key(state) if self.creep.value == "nonlinear" else None
-
     def update(self) -> None:
         try:
             self.valid = anti_slip_key(self.anti_slip.value, self.delay.value,

@@ -418,7 +418,7 @@ class ResponseView:
     plot_cut: float | None = None  # plots end here [s]: a torque exceeded GROWTH_CUT x M_ad
     # per series (outputs and "M_C"): (t [s], value), min/max-decimated, float32 for the browser
     plot: dict[str, tuple[np.ndarray, np.ndarray]] = field(repr=False, default=None)
-    history: str = "linear creep"  # which history: "linear creep", "nonlinear creep, …"
+    history: str = LINEAR_HISTORY  # which history: "linear creep", "nonlinear creep, …"
     fault_instant: float = math.nan  # the fault's time shift Δt of this history [s]
 
     @property
