@@ -116,9 +116,11 @@ def test_spectra_of_the_linear_and_the_nonlinear_history():
 
 def test_the_folder_tells_envelope_stores_from_maps(tmp_path):
     """An envelope store (its zarr.json says study = envelope) is listed as an envelope only;
-    every other store as a map (the Studies tab says when one is not a map); a name of the other
-    list is refused with that list's one notice."""
+    every other store as a map (the Studies tab says when one is not a map), a store whose
+    zarr.json is not a regular file in neither; a name of the other list is refused with that
+    list's one notice."""
     import json
+    import os
 
     from app.services.studies_folder import StudiesFolder, StudyNameRefused, refusal
 
@@ -130,6 +132,8 @@ def test_the_folder_tells_envelope_stores_from_maps(tmp_path):
         (root / name / "zarr.json").write_text(json.dumps({"attributes": attributes}))
     (root / "broken.zarr").mkdir()
     (root / "broken.zarr" / "zarr.json").write_text("{not json")
+    (root / "pipe.zarr").mkdir()
+    os.mkfifo(root / "pipe.zarr" / "zarr.json")  # never opened (a reader would wait forever)
     assert folder.names("envelope") == ["e.zarr"]
     assert sorted(folder.names("map")) == ["broken.zarr", "m.zarr", "plain.zarr"]
     with pytest.raises(StudyNameRefused) as refused:

@@ -6,9 +6,8 @@ say so, a map otherwise); new studies get names the server chooses.  A name is a
 it is in the list made afresh at the moment of use; a name with a path separator, a NUL byte,
 more than :data:`MAX_NAME` characters, a leading dot, or an entry that is a symbolic link,
 resolves outside the folder or (a store) holds a symbolic link anywhere inside, is not in the
-list.  Every refusal
-raises :class:`StudyNameRefused` with one message, the same whether or not something of that name
-exists anywhere (no file oracle), and no message names a server path.
+list.  Every refusal raises :class:`StudyNameRefused` with one message, the same whether or not
+something of that name exists anywhere (no file oracle), and no message names a server path.
 """
 
 from __future__ import annotations
@@ -58,16 +57,20 @@ def _has_link(root: Path) -> bool:
 
 
 def _store_study(path: Path) -> str | None:
-    """The ``study`` attribute of the Zarr store at ``path`` (checked: a folder without links
-    holding a regular ``zarr.json``), None if it has none or cannot be read."""
+    """The ``study`` attribute of the Zarr store at ``path`` (a folder of the studies folder),
+    None if it has none or its ``zarr.json`` is not a regular file that can be read (a link, a
+    pipe, more than MAX_INDEX_BYTES)."""
     import json
 
+    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
     try:
-        fd = os.open(path / "zarr.json", os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+        fd = os.open(path / "zarr.json", flags)  # no link followed, no pipe waited for
     except OSError:
         return None
     try:
         with os.fdopen(fd, "rb") as index:
+            if not stat.S_ISREG(os.fstat(index.fileno()).st_mode):
+                return None
             text = index.read(MAX_INDEX_BYTES + 1)
     except OSError:
         return None
@@ -107,7 +110,7 @@ class StudiesFolder:
         except OSError:
             return None
         if kind in ("map", "envelope"):
-            if not stat.S_ISDIR(mode) or _has_link(path):
+            if not stat.S_ISDIR(mode):
                 return None
             try:
                 marker = os.lstat(path / "zarr.json").st_mode
@@ -116,8 +119,8 @@ class StudiesFolder:
             if not stat.S_ISREG(marker):
                 return None
             # an envelope store is listed as such, every other store as a map (the map view
-            # says when a store is not one)
-            if (_store_study(path) == "envelope") != (kind == "envelope"):
+            # says when a store is not one); then the walk through the store (the costly check)
+            if (_store_study(path) == "envelope") != (kind == "envelope") or _has_link(path):
                 return None
         elif not stat.S_ISREG(mode) or os.lstat(path).st_size > MAX_RESULT_BYTES:
             return None
