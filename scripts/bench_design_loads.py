@@ -3,7 +3,7 @@ single responses, a nonlinear scenario against ``scipy.signal.lsim``, and the pa
 of a nonlinear envelope on the default local cluster.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/bench_design_loads.py [--t-end 2] [--fs 10000]
-        [--scenarios 1000] [--scenario-t-end 2] [--workers N] [--parts 1,2,3]
+        [--scenarios 1000] [--scenario-t-end 2] [--workers N] [--parts 1,2,3,4]
 
 In one run, calibrated set, all 20 outputs, 2 s at 10 kHz unless said otherwise:
 
@@ -24,6 +24,15 @@ In one run, calibrated set, all 20 outputs, 2 s at 10 kHz unless said otherwise:
    process and on the default local cluster (one single-thread worker process per core, started
    before the clock runs); efficiency = serial / (workers × cluster) (target ≥ 80 %), results
    checked identical.
+4. **the dashboard's design loads** (``--parts 4``; ``app.results.compute``, 2 s at 10 kHz, the
+   operating point's eigendecomposition warm, as after the dashboard's first answer): the fast
+   stage's short-circuit response with the 10 plotted outputs (before the Design loads tab) and
+   with the 14 of the peak table and CSV (the plotted ones and the drive parts), each with its
+   11 decimated plot series (``compute.history_view``); the Design loads tab's worst case
+   over every fault instant (three closed-form evaluations of the 8 drive parts, the closed form
+   over Δt, decimated bands) and its load spectra (rainflow, collective, matrix of the 8 drive
+   parts), each against the fast stage's response; s0 = 0.005 and 0.014 at 120 km/h, median
+   of 15, interleaved.
 
 Times are wall clock.  The machine may be shared: the load average is printed before and after.
 """
@@ -203,6 +212,52 @@ def _collect(study, keys, finished) -> tuple[dict, float]:
     return writer.arrays, cpu
 
 
+def dashboard_design_loads(repeats: int = 15) -> None:
+    """Part 4 (module docstring)."""
+    from app.results import compute
+
+    print("\n4. the dashboard's design loads (ms, median of "
+          f"{repeats}; ratio to the fast stage's response with 14 outputs)")
+    for s0 in (0.005, 0.014):
+        point = ("", "calibrated", s0, 120.0, 100.0, 3000.0)
+        excitation = compute.excitation(50.0, 90.0, 0.04, None)
+        model = compute.model("", "calibrated")
+        op = compute.operating_point(*point)
+        compute.point_result(*point)  # the eigendecomposition, as after the first answer
+
+        def before():  # the fast stage's response before: 10 outputs, 11 series decimated
+            r = short_circuit_response(model, op, excitation, t_end=2.0, fs=10_000.0,
+                                       outputs=list(compute.RESPONSE_OUTPUTS))
+            return [compute.decimate(r.t, [y]) for y in [*r.outputs.values(), r.M_C]]
+
+        def now():  # 14 outputs (the peak table's and the CSV's), the same 11 series decimated
+            r = short_circuit_response(model, op, excitation, t_end=2.0, fs=10_000.0,
+                                       outputs=list(compute.HISTORY_OUTPUTS))
+            return compute.history_view(r, compute.LINEAR_HISTORY, True,
+                                        compute.RESPONSE_OUTPUTS)
+
+        cases = {
+            "response, 10 outputs + plot series (before)": before,
+            "response, 14 outputs + plot series (now)": now,
+            "worst case over every fault instant (8 parts)":
+                lambda: compute.worst_case_result.__wrapped__(*point, 50.0, 90.0, 0.04, None,
+                                                              2.0),
+            "load spectra of the linear history (8 parts)":
+                lambda: compute.spectra_result.__wrapped__(*point, 50.0, 90.0, 0.04, None, 2.0,
+                                                           None),
+        }
+        compute.response_result(*point, 50.0, 90.0, 0.04, None, 2.0)  # the spectra's history
+        times = {name: [] for name in cases}
+        for _ in range(repeats):
+            for name, function in cases.items():
+                times[name].append(timed(function)[0])
+        reference = float(np.median(times["response, 14 outputs + plot series (now)"]))
+        print(f"  s0 = {s0}, 120 km/h (load {load()})")
+        for name, values in times.items():
+            median = float(np.median(values))
+            print(f"    {name:<52} {median * 1e3:7.1f} ms  {median / reference:5.2f}x")
+
+
 def _warm_up(parameters) -> int:
     """Import the model and build it once in a worker (not timed)."""
     return cached_model(parameters).n
@@ -218,7 +273,8 @@ def main() -> None:
                         help="horizon of each scenario of part 3 [s] (default 2)")
     parser.add_argument("--workers", type=int, default=None,
                         help="workers of the local cluster (default: one per core)")
-    parser.add_argument("--parts", default="1,2,3", help="which parts to run (default 1,2,3)")
+    parser.add_argument("--parts", default="1,2,3",
+                        help="which parts to run (default 1,2,3; 4: the dashboard's)")
     args = parser.parse_args()
     parts = {int(x) for x in args.parts.split(",")}
     parameters = load_parameters()
@@ -233,6 +289,8 @@ def main() -> None:
     if 3 in parts:
         parallel_efficiency(parameters, model, args.scenarios, args.scenario_t_end, args.fs,
                             args.workers)
+    if 4 in parts:
+        dashboard_design_loads()
     print(f"\nload average at the end: {load()}")
 
 

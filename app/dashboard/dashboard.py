@@ -11,23 +11,28 @@ locus, time histories, tables); its pieces have modules of their own:
 * :mod:`.downloads` — the files (CSV, JSON, TOML, HTML report);
 * :mod:`.session` — the served session's document, its URL query, showing results with its lock.
 
-The views (modes, nonlinear creep, sensitivity, studies, variant) get the dashboard object and
-use its public interface only: ``state()``, ``alive()``, ``post(doc, function, *args)``,
-``run_locked(function, *args)``, ``warn(text)``, ``clear_warning()``, ``when_shown(tab,
-function, *args)``, ``flush_view(tab)``, ``params_path``, ``set_key``, the parameters, the last
-valid results (``point``, ``response``, ``locus_result``) and the plots they draw on.  A rejected
-parameter combination shows a notice and keeps the last valid results on screen.
+The views (modes, nonlinear creep, sensitivity, studies, variant, design loads) get the
+dashboard object and use its public interface only: ``state()``, ``alive()``, ``post(doc,
+function, *args)``, ``run_locked(function, *args)``, ``warn(text)``, ``clear_warning()``,
+``when_shown(tab, function, *args)``, ``flush_view(tab)``, ``params_path``, ``set_key``,
+``study_owner`` (the session's claim in the server's study queue), ``show_history(key,
+history)`` (the nonlinear view: which history the peak table describes), the parameters, the
+last valid results (``point``, ``response``, ``history``, ``locus_result``), the nonlinear view's
+creep switch and anti-slip key (``nonlinear``) and the plots they draw on.  A rejected parameter
+combination shows a notice and keeps the last valid results on screen.
 """
 
 from __future__ import annotations
 
 import html
+import secrets
 
 import panel as pn
 import param
 
 from app.dashboard import layout
 from app.dashboard.controls import PUBLISHED_SPEED_KMH, Controls
+from app.dashboard.design_loads_view import DesignLoadsView
 from app.dashboard.downloads import Downloads
 from app.dashboard.modes_view import ModeClickThrough
 from app.dashboard.nonlinear_view import NonlinearView
@@ -98,9 +103,16 @@ class BogieDashboard(pn.viewable.Viewer):
         self._limit_for: tuple | None = None  # (rail, v, N0, b_M) of self.limit
         self.locus_result: compute.LocusResult | None = None
         self.shown_locus: tuple | None = None  # (locus key, dense?) of the locus on screen
-        self.response: compute.ResponseView | None = None
+        self.response: compute.ResponseView | None = None  # the linear history
+        # the history the peak table, the CSV and the report describe: the linear one, or the
+        # nonlinear one with nonlinear creep on (None while it is computed); and its key
+        self.history: compute.ResponseView | None = None
+        self.history_key: tuple | None = None
         self.error = ""  # last rejection message ("" if the current parameters are valid)
         self.closed = False  # the served session has ended: nothing more is computed for it
+        # the session's claim on its study in the server's queue (Studies and Design loads tabs:
+        # one study at a time per session)
+        self.study_owner = secrets.token_hex(8)
         self.scheduler = Scheduler(self)
         self._build()
         self.param.watch(self._on_change, COMPUTED)
@@ -174,6 +186,9 @@ class BogieDashboard(pn.viewable.Viewer):
         self.view_tabs.add("Sensitivity", self.sensitivity.panel)
         self.studies = StudiesView(self)  # stability maps over s0 × v from the server's queue
         self.view_tabs.add("Studies", self.studies.layout)
+        # the worst case over the fault instant, grid envelopes, load spectra
+        self.design_loads = DesignLoadsView(self)
+        self.view_tabs.add("Design loads", self.design_loads.layout)
         self.downloads = Downloads(self)
         self.controls = Controls(self, self.nonlinear.controls, self.downloads.widgets)
         self.sliders = self.controls.sliders
@@ -295,12 +310,34 @@ class BogieDashboard(pn.viewable.Viewer):
         self.creep_plot.update_point(point)
         self.response_plots.update(response)
         self._show_status()
-        self.peaks.object = peaks_html(response)
         self.when_shown("modes", self._show_modes, point)
         self.locus_plot.zoom(self.zoom == "low")
         # the sensitivity tornado is computed when its tab is open, shown when ready
         self.when_shown("sensitivity", self.sensitivity.request, self, state)
-        self.nonlinear.on_fast(state)  # the nonlinear result follows
+        self.when_shown("design-loads", self.design_loads.request_worst_case, state)
+        # the nonlinear result follows; the peak table shows the history of the creep model in
+        # use (show_history, called by the nonlinear view)
+        self.nonlinear.on_fast(state)
+
+    def show_history(self, key: tuple, history: compute.ResponseView | None,
+                     note: str = "") -> None:
+        """The history the peak table, its limit crossings, the CSV download and the report
+        describe: the linear one, or the nonlinear one when the nonlinear creep model is on
+        (``history`` None: not ready, ``note`` says why).  ``key``: its arguments of
+        :func:`app.results.compute.history_result`."""
+        self.history, self.history_key = history, key
+        self.peaks.object = (peaks_html(history) if history is not None else
+                             f"<b>Peaks</b> — {html.escape(note)}")
+        self.downloads.describe(history)
+        if history is not None:
+            self.when_shown("design-loads", self.design_loads.show_history, key, history)
+
+    def described_history(self) -> compute.ResponseView:
+        """The history the peak table describes; computed now (cached) if it is not ready yet
+        (raises what the model raises)."""
+        if self.history is not None:
+            return self.history
+        return compute.history_result(*self.history_key)
 
     def _show_modes(self, point: compute.PointResult) -> None:
         """The Modes tab: eigenvalue table, mode table, mode choice and the selected mode."""

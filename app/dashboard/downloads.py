@@ -1,7 +1,9 @@
 """The dashboard's downloads: what is on screen as files (CSV, JSON, TOML, the HTML report).
 
 Each file is made when its button is pressed, from the dashboard's last valid results and its
-current parameters; the CSV keeps the full 10 kHz histories (the plots show decimated ones).
+current parameters; the CSV keeps the full 10 kHz histories (the plots show decimated ones).  The
+CSV and the report describe the history of the peak table: the linear one, or the nonlinear one
+when the nonlinear creep model is on.
 """
 
 from __future__ import annotations
@@ -20,7 +22,8 @@ from model.mechanics.parameters import dumps_parameters
 class Downloads:
     """The download buttons of one dashboard (``widgets``) and the files behind them.
 
-    ``dashboard``: its ``response`` and ``point`` (last valid results) and ``state()``."""
+    ``dashboard``: its ``point`` (last valid result), ``described_history()``, ``history_key``
+    and ``state()``."""
 
     def __init__(self, dashboard):
         self.dashboard = dashboard
@@ -39,10 +42,18 @@ class Downloads:
                                     css_classes=["dl-report"], sizing_mode="stretch_width"),
         ]
 
+    def describe(self, history: compute.ResponseView | None) -> None:
+        """The CSV's file name says which history it holds (``time_histories.csv``: the linear
+        one; ``time_histories_nonlinear.csv``: the nonlinear creep model's)."""
+        nonlinear = history is not None and history.nonlinear
+        self.widgets[0].filename = ("time_histories_nonlinear.csv" if nonlinear
+                                    else "time_histories.csv")
+
     def time_histories_csv(self) -> io.StringIO:
-        """Time [s] and every output of the response (units in the header), the motor torque
-        M_C [N m] last."""
-        r = self.dashboard.response
+        """Time [s] and every output of the history the peak table describes (linear, or
+        nonlinear with nonlinear creep on; units in the header), the motor torque M_C [N m]
+        last."""
+        r = self.dashboard.described_history()
         names = list(r.outputs)
         header = "t [s]," + ",".join(f"{n} [{r.units[n]}]" for n in names) + ",M_C [N m]"
         data = np.column_stack([r.t, *r.outputs.values(), r.M_C])
@@ -78,6 +89,8 @@ class Downloads:
     def report_html(self) -> io.StringIO:
         """The self-contained HTML report of the current state (:mod:`app.report.page`)."""
         state = self.dashboard.state()
+        key = self.dashboard.history_key
+        anti_slip = key[-1] if key is not None else None  # None: linear creep
         return io.StringIO(build_report(state.params_path, state.rail, state.s0, state.v,
                                         state.N0, state.b_M, state.M0, state.f, state.D,
-                                        state.dt, state.t_end))
+                                        state.dt, state.t_end, anti_slip=anti_slip))

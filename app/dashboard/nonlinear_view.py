@@ -10,8 +10,12 @@ values and results.
 
 The dashboard builds ``NonlinearView(dashboard)`` and places its ``controls``, ``notice`` and
 ``status`` in its page; it calls ``prefetch(state)`` when the linear first answer is computed
-(served) and ``on_fast(state)`` when that answer is shown.  Computations here take primitives
-only (``pn.cache`` keys) and return plain read-only data, like :mod:`app.results.compute`.
+(served) and ``on_fast(state)`` when that answer is shown.  This view tells the dashboard which
+history its peak table, CSV download and report describe (``dashboard.show_history``): the
+linear one, or with nonlinear creep on the nonlinear one (none while it is computed).  The
+nonlinear histories are computed by :func:`app.results.compute.nonlinear_histories` (the report
+uses them too); the reaction-time search here takes primitives only (``pn.cache`` keys) and
+returns plain read-only data, like :mod:`app.results.compute`.
 """
 
 from __future__ import annotations
@@ -20,18 +24,18 @@ import html
 import logging
 import weakref
 from contextvars import ContextVar
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
 import panel as pn
 
 from app.results import compute
+from app.results.compute import NonlinearHistories, nonlinear_histories
 from app.results.plots import SeriesSource
 from app.services.thread_pools import NONLINEAR_POOL, SEARCH_POOL, LatestRequest, ignore_outcome
 from model.analysis.antislip import required_reaction_time
-from model.analysis.nonlinear import AntiSlip, NonlinearError, nonlinear_response
-from model.analysis.response import ShortCircuit
+from model.analysis.nonlinear import AntiSlip, NonlinearError
 
 log = logging.getLogger(__name__)
 CREEP_MODELS = ("linear", "nonlinear")
@@ -40,7 +44,6 @@ WHEEL_COLORS = {"ID1.rim12": "#8c564b", "ID1.rim14": "#e377c2", "ID2.rim12": "#1
 REACTION_DELAYS = np.linspace(0.0, 0.5, 11)  # [s] delay grid of the dashboard's reaction time
 REACTION_FS = 5_000.0  # [Hz] its sampling (the CLI's default is 10 kHz)
 REACTION_QUIET_MS = 1000  # [ms] the search starts when the operating point has stayed this long
-PATH_POINTS = 1500  # points of each wheel's creepage path sent to the browser
 # the views alive in this process: a reaction search that no view wants any more (superseded by
 # another operating point, or its session closed) stops between its runs instead of holding the
 # shared worker and the CPU for tens of seconds
@@ -71,19 +74,6 @@ def wanted_reaction(*key) -> Reaction:
 
 
 @dataclass(frozen=True)
-class NonlinearHistories:
-    """Nonlinear histories for the plots (decimated, float32) and a few numbers."""
-
-    plot: dict[str, tuple[np.ndarray, np.ndarray]] = field(repr=False)  # name -> (t, y)
-    paths: dict[str, tuple[np.ndarray, np.ndarray]] = field(repr=False)  # rim -> (s, μ)
-    peaks: dict[str, float]  # RESPONSE_OUTPUTS -> signed total of largest magnitude
-    detection_time: float | None  # [s]
-    action_time: float | None  # [s]
-    max_creepage: float  # largest creepage of any wheel [-]
-    M_ad: float  # [N m]
-
-
-@dataclass(frozen=True)
 class Reaction:
     """Required reaction time at an operating point (plain data)."""
 
@@ -100,38 +90,6 @@ def anti_slip_key(enabled: bool, delay: float, threshold: float, rate: float) ->
     return (bool(enabled), float(delay), float(threshold), float(rate))
 
 
-def _excitation(M0_kNm, f, D, dt_ms) -> ShortCircuit:
-    return ShortCircuit(M0=float(M0_kNm) * 1e3, f=float(f), D=float(D),
-                        dt=None if dt_ms is None else float(dt_ms) * 1e-3)
-
-
-@pn.cache(max_items=32)
-def nonlinear_histories(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                        b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
-                        t_end: float, anti_slip: tuple) -> NonlinearHistories:
-    """The nonlinear response (model.analysis.nonlinear) reshaped for the plots."""
-    m = compute.model(params_path, rail)
-    op = compute.operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
-    enabled, delay, threshold, rate = anti_slip
-    protection = AntiSlip(True, delay, threshold, rate) if enabled else None
-    fs = max(compute.RESPONSE_FS, 20.0 * float(f))
-    r = nonlinear_response(m, op, _excitation(M0_kNm, f, D, dt_ms), float(t_end), fs,
-                           anti_slip=protection, outputs=list(compute.RESPONSE_OUTPUTS))
-    plot = {}
-    for name in compute.RESPONSE_OUTPUTS:
-        td, (yd,) = compute.decimate(r.t, [r.outputs[name]])
-        plot[name] = (td.astype(np.float32), yd.astype(np.float32))
-    stride = max(1, len(r.t) // PATH_POINTS)
-    paths = {rim: (s[::stride].astype(np.float32),
-                   (r.utilisation[rim][::stride] * r.mu_max).astype(np.float32))
-             for rim, s in r.creepage.items()}
-    return NonlinearHistories(
-        plot=plot, paths=paths, peaks={k: float(r.peaks[k]) for k in compute.RESPONSE_OUTPUTS},
-        detection_time=r.detection_time, action_time=r.action_time,
-        max_creepage=float(max(s.max() for s in r.creepage.values())),
-        M_ad=float(r.limits["M_ad"]))
-
-
 @pn.cache(max_items=64)
 def reaction(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
              M0_kNm: float, f: float, D: float, dt_ms: float | None, threshold: float,
@@ -143,7 +101,8 @@ def reaction(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
     m = compute.model(params_path, rail)
     op = compute.operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
     result = required_reaction_time(
-        m, op, _excitation(M0_kNm, f, D, dt_ms), anti_slip=AntiSlip(True, 0.1, threshold, rate),
+        m, op, compute.excitation(M0_kNm, f, D, dt_ms),
+        anti_slip=AntiSlip(True, 0.1, threshold, rate),
         delays=REACTION_DELAYS, t_end=2.0, fs=max(REACTION_FS, 20.0 * float(f)),
         progress=lambda _text: _stop_unless_wanted(key))  # after each run of the delay grid
     return Reaction(result.required_delay, result.reason, result.detection_time,
@@ -224,6 +183,7 @@ class NonlinearView:
 
     def _show(self, key, histories: NonlinearHistories) -> None:
         self.histories, self._shown_key = histories, key
+        self.dash.show_history(key, histories.response)  # the peak table describes it
         self.sources.update(histories.plot)
         self.paths.update(histories.paths)
         self._progress = self._describe(histories)
@@ -276,21 +236,24 @@ class NonlinearView:
         try:
             self.valid = anti_slip_key(self.anti_slip.value, self.delay.value,
                                        self.threshold.value, self.rate.value)
+            self.notice.visible = False
         except (NonlinearError, TypeError, ValueError) as error:
+            # the last valid values stay in use (nothing is recomputed for the bad input)
             message = error.args[0] if error.args else str(error)
             self.notice.object = (f"**Anti-slip input rejected:** {html.escape(str(message))} — "
                                   "keeping the last valid values and results.")
             self.notice.visible = True
-            return
-        self.notice.visible = False
+        key = self._key()
         if self.creep.value == "linear":
             self._clear()
             self._progress = ""
+            self.dash.show_history((*key[:-1], None), self.dash.response)
+        elif key != self._shown_key:
+            self._progress = "nonlinear creep: computing…"
+            self.dash.show_history(key, None, "computing the nonlinear history…")
+            self._start(key, partial(nonlinear_histories, *key), self._apply_histories)
         else:
-            key = self._key()
-            if key != self._shown_key:
-                self._progress = "nonlinear creep: computing…"
-                self._start(key, partial(nonlinear_histories, *key), self._apply_histories)
+            self.dash.show_history(key, self.histories.response)
         self._request_reaction()
         self._render_status()
 
@@ -370,6 +333,10 @@ class NonlinearView:
 
     def _reject(self, error: Exception) -> None:
         message = error.args[0] if error.args else str(error)
+        if self.creep.value == "nonlinear" and self._state is not None \
+                and self._key() != self._shown_key:
+            self.dash.show_history(self._key(), None, "the nonlinear history was rejected "
+                                   "(see the notice above)")
         self.notice.object = (f"**Nonlinear computation rejected:** {html.escape(str(message))} — "
                               "showing the last valid result.")
         self.notice.visible = True

@@ -127,7 +127,9 @@ class StudiesView(pn.viewable.Viewer):
         super().__init__(**params)
         self.dashboard = dashboard
         self.queue = queue or study_queue()
-        self.owner = secrets.token_hex(8)  # this session's claim on its study
+        # this session's claim on its study (the dashboard's: one study per session, a map here
+        # or an envelope of the Design loads tab)
+        self.owner = getattr(dashboard, "study_owner", None) or secrets.token_hex(8)
         self.map: MapView | None = None  # last map shown
         self.ticket: StudyTicket | None = None  # the session's running / last study
         self.error = ""

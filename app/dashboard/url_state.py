@@ -131,3 +131,39 @@ def make_query(dashboard, tab: str | None = None) -> str:
     if dashboard.variant:
         items.append(("variant", dashboard.variant))
     return urlencode(items, safe=":,")
+
+
+def fit_phase(phase: float, period: float, limit: float = 0.010) -> float | None:
+    """A fault instant Δt [s] moved by whole periods ``period`` [s] (the same short circuit) into
+    the dashboard's range [−``limit``, ``limit``] [s]; None if no shift fits."""
+    if not math.isfinite(phase):
+        return None
+    if abs(phase) <= limit:
+        return phase
+    if period > 0 and math.isfinite(period):
+        shifted = phase - round(phase / period) * period
+        if abs(shifted) <= limit:
+            return shifted
+    return None
+
+
+def scenario_query(scenario: Mapping, t_end: float, variant: str = "",
+                   tab: str | None = "response") -> str:
+    """The query (without '?') that opens one scenario of a design-load envelope (the
+    ``max_at``/``min_at`` dicts of :func:`model.studies.envelope.envelope`: ``s0``, ``v_kmh``,
+    ``n0`` [N], ``bm``, ``m0`` [N m], ``f`` [Hz], ``decay``, ``phase_s`` [s], ``rail``) with the
+    simulated time ``t_end`` [s]; the fault instant is moved by whole periods into the
+    dashboard's range (left out, automatic, if none fits)."""
+    items = [("s0", _number(scenario["s0"])), ("v", _number(scenario["v_kmh"])),
+             ("n0", _number(scenario["n0"])), ("bm", _number(scenario["bm"])),
+             ("m0", _number(scenario["m0"])), ("f", _number(scenario["f"])),
+             ("decay", _number(scenario["decay"]))]
+    phase = fit_phase(float(scenario["phase_s"]), 1.0 / float(scenario["f"]))
+    if phase is not None:
+        items.append(("phase", _number(phase)))
+    items += [("t_end", _number(t_end)), ("rail", str(scenario["rail"]))]
+    if tab:
+        items.append(("tab", tab))
+    if variant:
+        items.append(("variant", variant))
+    return urlencode(items, safe=":,")

@@ -3,8 +3,10 @@ inline, no external script or stylesheet).
 
 Contents: verdict, operating point and excitation, the parameter set (name, hash, differences
 from the bundled baseline), status numbers and s0*(v), Table 1/2 layouts, the root locus (dense
-sweep), Fig. 6, the creep characteristic, the time histories, the peak table with the limit
-crossings, the code version and the date.  The figures are the dashboard's own
+sweep), Fig. 6, the creep characteristic, the time histories and the peak table with the limit
+crossings (of the linear closed form, or of the nonlinear creep model when the dashboard has it
+on), the design loads (the worst case over every fault instant, the load collective and the
+damage-equivalent ranges of the history), the code version and the date.  The figures are the dashboard's own
 (:mod:`app.results.plots`, :mod:`app.results.eigenvalue_sweep`), fed with the same cached
 results (:mod:`app.results.compute`).
 
@@ -28,8 +30,15 @@ from bokeh.layouts import column, row
 from app.report.embedding import EmbeddedFigures, embed_inline
 from app.results import compute
 from app.results.eigenvalue_sweep import Fig6Plot
+from app.results.load_plots import LoadCollectivePlot
 from app.results.plots import CreepPlot, ResponsePlots, RootLocusPlot
-from app.results.tables import eigen_table_html, mode_table_html, peaks_html
+from app.results.tables import (
+    eigen_table_html,
+    mode_table_html,
+    peaks_html,
+    spectra_html,
+    worst_case_html,
+)
 from app.results.variants import differences, parameters_of_key, set_hash, split_key
 from model.mechanics.parameters import SCHEMA
 
@@ -76,6 +85,9 @@ class ReportCase:
     D: float  # short-circuit decay [-]
     dt_ms: float | None  # short-circuit time shift [ms] (None: continuous motor torque)
     t_end: float  # simulated time [s]
+    # nonlinear creep: ID2's anti-slip key (enabled, delay [s], threshold [m/s], rate [1/s]);
+    # None: the linear closed form
+    anti_slip: tuple | None = None
 
     @property
     def point(self) -> tuple:
@@ -88,24 +100,29 @@ class ReportResults:
     """The results a report shows (cached, plain data)."""
 
     point: compute.PointResult
-    response: compute.ResponseView
+    response: compute.ResponseView  # the history shown: linear, or nonlinear creep
     locus: compute.LocusResult  # the dense root locus over s0 at the case's speed
     limit: compute.LimitResult
+    worst: compute.WorstCaseView  # the worst case over every fault instant (linear)
+    spectra: compute.SpectraView  # load spectra of the history shown
 
 
 def report_results(case: ReportCase, say=lambda _text: None) -> ReportResults:
     """Compute (or take from the cache) what the report shows; ``say(text)`` names each step."""
     say("eigenvalues and modes")
     point = compute.point_result(*case.point)
-    say("short-circuit response")
-    response = compute.response_result(*case.point, case.M0_kNm, case.f, case.D, case.dt_ms,
-                                       case.t_end)
+    excitation = (case.M0_kNm, case.f, case.D, case.dt_ms, case.t_end)
+    say("short-circuit response" + (" (nonlinear creep)" if case.anti_slip is not None else ""))
+    response = compute.history_result(*case.point, *excitation, case.anti_slip)
     say("root locus (dense sweep over s0)")
     locus = compute.dense_locus_result(case.set_key, case.rail, "s0", case.v_kmh, case.N0_kN,
                                        case.b_M)
     say("stability limit s0*(v)")
     limit = compute.limit_result(case.set_key, case.rail, case.v_kmh, case.N0_kN, case.b_M)
-    return ReportResults(point, response, locus, limit)
+    say("design loads: worst case over the fault instant, load spectra")
+    worst = compute.worst_case_result(*case.point, *excitation)
+    spectra = compute.spectra_result(*case.point, *excitation, case.anti_slip)
+    return ReportResults(point, response, locus, limit, worst, spectra)
 
 
 def report_figures(results: ReportResults) -> dict:
@@ -123,6 +140,11 @@ def report_figures(results: ReportResults) -> dict:
     creep.update_limit(results.limit)
     responses = ResponsePlots()
     responses.update(results.response)
+    collectives = []
+    for part in compute.PARTS:
+        plot = LoadCollectivePlot()
+        plot.update(results.spectra, part)
+        collectives.append(plot.figure)
     return {
         "locus": locus_plot.figure,
         "fig6": column(row(*fig6.figures[:2], sizing_mode="stretch_width"), fig6.figures[2],
@@ -131,6 +153,9 @@ def report_figures(results: ReportResults) -> dict:
         "response": column(row(*responses.figures[:2], sizing_mode="stretch_width"),
                            row(*responses.figures[2:], sizing_mode="stretch_width"),
                            sizing_mode="stretch_width"),
+        "collective": column(row(*collectives[:2], sizing_mode="stretch_width"),
+                             row(*collectives[2:], sizing_mode="stretch_width"),
+                             sizing_mode="stretch_width"),
     }
 
 
@@ -152,7 +177,8 @@ def operating_table(case: ReportCase) -> str:
         ("decay D [-]", f"{case.D:g}"),
         ("time shift Δt [s]", "automatic (continuous motor torque)" if case.dt_ms is None
          else f"{case.dt_ms * 1e-3:g}"),
-        ("simulated time [s]", f"{case.t_end:g}")])
+        ("simulated time [s]", f"{case.t_end:g}"),
+        ("longitudinal creep", compute.anti_slip_description(case.anti_slip))])
 
 
 def stability_table(case: ReportCase, results: ReportResults) -> str:
@@ -184,6 +210,25 @@ def differences_table(diff: dict[str, tuple[float, float]]) -> str:
                 for n, (a, b) in diff.items()) + "</table>")
 
 
+def design_loads_section(results: ReportResults, collective_div: str) -> str:
+    """The design loads (docs/design-loads.md): the worst case over every fault instant at the
+    point (linear closed form, table per drive part) and the load spectrum of the history shown
+    (equivalent ranges, the load collective of each drive part)."""
+    unstable = "" if results.point.stable else (
+        "<p><b>The operating point is unstable:</b> the linear response grows without bound, "
+        "and so does its worst case over the fault instant — it says “unstable”, not a design "
+        "load.  The nonlinear creep model bounds it (the dashboard's creep switch).</p>")
+    meaningless = "" if results.point.stable or results.spectra.history != \
+        compute.LINEAR_HISTORY else ("<p>The load spectrum below is that of a linear blow-up "
+                                     "and means nothing.</p>")
+    return f"""<h2>Design loads</h2>
+<h3>Worst case over every fault instant (linear creep, closed form)</h3>
+{unstable}{worst_case_html(results.worst)}
+<h3>Load spectrum of the history above ({html.escape(results.spectra.history)})</h3>
+{meaningless}{spectra_html(results.spectra)}
+{collective_div}"""
+
+
 # --- the page --------------------------------------------------------------------------------------
 
 def report_page(case: ReportCase, results: ReportResults, figures: EmbeddedFigures,
@@ -212,12 +257,13 @@ parameter set {name}{' (variant)' if changes else ''}, hash <code>{set_hash(para
 <h2>Root locus over s0 at {v_kmh:g} km/h ({len(results.locus.values)} points)</h2>{divs['locus']}
 <h2>Fig. 6: eigenvalues against s0</h2>{divs['fig6']}
 <div class="cols"><div>{eigen_table_html(point)}</div><div>{mode_table_html(point)}</div></div>
-<h2>Short-circuit response</h2>
+<h2>Short-circuit response ({html.escape(results.response.history)})</h2>
 <div class="cols"><div>{divs['creep']}</div><div>{peaks_html(results.response)}</div></div>
 {divs['response']}
 <p class="sub">Time histories min/max-decimated for plotting (every extreme kept); the peaks are
-from the full 10 kHz history.  Generated by the dashboard's report button or
-<code>bogie report</code>.</p>
+from the full 10 kHz history.</p>
+{design_loads_section(results, divs['collective'])}
+<p class="sub">Generated by the dashboard's report button or <code>bogie report</code>.</p>
 {figures.script}
 </body></html>
 """
@@ -225,11 +271,15 @@ from the full 10 kHz history.  Generated by the dashboard's report button or
 
 def build_report(set_key: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
                  M0_kNm: float, f: float, D: float, dt_ms: float | None, t_end: float,
-                 progress=None, now: datetime.datetime | None = None) -> str:
+                 progress=None, now: datetime.datetime | None = None,
+                 anti_slip: tuple | None = None) -> str:
     """The report as one HTML text.  Arguments as in :mod:`app.results.compute` (``set_key``: the
     parameter set, a bundled file or a variant of it, :mod:`app.results.variants`); ``progress``:
-    called with the name of each step; ``now``: the date shown (default: now, UTC)."""
-    case = ReportCase(set_key, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, t_end)
+    called with the name of each step; ``now``: the date shown (default: now, UTC);
+    ``anti_slip``: with nonlinear creep, ID2's anti-slip key (enabled, delay [s], threshold
+    [m/s], rate [1/s]) — the histories, peaks and spectra are then the nonlinear ones."""
+    case = ReportCase(set_key, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, t_end,
+                      None if anti_slip is None else tuple(anti_slip))
     say = progress or (lambda _text: None)
     results = report_results(case, say)
     say("writing the report")

@@ -50,7 +50,20 @@ RESPONSE_FS = 10_000.0  # sampling of the time histories [Hz]: 33 samples per pe
 
 TORQUES = ("driving_shaft.torque", "disc_clutch.torque")
 FORCES = ("disc_clutch.force_x", "disc_clutch.force_y", "disc_clutch.force_z")
-RESPONSE_OUTPUTS = tuple(f"{d}.{q}" for d in ("ID1", "ID2") for q in TORQUES + FORCES)
+RESPONSE_OUTPUTS = tuple(f"{d}.{q}" for d in ("ID1", "ID2") for q in TORQUES + FORCES)  # plotted
+# the drive parts a design review signs off (docs/design-loads.md): torques [N m], the gear
+# mesh force [N]
+PARTS = ("driving_shaft.torque", "disc_clutch.torque", "claw_clutch.torque", "gear_mesh.force")
+PART_LABELS = {"driving_shaft.torque": "driving shaft torque", "disc_clutch.torque":
+               "disc clutch torque", "claw_clutch.torque": "claw clutch torque",
+               "gear_mesh.force": "gear mesh force"}
+DRIVE_PARTS = tuple(f"{d}.{q}" for d in ("ID1", "ID2") for q in PARTS)
+# every history the dashboard computes (peak table, CSV, spectra): the plotted outputs and the
+# drive parts
+HISTORY_OUTPUTS = RESPONSE_OUTPUTS + tuple(n for n in DRIVE_PARTS if n not in RESPONSE_OUTPUTS)
+LINEAR_HISTORY = "linear creep"  # the name of the linear closed form's history
+PATH_POINTS = 1500  # points of each wheel's creepage path (nonlinear creep) sent to the browser
+RAINFLOW_BINS = 24  # bins of the rainflow matrix along the range and the mean
 
 
 class ModelRejected(ValueError):
@@ -390,10 +403,11 @@ def broken_columns(series: np.ndarray, jumps: np.ndarray | None) -> list[np.ndar
 
 @dataclass(frozen=True)
 class ResponseView:
-    """Time histories of both drives, full resolution (CSV) and decimated (plots)."""
+    """Time histories of both drives, full resolution (CSV, spectra) and decimated (plots); the
+    linear closed form or the nonlinear creep model (``history`` says which)."""
 
     t: np.ndarray  # [s]
-    outputs: dict[str, np.ndarray]  # RESPONSE_OUTPUTS -> total value [N m or N]
+    outputs: dict[str, np.ndarray]  # HISTORY_OUTPUTS -> total value [N m or N]
     M_C: np.ndarray  # short-circuit torque [N m]
     peaks: dict[str, float]  # signed total of largest magnitude
     peak_times: dict[str, float]  # [s]
@@ -404,6 +418,13 @@ class ResponseView:
     plot_cut: float | None = None  # plots end here [s]: a torque exceeded GROWTH_CUT x M_ad
     # per series (outputs and "M_C"): (t [s], value), min/max-decimated, float32 for the browser
     plot: dict[str, tuple[np.ndarray, np.ndarray]] = field(repr=False, default=None)
+    history: str = LINEAR_HISTORY  # which history: "linear creep", "nonlinear creep, …"
+    fault_instant: float = math.nan  # the fault's time shift Δt of this history [s]
+
+    @property
+    def nonlinear(self) -> bool:
+        """Whether this is the history of the nonlinear creep model."""
+        return self.history.startswith("nonlinear")
 
 
 def decimate(t: np.ndarray, ys: list[np.ndarray], buckets: int = PLOT_BUCKETS):
@@ -425,38 +446,242 @@ def decimate(t: np.ndarray, ys: list[np.ndarray], buckets: int = PLOT_BUCKETS):
     return t[index], [y[index] for y in ys]
 
 
-@pn.cache(max_items=64)
-def response_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                    b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
-                    t_end: float) -> ResponseView:
-    """Short-circuit response of both drives (model.analysis.response)."""
-    from model.analysis.response import ShortCircuit, short_circuit_response
-
-    m = model(params_path, rail)
-    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
-    excitation = ShortCircuit(M0=float(M0_kNm) * 1e3, f=float(f), D=float(D),
-                              dt=None if dt_ms is None else float(dt_ms) * 1e-3)
-    fs = max(RESPONSE_FS, 20.0 * float(f))
-    r = short_circuit_response(m, op, excitation, t_end=float(t_end), fs=fs,
-                               outputs=list(RESPONSE_OUTPUTS))
-    outputs = {name: np.asarray(r.outputs[name]) for name in RESPONSE_OUTPUTS}
-    M_ad = float(r.limits["M_ad"])
-    # plots stop where a torque grows beyond GROWTH_CUT x M_ad (unstable: exponential growth
-    # would flatten everything before it); the CSV keeps the whole history
+def _growth_stop(t: np.ndarray, outputs: dict[str, np.ndarray], M_ad: float) -> int:
+    """Samples to plot: up to where a plotted torque first exceeds GROWTH_CUT x M_ad (unstable:
+    exponential growth would flatten everything before it), else all."""
     torques = np.array([np.abs(outputs[n]) for n in RESPONSE_OUTPUTS if n.endswith("torque")])
     beyond = np.flatnonzero(torques.max(axis=0) > GROWTH_CUT * M_ad)
-    stop = int(beyond[0]) + 1 if len(beyond) else len(r.t)
+    return int(beyond[0]) + 1 if len(beyond) else len(t)
+
+
+def history_view(r, history: str, cut_growth: bool,
+                 plotted: tuple[str, ...] = HISTORY_OUTPUTS) -> ResponseView:
+    """A linear (:class:`model.analysis.response.ResponseResult`) or nonlinear
+    (:class:`model.analysis.nonlinear.NonlinearResult`) response of HISTORY_OUTPUTS as the
+    dashboard and the report show it: the full histories, their peaks and limit crossings (one
+    rule for both: :mod:`model.analysis.load_peaks`), the decimated plot series of ``plotted``
+    and M_C (``cut_growth``: they end where a torque grows beyond GROWTH_CUT x M_ad)."""
+    outputs = {name: np.asarray(r.outputs[name]) for name in HISTORY_OUTPUTS}
+    M_ad = float(r.limits["M_ad"])
+    stop = _growth_stop(r.t, outputs, M_ad) if cut_growth else len(r.t)
     plot = {}
-    for name, y in [*outputs.items(), ("M_C", r.M_C)]:
+    for name, y in [*((n, outputs[n]) for n in plotted), ("M_C", r.M_C)]:
         td, (yd,) = decimate(r.t[:stop], [y[:stop]])
         plot[name] = (td.astype(np.float32), yd.astype(np.float32))
     return ResponseView(
         t=r.t, outputs=outputs, M_C=np.asarray(r.M_C),
-        peaks={k: float(r.peaks[k]) for k in RESPONSE_OUTPUTS},
-        peak_times={k: float(r.peak_times[k]) for k in RESPONSE_OUTPUTS},
-        units={k: r.units[k] for k in RESPONSE_OUTPUTS}, M_ad=M_ad,
+        peaks={k: float(r.peaks[k]) for k in HISTORY_OUTPUTS},
+        peak_times={k: float(r.peak_times[k]) for k in HISTORY_OUTPUTS},
+        units={k: r.units[k] for k in HISTORY_OUTPUTS}, M_ad=M_ad,
         plot_cut=float(r.t[stop - 1]) if stop < len(r.t) else None,
-        truncated_at=r.truncated_at,
+        truncated_at=getattr(r, "truncated_at", None),
         crossings=[(c.output, c.limit_name, c.time, c.value) for c in r.limit_crossings
                    if c.output in outputs],
-        plot=plot)
+        plot=plot, history=history, fault_instant=float(r.excitation.shift(r.motor_torque)))
+
+
+def excitation(M0_kNm: float, f: float, D: float, dt_ms: float | None):
+    """The short circuit of the dashboard's units (:class:`model.analysis.response.ShortCircuit`):
+    ``M0_kNm`` [kN m], ``f`` [Hz], ``D`` [-], ``dt_ms`` [ms] (None: continuous motor torque)."""
+    from model.analysis.response import ShortCircuit
+
+    return ShortCircuit(M0=float(M0_kNm) * 1e3, f=float(f), D=float(D),
+                        dt=None if dt_ms is None else float(dt_ms) * 1e-3)
+
+
+def sampling_rate(f: float) -> float:
+    """The histories' sampling rate [Hz]: RESPONSE_FS, at least 20 samples per period of f."""
+    return max(RESPONSE_FS, 20.0 * float(f))
+
+
+@pn.cache(max_items=64)
+def response_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                    b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
+                    t_end: float) -> ResponseView:
+    """Short-circuit response of both drives (model.analysis.response), linear creep."""
+    from model.analysis.response import short_circuit_response
+
+    m = model(params_path, rail)
+    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
+    r = short_circuit_response(m, op, excitation(M0_kNm, f, D, dt_ms), t_end=float(t_end),
+                               fs=sampling_rate(f), outputs=list(HISTORY_OUTPUTS))
+    # the Response tab's plots (the Design loads tab draws the drive parts of its own result)
+    return history_view(r, LINEAR_HISTORY, cut_growth=True, plotted=RESPONSE_OUTPUTS)
+
+
+# --- the nonlinear creep model ----------------------------------------------------------------------
+
+def anti_slip_description(anti_slip: tuple | None) -> str:
+    """The history's name for an anti-slip key ``(enabled, delay [s], threshold [m/s], rate
+    [1/s])`` (None: linear creep)."""
+    if anti_slip is None:
+        return LINEAR_HISTORY
+    enabled, delay, threshold, rate = anti_slip
+    if not enabled:
+        return "nonlinear creep, anti-slip off"
+    return (f"nonlinear creep, anti-slip on ID2 (delay {delay:g} s, threshold {threshold:g} m/s, "
+            f"ramp {rate:g} 1/s)")
+
+
+@dataclass(frozen=True)
+class NonlinearHistories:
+    """The nonlinear response (full histories, peaks, crossings: ``response``) and what the
+    dashboard draws besides: the creepage paths and a few numbers."""
+
+    response: ResponseView  # the nonlinear history, as the peak table, CSV and spectra read it
+    paths: dict[str, tuple[np.ndarray, np.ndarray]] = field(repr=False)  # rim -> (s, μ)
+    detection_time: float | None  # [s]
+    action_time: float | None  # [s]
+    max_creepage: float  # largest creepage of any wheel [-]
+    M_ad: float  # [N m]
+
+    @property
+    def plot(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """The decimated histories (t [s], value) for the plots."""
+        return self.response.plot
+
+    @property
+    def peaks(self) -> dict[str, float]:
+        """Signed total of largest magnitude of each output."""
+        return self.response.peaks
+
+
+@pn.cache(max_items=32)
+def nonlinear_histories(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                        b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
+                        t_end: float, anti_slip: tuple) -> NonlinearHistories:
+    """The nonlinear response (model.analysis.nonlinear) of HISTORY_OUTPUTS; ``anti_slip``:
+    (enabled, delay [s], threshold [m/s], rate [1/s]) of ID2's protection."""
+    from model.analysis.nonlinear import AntiSlip, nonlinear_response
+
+    m = model(params_path, rail)
+    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
+    enabled, delay, threshold, rate = anti_slip
+    protection = AntiSlip(True, delay, threshold, rate) if enabled else None
+    r = nonlinear_response(m, op, excitation(M0_kNm, f, D, dt_ms), float(t_end),
+                           sampling_rate(f), anti_slip=protection, outputs=list(HISTORY_OUTPUTS))
+    stride = max(1, len(r.t) // PATH_POINTS)
+    paths = {rim: (s[::stride].astype(np.float32),
+                   (r.utilisation[rim][::stride] * r.mu_max).astype(np.float32))
+             for rim, s in r.creepage.items()}
+    return NonlinearHistories(
+        # every drive part plotted: the Design loads tab overlays the nonlinear history
+        response=history_view(r, anti_slip_description(anti_slip), cut_growth=False),
+        paths=paths, detection_time=r.detection_time, action_time=r.action_time,
+        max_creepage=float(max(s.max() for s in r.creepage.values())),
+        M_ad=float(r.limits["M_ad"]))
+
+
+def history_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                   b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
+                   t_end: float, anti_slip: tuple | None) -> ResponseView:
+    """The history the dashboard describes (peak table, CSV, spectra, report): the linear one
+    (``anti_slip`` None) or the nonlinear one with that anti-slip key (both cached)."""
+    point = (params_path, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, t_end)
+    if anti_slip is None:
+        return response_result(*point)
+    return nonlinear_histories(*point, tuple(anti_slip)).response
+
+
+# --- design loads: the worst fault instant and the load spectrum -----------------------------------
+
+@dataclass(frozen=True)
+class WorstCaseView:
+    """The worst case over every fault instant Δt of the drive parts at one point (linear creep,
+    closed form: :mod:`model.analysis.fault_instant`), beside the history at the dashboard's Δt.
+    Dicts are keyed by the DRIVE_PARTS names; values in the output's unit (N m or N)."""
+
+    key: tuple  # the arguments of worst_case_result
+    units: dict[str, str]
+    max: dict[str, float]  # largest total over every Δt and the time grid
+    min: dict[str, float]  # smallest
+    phase_of_max: dict[str, float]  # the Δt [s] that gives it, in (−T/2, T/2]
+    phase_of_min: dict[str, float]  # [s]
+    time_of_max: dict[str, float]  # [s] after the fault
+    time_of_min: dict[str, float]  # [s]
+    at_dt_max: dict[str, float]  # largest total of the history at the dashboard's Δt
+    at_dt_min: dict[str, float]
+    at_dt_time_of_max: dict[str, float]  # [s]
+    at_dt_time_of_min: dict[str, float]  # [s]
+    dt: float  # the dashboard's Δt [s] (the continuity root when automatic)
+    dt_auto: bool  # Δt is the continuity root (else given)
+    roots: tuple[float, float]  # both continuity roots [s]
+    period: float  # T = 1/f [s]
+    M_ad: float  # [N m]
+    truncated_at: float | None  # [s]: the time grid was cut (growth beyond 1e250)
+    plot_cut: float | None  # plots end here [s]: a torque exceeded GROWTH_CUT x M_ad
+    # name -> (t [s], upper, lower, history at Δt) min/max-decimated on common points, float32
+    plot: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = field(repr=False)
+
+
+@pn.cache(max_items=64)
+def worst_case_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                      b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
+                      t_end: float) -> WorstCaseView:
+    """Max and min over every fault instant of each drive part's total, at each time and over
+    the time grid of :func:`response_result` (three closed-form evaluations), and the history at
+    the dashboard's Δt for comparison."""
+    from model.analysis.fault_instant import history_peaks, phase_families, worst_fault_instant
+
+    m = model(params_path, rail)
+    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
+    shock = excitation(M0_kNm, f, D, dt_ms)
+    family = phase_families(m, op, [(shock.f, shock.D)], float(t_end), sampling_rate(f),
+                            list(DRIVE_PARTS))[0]
+    worst = worst_fault_instant(family, shock.M0)
+    dt = shock.shift(family.motor_torque)
+    at_dt = family.totals(shock.M0, dt)
+    peaks = history_peaks(family.t, at_dt, dt)
+    M_ad = adhesion_moment(m.parameters, op.v, op.N0)
+    names = family.names
+    # plots end where a torque of the worst case grows beyond GROWTH_CUT x M_ad (unstable)
+    torque = [j for j, name in enumerate(names) if family.units[name] == "N m"]
+    reach = np.maximum(np.abs(worst.upper[:, torque]), np.abs(worst.lower[:, torque])).max(axis=1)
+    beyond = np.flatnonzero(reach > GROWTH_CUT * M_ad)
+    stop = int(beyond[0]) + 1 if len(beyond) else len(family.t)
+    plot = {}
+    for j, name in enumerate(names):
+        td, ys = decimate(family.t[:stop], [worst.upper[:stop, j], worst.lower[:stop, j],
+                                            at_dt[:stop, j]])
+        plot[name] = (td.astype(np.float32), *(y.astype(np.float32) for y in ys))
+    by_name = lambda values: {name: float(values[j]) for j, name in enumerate(names)}  # noqa: E731
+    return WorstCaseView(
+        key=(params_path, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, t_end),
+        units={name: family.units[name] for name in names},
+        max=by_name(worst.peaks.max), min=by_name(worst.peaks.min),
+        phase_of_max=by_name(worst.peaks.phase_of_max),
+        phase_of_min=by_name(worst.peaks.phase_of_min),
+        time_of_max=by_name(worst.peaks.time_of_max), time_of_min=by_name(worst.peaks.time_of_min),
+        at_dt_max=by_name(peaks.max), at_dt_min=by_name(peaks.min),
+        at_dt_time_of_max=by_name(peaks.time_of_max),
+        at_dt_time_of_min=by_name(peaks.time_of_min),
+        dt=float(dt), dt_auto=dt_ms is None, roots=family.continuity_phases(shock.M0),
+        period=1.0 / shock.f, M_ad=float(M_ad), truncated_at=family.truncated_at,
+        plot_cut=float(family.t[stop - 1]) if stop < len(family.t) else None, plot=plot)
+
+
+@dataclass(frozen=True)
+class SpectraView:
+    """Load spectra of the drive parts' histories (one history: ``history``)."""
+
+    history: str  # which history: "linear creep" or "nonlinear creep, …"
+    fault_instant: float  # its Δt [s]
+    spectra: dict[str, object]  # DRIVE_PARTS -> model.analysis.load_spectrum.LoadSpectrum
+    matrices: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = field(repr=False)
+    # name -> rainflow matrix (counts: range bins x mean bins [-], range edges, mean edges [unit])
+
+
+@pn.cache(max_items=32)
+def spectra_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                   b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
+                   t_end: float, anti_slip: tuple | None) -> SpectraView:
+    """Rainflow cycles, load collective, damage-equivalent ranges (m = 3 and 5, N_ref = 10⁷) and
+    the rainflow matrix of each drive part's total in the history of :func:`history_result`."""
+    from model.analysis.load_spectrum import load_spectrum, rainflow_matrix
+
+    response = history_result(params_path, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms,
+                              t_end, anti_slip)
+    spectra = {name: load_spectrum(response.outputs[name], name, response.units[name])
+               for name in DRIVE_PARTS}
+    matrices = {name: rainflow_matrix(s.cycles, RAINFLOW_BINS) for name, s in spectra.items()}
+    return SpectraView(response.history, response.fault_instant, spectra, matrices)

@@ -42,22 +42,84 @@ def mode_table_html(point: compute.PointResult) -> str:
             '<th class="text">dominant motion</th></tr>' + rows + "</table>")
 
 
+def format_load(x: float) -> str:
+    """A load for a table: thousands separated, or in exponent form beyond 10⁷ (growth)."""
+    return f"{x:,.0f}" if abs(x) < 1e7 else f"{x:.3e}"
+
+
 def peaks_html(response: compute.ResponseView) -> str:
-    """Peaks (signed total of largest magnitude) and their times, per output."""
+    """Peaks (signed total of largest magnitude) and their times, per output, and the first
+    limit crossings, of the history ``response`` (the heading says which: linear or nonlinear
+    creep, and its fault instant Δt)."""
     rows = []
     for name in response.outputs:
         peak, unit = response.peaks[name], response.units[name]
-        over = unit == "N m" and "disc_clutch" in name and abs(peak) > response.M_ad
-        value = f"{peak:,.0f}" if abs(peak) < 1e7 else f"{peak:.3e}"
+        over = unit == "N m" and ("disc_clutch" in name or "claw_clutch" in name) \
+            and abs(peak) > response.M_ad
         rows.append(f'<tr><td class="text">{name}</td><td class="{"bad" if over else ""}">'
-                    f"{value} {unit}</td><td>{response.peak_times[name]:.4f} s</td></tr>")
+                    f"{format_load(peak)} {unit}</td><td>{response.peak_times[name]:.4f} s</td></tr>")
     note = ""
     if response.truncated_at is not None:
         note = f" — growth: the time grid was cut at {response.truncated_at:.3f} s"
     elif response.plot_cut is not None:
         note = f" — unstable growth (plots end at {response.plot_cut:.3f} s; CSV has all)"
     crossings = "; ".join(f"{o} exceeds {n} at {t:.3f} s" for o, n, t, _ in response.crossings[:4])
-    return (f"<b>Peaks</b> (M_ad = {response.M_ad:,.0f} N m){note}"
+    history = (f"<div class='peaks-history'>of the history with <b>{html.escape(response.history)}"
+               f"</b>, Δt = {response.fault_instant * 1e3:.4g} ms</div>")
+    return (f"<b>Peaks</b> (M_ad = {response.M_ad:,.0f} N m){note}{history}"
             '<table class="bogie"><tr><th class="text">output</th><th>peak</th><th>at</th></tr>'
             + "".join(rows) + "</table>"
             + (f"<div style='font-size:12px'>{html.escape(crossings)}</div>" if crossings else ""))
+
+
+# --- design loads ------------------------------------------------------------------------------
+
+def _part(name: str) -> str:
+    drive, part = name.split(".", 1)
+    return f"{drive} {compute.PART_LABELS.get(part, part)}"
+
+
+def worst_case_html(worst: compute.WorstCaseView) -> str:
+    """Per drive part: the max and the min over every fault instant Δt (closed form), the Δt [s]
+    and the time [s] of each, and the max and min of the history at the dashboard's Δt."""
+    rows = []
+    for name, unit in worst.units.items():
+        rows.append(
+            f'<tr><td class="text">{_part(name)} [{unit}]</td>'
+            f"<td><b>{format_load(worst.max[name])}</b></td><td>{worst.phase_of_max[name]:.6f}</td>"
+            f"<td>{worst.time_of_max[name]:.4f}</td>"
+            f"<td><b>{format_load(worst.min[name])}</b></td><td>{worst.phase_of_min[name]:.6f}</td>"
+            f"<td>{worst.time_of_min[name]:.4f}</td>"
+            f"<td>{format_load(worst.at_dt_max[name])}</td><td>{format_load(worst.at_dt_min[name])}</td>"
+            "</tr>")
+    which = ("the continuity root (the Response tab's)" if worst.dt_auto
+             else "the given Δt (the Response tab's)")
+    return ('<table class="bogie worst-case"><tr><th class="text" rowspan="2">drive part</th>'
+            '<th colspan="3">max over every fault instant</th>'
+            '<th colspan="3">min over every fault instant</th>'
+            f'<th colspan="2">at Δt = {worst.dt:.6f} s</th></tr>'
+            "<tr><th>value</th><th>Δt [s]</th><th>t [s]</th><th>value</th><th>Δt [s]</th>"
+            "<th>t [s]</th><th>max</th><th>min</th></tr>" + "".join(rows) + "</table>"
+            f"<div style='font-size:12px'>Totals (pre-fault + perturbation) over t = 0 … "
+            f"the simulated time; Δt in (−T/2, T/2], T = {worst.period * 1e3:.4g} ms; the last "
+            f"two columns: the history at {which}; continuity roots Δt = "
+            f"{worst.roots[0]:.6f} s and {worst.roots[1]:.6f} s.</div>")
+
+
+def spectra_html(spectra: compute.SpectraView) -> str:
+    """Per drive part: rainflow cycles, the largest range and the damage-equivalent ranges
+    (N_ref cycles) of the history ``spectra`` describes."""
+    first = next(iter(spectra.spectra.values()))
+    slopes = list(first.equivalent_range)
+    rows = "".join(
+        f'<tr><td class="text">{_part(name)} [{s.unit}]</td><td>{s.total_cycles:g}</td>'
+        f"<td>{format_load(s.largest_range)}</td>"
+        + "".join(f"<td>{s.equivalent_range[m]:,.4g}</td>" for m in slopes) + "</tr>"
+        for name, s in spectra.spectra.items())
+    return ('<table class="bogie spectra"><tr><th class="text">drive part</th><th>cycles</th>'
+            "<th>largest range</th>"
+            + "".join(f"<th>ΔM_eq, m = {m:g}</th>" for m in slopes) + "</tr>" + rows + "</table>"
+            f"<div style='font-size:12px'>Rainflow (ASTM E1049-85, residue as half cycles) of "
+            f"the history with {html.escape(spectra.history)}, Δt = "
+            f"{spectra.fault_instant * 1e3:.4g} ms; ΔM_eq = (Σ nᵢ ΔMᵢ^m / N_ref)^(1/m), "
+            f"N_ref = {first.n_ref:.0e} cycles, in the part's unit.</div>")

@@ -1,12 +1,13 @@
 """The server's studies folder: the only place a browser's study names lead to.
 
-A reviewer picks finished map stores and uncertainty results **by name from a list** the server
-made of this folder; new studies get names the server chooses.  A name is accepted only if it is
-in the list made afresh at the moment of use; a name with a path separator, a NUL byte, more than
-:data:`MAX_NAME` characters, a leading dot, or an entry that is a symbolic link, resolves outside
-the folder or (a store) holds a symbolic link anywhere inside, is not in the list.  Every refusal
-raises :class:`StudyNameRefused` with one message, the same whether or not something of that name
-exists anywhere (no file oracle), and no message names a server path.
+A reviewer picks finished map stores, design-load envelope stores and uncertainty results **by
+name from a list** the server made of this folder (a store is an envelope when its attributes
+say so, a map otherwise); new studies get names the server chooses.  A name is accepted only if
+it is in the list made afresh at the moment of use; a name with a path separator, a NUL byte,
+more than :data:`MAX_NAME` characters, a leading dot, or an entry that is a symbolic link,
+resolves outside the folder or (a store) holds a symbolic link anywhere inside, is not in the
+list.  Every refusal raises :class:`StudyNameRefused` with one message, the same whether or not
+something of that name exists anywhere (no file oracle), and no message names a server path.
 """
 
 from __future__ import annotations
@@ -21,9 +22,11 @@ from pathlib import Path
 MAX_NAME = 200  # characters of a name in the list (longer: not listed, refused)
 KINDS = {
     "map": (".zarr", "a stability-map store"),
+    "envelope": (".zarr", "a design-load envelope store"),
     "uncertainty": (".json", "an uncertainty result"),
 }
 MAX_RESULT_BYTES = 50_000_000  # an uncertainty result larger than this is not listed (not read)
+MAX_INDEX_BYTES = 1_000_000  # a store's zarr.json larger than this is not read (not listed)
 
 
 class StudyNameRefused(ValueError):
@@ -53,6 +56,34 @@ def _has_link(root: Path) -> bool:
     return False
 
 
+def _store_study(path: Path) -> str | None:
+    """The ``study`` attribute of the Zarr store at ``path`` (a folder of the studies folder),
+    None if it has none or its ``zarr.json`` is not a regular file that can be read (a link, a
+    pipe, more than MAX_INDEX_BYTES)."""
+    import json
+
+    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
+    try:
+        fd = os.open(path / "zarr.json", flags)  # no link followed, no pipe waited for
+    except OSError:
+        return None
+    try:
+        with os.fdopen(fd, "rb") as index:
+            if not stat.S_ISREG(os.fstat(index.fileno()).st_mode):
+                return None
+            text = index.read(MAX_INDEX_BYTES + 1)
+    except OSError:
+        return None
+    if len(text) > MAX_INDEX_BYTES:
+        return None
+    try:
+        attributes = json.loads(text).get("attributes", {})
+    except (ValueError, AttributeError):
+        return None
+    study = attributes.get("study") if isinstance(attributes, dict) else None
+    return study if isinstance(study, str) else None
+
+
 class StudiesFolder:
     """The operator's studies folder (created if missing)."""
 
@@ -78,14 +109,18 @@ class StudiesFolder:
             mode = os.lstat(path).st_mode
         except OSError:
             return None
-        if kind == "map":
-            if not stat.S_ISDIR(mode) or _has_link(path):
+        if kind in ("map", "envelope"):
+            if not stat.S_ISDIR(mode):
                 return None
             try:
                 marker = os.lstat(path / "zarr.json").st_mode
             except OSError:
                 return None
             if not stat.S_ISREG(marker):
+                return None
+            # an envelope store is listed as such, every other store as a map (the map view
+            # says when a store is not one); then the walk through the store (the costly check)
+            if (_store_study(path) == "envelope") != (kind == "envelope") or _has_link(path):
                 return None
         elif not stat.S_ISREG(mode) or os.lstat(path).st_size > MAX_RESULT_BYTES:
             return None

@@ -1,8 +1,11 @@
 """The server's study queue: every session's studies on one engine, at most K at a time.
 
-One :class:`StudyQueue` per server process (:func:`study_queue`).  It owns the study engine the
-operator chose (:mod:`app.services.settings`): a client of the operator's Dask scheduler, or **one**
-local cluster of worker processes (one per core), started on the first study and shared by all
+One :class:`StudyQueue` per server process (:func:`study_queue`).  It runs the studies a
+session may ask for — stability maps (:class:`model.studies.maps.MapStudy`, the Studies tab) and
+design-load envelopes (:class:`model.studies.envelope.EnvelopeStudy`, the Design loads tab) —
+under the same rules, and owns the study engine the operator chose
+(:mod:`app.services.settings`): a client of the operator's Dask scheduler, or **one** local
+cluster of worker processes (one per core), started on the first study and shared by all
 sessions.  A session *asks* for a study (:meth:`StudyQueue.submit`); the queue decides when it
 runs:
 
@@ -15,8 +18,9 @@ runs:
 * a closed session's waiting study is dropped and its running one stops after its chunk
   (:meth:`StudyQueue.drop_owner`, called when Bokeh destroys the session).
 
-Nothing here comes from a browser but the study's grid (bounded by ``max_study_points``) and the
-dashboard's parameter set; the store's name is the queue's own (:mod:`app.services.studies_folder`).
+Nothing here comes from a browser but the study's grid (bounded by ``max_study_points``: the
+s0 × v points of a map, the scenarios of an envelope) and the dashboard's parameter set; the
+store's name is the queue's own (:mod:`app.services.studies_folder`).
 """
 
 from __future__ import annotations
@@ -51,7 +55,7 @@ class StudyTicket:
     """One requested study and what became of it (read by the session's view)."""
 
     owner: str  # the asking session's token
-    study: object  # model.studies.maps.MapStudy
+    study: object  # model.studies.maps.MapStudy or model.studies.envelope.EnvelopeStudy
     parameters: object  # model.parameters.Parameters
     name: str  # store name in the studies folder
     state: str = WAITING
@@ -64,8 +68,20 @@ class StudyTicket:
 
     @property
     def points(self) -> int:
-        return int(len(self.study.s0) * len(self.study.v) * len(self.study.N0)
-                   * len(self.study.b_M))
+        """The study's size as the limit counts it (:func:`study_points`)."""
+        return study_points(self.study)
+
+
+STUDY_KINDS = {"map": ("map", "points (s0 points × v points)"),
+               "envelope": ("envelope", "scenarios (grid points × fault instants)")}
+
+
+def study_points(study) -> int:
+    """What ``max_study_points`` counts: the s0 × v × N0 × b_M points of a map, the scenarios of
+    an envelope (every fault instant and anti-slip setting counted)."""
+    if study.kind == "envelope":
+        return int(study.scenarios)
+    return int(len(study.s0) * len(study.v) * len(study.N0) * len(study.b_M))
 
 
 class StudyQueue:
@@ -132,24 +148,31 @@ class StudyQueue:
 
     # --- requests ------------------------------------------------------------------------------
 
-    def submit(self, owner: str, study, parameters, prefix: str = "map") -> StudyTicket:
-        """Queue ``study`` for the session ``owner`` (raises :class:`StudyRefused`)."""
-        points = int(len(study.s0) * len(study.v) * len(study.N0) * len(study.b_M))
+    def submit(self, owner: str, study, parameters, prefix: str | None = None) -> StudyTicket:
+        """Queue ``study`` (a map or an envelope) for the session ``owner``; its store gets a
+        name of the folder starting with ``prefix`` (default: the study's kind).  Raises
+        :class:`StudyRefused`."""
+        if study.kind not in STUDY_KINDS:
+            raise StudyRefused(f"the server runs map and envelope studies, not '{study.kind}'")
+        kind, counted = STUDY_KINDS[study.kind]
+        points = study_points(study)
         limit = self.settings.max_study_points
         if points > limit:
-            raise StudyRefused(f"{points} points asked; the server runs studies of at most "
-                               f"{limit} points (s0 points × v points)")
+            unit = counted.split(" ", 1)[0]
+            raise StudyRefused(f"{points} {unit} asked; the server runs studies of at most "
+                               f"{limit} {counted}")
         with self._lock:
             previous = self._by_owner.get(owner)
             if previous is not None and previous.state in (WAITING, RUNNING):
-                raise StudyRefused("this session's study is still "
-                                   f"{previous.state}: stop it or wait for it")
+                raise StudyRefused(f"this session's {previous.study.kind} study is still "
+                                   f"{previous.state}: stop it or wait for it (a session runs "
+                                   "one study at a time)")
             if len(self._waiting) >= self.settings.max_waiting_studies and (
                     len(self._running) >= self.settings.max_running_studies):
                 raise StudyRefused(f"the server's study queue is full "
                                    f"({len(self._waiting)} waiting); try again later")
             ticket = StudyTicket(owner, study, parameters,
-                                 self.folder.new_name("map", prefix),
+                                 self.folder.new_name(kind, prefix or study.kind),
                                  total=len(study.chunks()))
             self._by_owner[owner] = ticket
             self._waiting.append(ticket)

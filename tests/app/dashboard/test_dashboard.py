@@ -171,7 +171,8 @@ def test_downloads(dash):
     assert header.startswith("t [s],ID1.driving_shaft.torque [N m]")
     assert float(first.split(",")[0]) == 0.0
     data = np.loadtxt(io.StringIO(csv), delimiter=",", skiprows=1)
-    assert data.shape == (len(dash.response.t), 2 + len(compute.RESPONSE_OUTPUTS))
+    # every output of the history (the plotted ones and the drive parts), time and M_C
+    assert data.shape == (len(dash.response.t), 2 + len(compute.HISTORY_OUTPUTS))
     eig = json.loads(dash.downloads.eigenvalues_json().read())
     assert eig["stable"] == dash.point.stable
     assert len(eig["eigenvalues"]) == len(dash.point.eigenvalues)
@@ -241,8 +242,9 @@ def test_render_whole_layout(dash):
         plots.update({model.id: model for model in doc.models if isinstance(model, Plot)})
     plots = list(plots.values())
     # locus, creep, 2 torques, forces, M_C, side and top view, Fig. 6 (Im, Re, real), variant s0*,
-    # sensitivity tornado, study heat map
-    assert len(plots) == 14
+    # sensitivity tornado, study heat map; design loads: worst case ID1 and ID2, load
+    # collective, rainflow matrix ID1 and ID2, envelope heat map
+    assert len(plots) == 20
     assert {"root-locus", "fig6-im", "fig6-re", "fig6-real", "variant-limits"} <= {
         p.name for p in plots}
     titled = {model.title for model in models if getattr(model, "css_classes", None)

@@ -1,5 +1,5 @@
 """Unit tests of the calibration's pieces (model/studies/calibration.py) — not of the calibrated numbers
-(those are tests/test_literature.py), and without running the whole calibration (a minute or
+(those are tests/literature/test_table1.py), and without running the whole calibration (a minute or
 two; its reproducibility is checked by scripts/bench_calibration.py, BENCHMARKS.md)."""
 
 from __future__ import annotations
