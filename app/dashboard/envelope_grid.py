@@ -386,28 +386,16 @@ class EnvelopeGrid:
         ticket = self.ticket
         if ticket is None:
             return
-        finished, total, elapsed = ticket.finished, ticket.total, ticket.elapsed
-        self.progress.value = min(finished, self.progress.max)
+        line, ended = self.queue.status_line(ticket, "chunks")
+        self.progress.value = min(ticket.finished, self.progress.max)
+        self.status.object = f"{line} — {self._conditions}"
         if ticket.state == WAITING:
-            ahead = self.queue.position(ticket)
-            running, _waiting = self.queue.counts()
-            self.status.object = (f"waiting: {ahead if ahead is not None else 0} stud"
-                                  f"{'y' if ahead == 1 else 'ies'} ahead in the queue, {running} "
-                                  f"running — {self._conditions}")
             return
-        left = ""
-        if 0 < finished < total:
-            left = f", ~{elapsed / finished * (total - finished):.0f} s left"
-        self.status.object = (f"running: {finished}/{total} chunks, {elapsed:.0f} s{left} — "
-                              f"{self._conditions}")
-        ended = ticket.ended.is_set()
-        if finished != self._read_at or ended:
+        if ticket.finished != self._read_at or ended:
             self._show_running_store(ticket)
         if ended:
             if ticket.state == FAILED:
                 self._reject(f"the envelope failed: {ticket.message}")
-            self.status.object = (f"{ticket.state}: {finished}/{total} chunks in "
-                                  f"{elapsed:.1f} s — {self._conditions}")
             self.start_button.disabled, self.stop_button.disabled = False, True
             self.refresh_list()
             if self._poller is not None:

@@ -310,26 +310,15 @@ class StudiesView(pn.viewable.Viewer):
         ticket = self.ticket
         if ticket is None:
             return
-        finished, total, elapsed = ticket.finished, ticket.total, ticket.elapsed
-        self.progress.value = min(finished, self.progress.max)
+        line, ended = self.queue.status_line(ticket, "s0-lines")
+        self.progress.value = min(ticket.finished, self.progress.max)
+        self.status.object = f"{line} — {self._conditions}"
         if ticket.state == WAITING:
-            ahead = self.queue.position(ticket)
-            running, _waiting = self.queue.counts()
-            self.status.object = (f"waiting: {ahead if ahead is not None else 0} stud"
-                                  f"{'y' if ahead == 1 else 'ies'} ahead in the queue, {running} "
-                                  f"running — {self._conditions}")
             return
-        left = ""
-        if 0 < finished < total:
-            left = f", ~{elapsed / finished * (total - finished):.0f} s left"
-        self.status.object = (f"running: {finished}/{total} s0-lines, {elapsed:.0f} s{left} — "
-                              f"{self._conditions}")
         self._show_running_store(ticket)
-        if ticket.ended.is_set():
+        if ended:
             if ticket.state == FAILED:
                 self._reject(f"the study failed: {ticket.message}")
-            self.status.object = (f"{ticket.state}: {finished}/{total} s0-lines in "
-                                  f"{elapsed:.1f} s — {self._conditions}")
             self.start_button.disabled, self.stop_button.disabled = False, True
             self.refresh_lists()
             if self._poller is not None:

@@ -187,6 +187,27 @@ class StudyQueue:
             except ValueError:
                 return None
 
+    def status_line(self, ticket: StudyTicket, unit: str) -> tuple[str, bool]:
+        """(the line a session shows for its ``ticket``, whether the ticket has ended), read in
+        one snapshot of the queue, so that the server's counts in it never disagree with each
+        other (``unit``: what a chunk is, e.g. "s0-lines")."""
+        with self._lock:
+            state, ended = ticket.state, ticket.ended.is_set()
+            finished, total, elapsed = ticket.finished, ticket.total, ticket.elapsed
+            running, waiting = len(self._running), len(self._waiting)
+            ahead = self._waiting.index(ticket) if state == WAITING else None
+        limit = self.settings.max_running_studies
+        if ended:
+            return f"{state}: {finished}/{total} {unit} in {elapsed:.1f} s", True
+        if state == WAITING:
+            return (f"waiting: {ahead} stud{'y' if ahead == 1 else 'ies'} ahead in the queue, "
+                    f"{running} running"), False
+        left = ""
+        if 0 < finished < total:
+            left = f", ~{elapsed / finished * (total - finished):.0f} s left"
+        return (f"running: {finished}/{total} {unit}, {elapsed:.0f} s{left}; server: {running} "
+                f"of at most {limit} running, {waiting} waiting"), False
+
     def counts(self) -> tuple[int, int]:
         """(running, waiting) studies of the server."""
         with self._lock:

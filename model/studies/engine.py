@@ -94,15 +94,18 @@ class StudyEngine:
 
     def __init__(self, scheduler: str | None = None, workers: int | None = None,
                  connect_timeout: float = 10.0, use_environment: bool = True,
-                 supervised: bool = True, niceness: int = 0):
+                 supervised: bool = True, niceness: int = 0, worker_timeout: float = 120.0):
         """``use_environment=False``: ``scheduler=None`` means a local cluster even when
         ``$DASK_SCHEDULER_ADDRESS`` is set (a server whose operator chose the engine);
-        ``supervised``, ``niceness``: the local cluster's workers (module docstring)."""
+        ``supervised``, ``niceness``: the local cluster's workers (module docstring);
+        ``worker_timeout`` [s]: how long :meth:`start` waits for all of a local cluster's workers
+        to join (a study never waits for workers that will not come)."""
         self.scheduler = scheduler_address(scheduler) if use_environment else (scheduler or None)
         self.supervised = supervised
         self.niceness = niceness
         self.workers = workers or os.cpu_count() or 1
         self.connect_timeout = connect_timeout
+        self.worker_timeout = worker_timeout
         self.client = None
         self.cluster = None
 
@@ -151,6 +154,13 @@ class StudyEngine:
             if previous is not None:
                 signal.signal(signal.SIGINT, previous)
         self.client = Client(self.cluster, set_as_default=False)
+        try:
+            self.client.wait_for_workers(self.workers, timeout=self.worker_timeout)
+        except TimeoutError:
+            joined = len(self.client.scheduler_info()["workers"])
+            self.close()
+            raise EngineUnavailable(f"only {joined} of the local cluster's {self.workers} "
+                                    f"workers joined within {self.worker_timeout:g} s") from None
 
     def healthy(self) -> bool:
         """Whether the engine still has its workers (a local cluster: all it started; a cluster at

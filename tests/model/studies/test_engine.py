@@ -246,3 +246,16 @@ def test_uncertainty_study_on_the_cluster_equals_serial(cluster):
     assert np.array_equal(on_cluster.samples, serial.samples)
     assert np.array_equal(on_cluster.values, serial.values, equal_nan=True)
     assert np.array_equal(on_cluster.first_order, serial.first_order, equal_nan=True)
+
+
+def test_a_local_cluster_whose_workers_do_not_join_in_time_is_unavailable():
+    """``start`` waits for every worker of a local cluster; when they do not all join within
+    ``worker_timeout`` (here far shorter than a worker's ≈ 0.5 s start-up) it closes the
+    cluster and says so, instead of leaving a study to wait for workers forever."""
+    from model.studies.engine import EngineUnavailable
+
+    engine = StudyEngine(None, workers=2, use_environment=False, supervised=False,
+                         worker_timeout=0.001)
+    with pytest.raises(EngineUnavailable, match=r"of the local cluster's 2 workers joined"):
+        engine.start()
+    assert engine.client is None and engine.cluster is None
