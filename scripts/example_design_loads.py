@@ -68,7 +68,7 @@ def main() -> None:
     parameters = load_parameters()
     model = cached_model(parameters)
     grid = tuple(np.arange(args.phases) / args.phases / 90.0)
-    grid_text = f"0:{grid[-1]!r}:{args.phases}"
+    grid_text = f"0:{float(grid[-1]):.6g}:{args.phases}"
     for s0 in (0.005, 0.014):
         outputs = ",".join(OUTPUTS)
         table(f"s0 = {s0}, 120 km/h, linear creep",

@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # Everything numeric that follows the default parameter set, regenerated in dependency order
-# after `bogie calibrate` has rewritten assets/parameters/calibrated.toml (issue 11).
+# after `bogie calibrate` has rewritten assets/parameters/calibrated.toml.
 #
 #     bash scripts/regenerate_after_calibration.sh            # all (≈ 25 min on 2 cores)
 #     bash scripts/regenerate_after_calibration.sh --no-app   # without the screenshots
 #
 # Then read what changed: `git diff --stat`, the figures and screenshots (open the PNGs), and the
 # numbers the scripts print against those quoted in docs/validation.md, docs/response.md,
-# docs/nonlinear.md, docs/sensitivity.md and README.md (scripts/validation_table.py prints the
-# tables of docs/validation.md).
+# docs/nonlinear.md, docs/sensitivity.md, docs/design-loads.md and README.md
+# (scripts/validation_table.py prints the tables of docs/validation.md; the worked example of
+# docs/design-loads.md is printed to /tmp/regen_design_loads.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=${PY:-.venv/bin/python}
@@ -36,7 +37,10 @@ if [[ "${1:-}" != "--no-app" ]]; then
     $PY scripts/figures_posterior.py --app   # + uncertainty_band_app.png (needs chromium)
     step "screenshots (assets/screenshots; needs chromium)"
     $PY scripts/bench_app.py --only-screenshots
+    $PY scripts/screenshot_design_loads.py
 else
     $PY scripts/figures_posterior.py
 fi
+step "the worked example of docs/design-loads.md (/tmp/regen_design_loads.md)"
+$PY scripts/example_design_loads.py > /tmp/regen_design_loads.md
 step "done"
