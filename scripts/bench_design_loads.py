@@ -225,12 +225,14 @@ def dashboard_design_loads(repeats: int = 15) -> None:
         op = compute.operating_point(*point)
         compute.point_result(*point)  # the eigendecomposition, as after the first answer
 
-        def before():  # the fast stage's response before: 10 outputs, 11 series decimated
+        # the fast stage's response before: 10 outputs, 11 series decimated
+        def before(model=model, op=op, excitation=excitation):
             r = short_circuit_response(model, op, excitation, t_end=2.0, fs=10_000.0,
                                        outputs=list(compute.RESPONSE_OUTPUTS))
             return [compute.decimate(r.t, [y]) for y in [*r.outputs.values(), r.M_C]]
 
-        def now():  # 14 outputs (the peak table's and the CSV's), the same 11 series decimated
+        # 14 outputs (the peak table's and the CSV's), the same 11 series decimated
+        def now(model=model, op=op, excitation=excitation):
             r = short_circuit_response(model, op, excitation, t_end=2.0, fs=10_000.0,
                                        outputs=list(compute.HISTORY_OUTPUTS))
             return compute.history_view(r, compute.LINEAR_HISTORY, True,
@@ -240,10 +242,10 @@ def dashboard_design_loads(repeats: int = 15) -> None:
             "response, 10 outputs + plot series (before)": before,
             "response, 14 outputs + plot series (now)": now,
             "worst case over every fault instant (8 parts)":
-                lambda: compute.worst_case_result.__wrapped__(*point, 50.0, 90.0, 0.04, None,
+                lambda point=point: compute.worst_case_result.__wrapped__(*point, 50.0, 90.0, 0.04, None,
                                                               2.0),
             "load spectra of the linear history (8 parts)":
-                lambda: compute.spectra_result.__wrapped__(*point, 50.0, 90.0, 0.04, None, 2.0,
+                lambda point=point: compute.spectra_result.__wrapped__(*point, 50.0, 90.0, 0.04, None, 2.0,
                                                            None),
         }
         compute.response_result(*point, 50.0, 90.0, 0.04, None, 2.0)  # the spectra's history

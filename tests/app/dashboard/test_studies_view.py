@@ -131,8 +131,8 @@ def test_queue_position_and_stopping_only_ones_own(dash, tmp_path):
         assert queue.position(third) == 1
         line, ended = queue.status_line(first, "s0-lines")  # the running one, as its page reads it
         assert not ended
-        assert line.startswith("running: 0/") and line.endswith(
-            "server: 1 of at most 1 running, 2 waiting"), line
+        assert line.startswith("running: 0/"), line
+        assert line.endswith("server: 1 of at most 1 running, 2 waiting"), line
         assert not queue.stop(first, view.owner)  # another session's ticket: nothing happens
         assert not first.stop_requested.is_set()
         view.stop()

@@ -258,4 +258,5 @@ def test_a_local_cluster_whose_workers_do_not_join_in_time_is_unavailable():
                          worker_timeout=0.001)
     with pytest.raises(EngineUnavailable, match=r"of the local cluster's 2 workers joined"):
         engine.start()
-    assert engine.client is None and engine.cluster is None
+    assert engine.client is None
+    assert engine.cluster is None
