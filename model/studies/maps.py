@@ -15,7 +15,7 @@ the same continuation.  Against a full eigen-analysis at every point of 100-poin
 (``scripts/bench_study.py --check-lines``, tests/model/analysis/test_continuation.py).
 
 The reduced method, :func:`reduced_s0_line` (method "reduced", the default: it is
-cheaper, see BENCHMARKS.md), reuses one Galerkin-reduced model (:class:`model.analysis.locus._Reduced`)
+cheaper, see BENCHMARKS.md), reuses one Galerkin-reduced model (:class:`model.analysis.locus.Reduced`)
 per line and costs one dense eigen-analysis with vectors (the *anchor*: the last creepage), two
 without (the first creepage and the grid creepage of the most negative b11, the steepest falling
 creep slope, the most destabilizing point) and one small eigenproblem per point (2r − 2
@@ -83,11 +83,11 @@ from model.analysis.continuation import LineContinuation
 from model.analysis.eigen import eigen_analysis, non_neutral
 from model.analysis.linear_system import Deflation
 from model.analysis.locus import (
-    _coefficients,
-    _newton,
-    _Reduced,
+    Reduced,
     creep_patterns,
+    newton,
     nonlinear_inverse_iteration,
+    pattern_coefficients,
 )
 from model.analysis.stability import NoStabilityLimit, stability_limit
 from model.mechanics.assembly import BogieModel, build_model
@@ -277,7 +277,7 @@ def _line_limit(model, line_model, s0_values, growth, v, N0, b_M, xtol) -> float
 
 def _newton_without_rigid(M, C, K, R, lam: complex, x: np.ndarray, rtol: float,
                           iterations: int = 6):
-    """Newton's method (nonlinear inverse iteration, as :func:`model.analysis.locus._newton`) for a
+    """Newton's method (nonlinear inverse iteration, as :func:`model.analysis.locus.newton`) for a
     non-rigid eigenpair of ``(λ² M + λ C + K) x = 0`` near 0: with ``K R = 0`` (R: the rigid-body
     modes, orthonormal or not) the rows Rᵀ of the equation are λ Rᵀ(λ M + C) x, so they are
     divided by λ: S(λ) = [Rᵀ(λ M + C); Zᵀ(λ² M + λ C + K)] (Z: the orthogonal complement of R)
@@ -343,7 +343,7 @@ class _LineModel:
             vectors = [stacked[:, norms > 0] / norms[norms > 0]]
         U, sigma, _ = np.linalg.svd(np.hstack(vectors), full_matrices=False)
         basis = U[:, sigma > BASIS_CUTOFF * sigma[0]]
-        self.reduced = _Reduced(model, anchors[0].operating_point, patterns, [basis])
+        self.reduced = Reduced(model, anchors[0].operating_point, patterns, [basis])
         self.newton = 0
         red, r = self.reduced, self.reduced.size
         # The first-order reduced matrix [[0, I], [−K_r, −C]] is affine in the creep
@@ -433,7 +433,7 @@ class _LineModel:
         b23, b33) if already known."""
         op = OperatingPoint(float(s0), self.v, self.N0, self.b_M)
         if c is None:
-            c = _coefficients(self.model, op)
+            c = pattern_coefficients(self.model, op)
         red = self.reduced
         A22, C, C_Phi = self._matrices(c)
         lam = self._eigvals(A22)
@@ -486,8 +486,8 @@ class _LineModel:
                         self.model.M, C_full, self.model.K, self.model.rigid_body_modes, lam[b],
                         red.Phi @ vectors[:, b], self.rtol)
                 else:
-                    value, _, step = _newton(self.model.M, C_full, self.model.K, lam[b],
-                                             red.Phi @ vectors[:, b], self.rtol, floor=1.0)
+                    value, _, step = newton(self.model.M, C_full, self.model.K, lam[b],
+                                            red.Phi @ vectors[:, b], self.rtol, floor=1.0)
                 if not step <= self.rtol:
                     return self._result(_dense_point(self.model, op).eigenvalues, True)
                 lam[b] = value

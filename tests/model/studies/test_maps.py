@@ -299,7 +299,7 @@ def test_basis_check_at_the_most_destabilizing_point(setup):
     b11 the dense eigenvalues check it: with both ends every eigenvalue the selection takes there
     has a Ritz value next to it, with the first end alone (the ≈ 50 Hz rim modes are damped by
     more than 5 1/s there and not in the basis) some have none and the check fails."""
-    from model.analysis.locus import _coefficients
+    from model.analysis.locus import pattern_coefficients
     from model.mechanics.operating_point import OperatingPoint
     from model.studies.maps import _dense_point, _LineModel, _missing_modes
 
@@ -307,10 +307,10 @@ def test_basis_check_at_the_most_destabilizing_point(setup):
     v, N0, b_M = 120 * KMH, parameters["wheel_force"], parameters["motor_slope"]
     s0 = np.linspace(0.001, 0.02, 100)
     points = [OperatingPoint(float(s), v, N0, b_M) for s in s0]
-    b11 = [_coefficients(model, op)[0] for op in points]
+    b11 = [pattern_coefficients(model, op)[0] for op in points]
     middle = int(np.argmin(b11))
     assert 0 < middle < len(s0) - 1
-    c = _coefficients(model, points[middle])
+    c = pattern_coefficients(model, points[middle])
     eigenvalues = _dense_point(model, points[middle]).eigenvalues
     radius = 2 * np.pi * 10.0
     ends = [_dense_point(model, points[i], vectors=True) for i in (0, len(s0) - 1)]
@@ -350,7 +350,7 @@ def test_point_at_the_crossing_needs_no_full_analysis(setup):
     refinement divides the rigid rows by λ and converges; the point is not sent to a full
     eigen-analysis, and its largest real part is the dense one within rtol = 1e-6 1/s."""
     from model.analysis.eigen import eigen_analysis
-    from model.analysis.locus import _coefficients
+    from model.analysis.locus import pattern_coefficients
     from model.mechanics.operating_point import OperatingPoint
     from model.studies.maps import _dense_point, _LineModel
 
@@ -363,7 +363,7 @@ def test_point_at_the_crossing_needs_no_full_analysis(setup):
     line_model = _LineModel(model, v, N0, b_M, ends, 10.0, 1e-6)
     for s in (s0_limit - 2e-7, s0_limit + 2e-7):
         op = OperatingPoint(s, v, N0, b_M)
-        (growth, _, _), dense = line_model.point(s, _coefficients(model, op))
+        (growth, _, _), dense = line_model.point(s, pattern_coefficients(model, op))
         assert not dense
         dense_growth = eigen_analysis(model, op, vectors=False).max_real_part
         assert abs(growth) < 1e-2  # the crossing eigenvalue: ≈ 0
