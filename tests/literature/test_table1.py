@@ -38,7 +38,6 @@ from model.studies.calibration import (
     ADHESION_MOMENT,
     DIVERGENCE_RATES,
     DRIVING_SHAFT_HZ,
-    FREE_PARAMETERS,
     MOTOR_TORQUE,
     RE_MODES,
     STABILITY_LIMIT,
@@ -46,12 +45,11 @@ from model.studies.calibration import (
     TABLE1_RE,
     TABLE1_UNSTABLE,
     V_REF,
-    constraint_values,
     driving_shaft_mode,
     match_table1_modes,
-    on_bound,
     wheelset_yaw_fraction,
 )
+from model.studies.calibration_bounds import FREE_PARAMETERS, constraint_values, on_bound
 
 IM_TOLERANCE = 0.05  # [-] relative, by rank
 RE_TOLERANCE, RE_ABSOLUTE = 0.30, 0.05  # [-] relative; [1/s] where |Re_published| < 0.2 1/s
@@ -174,9 +172,9 @@ def test_wheelset_modes_told_apart_by_journal_phase(calibrated):
 
 def test_calibrated_inertias_are_physical(calibrated):
     """A rigid body's principal inertias obey |I_x − I_y| <= I_z <= I_x + I_y
-    (calibration.constraint_values); the frame's roll inertia cannot exceed all its mass at the
-    frame's outer edges (m · 1.1² m²), its pitch inertia all its mass at the ends (m · 1.75² m²);
-    Polach's kS <= kA."""
+    (calibration_bounds.constraint_values); the frame's roll inertia cannot exceed all its mass
+    at the frame's outer edges (m · 1.1² m²), its pitch inertia all its mass at the ends
+    (m · 1.75² m²); Polach's kS <= kA."""
     parameters = calibrated[0]
     assert np.all(constraint_values(parameters) <= 1e-12)
     assert parameters["frame_inertia_x"] <= parameters["frame_mass"] * 1.1**2
@@ -186,9 +184,9 @@ def test_calibrated_inertias_are_physical(calibrated):
 
 def test_calibrated_values_inside_their_bounds_at_most_two_on_one(calibrated):
     """Every calibrated parameter within the range its source allows (its calibration bounds,
-    calibration.FREE_PARAMETERS, each with its reason), and at most two on a bound (within
-    0.1 %, calibration.on_bound): the issue's target; a set that fits by bending its data sits
-    on many."""
+    calibration_bounds.FREE_PARAMETERS, each with its reason), and at most two on a bound (within
+    0.1 %, calibration_bounds.on_bound): the acceptance limit; a set that fits by bending its data
+    sits on many."""
     parameters = calibrated[0]
     for f in FREE_PARAMETERS:
         assert f.low - 1e-12 * abs(f.low) <= parameters[f.name] <= f.high + 1e-12 * abs(f.high)
