@@ -4,7 +4,7 @@
 Table 1 is compared **by rank**, as the study lists it ("the first ten pairs of complex conjugate
 eigenvalues sequenced according to magnitude of imaginary parts"): the model's k-th complex pair
 by imaginary part against the published k-th, and it must have Table 2's k-th character
-(``calibration.MODE_SIGNATURES``, optimal one-to-one assignment over the lowest pairs).
+(``calibration_targets.MODE_SIGNATURES``, optimal one-to-one assignment over the lowest pairs).
 
 Tolerances (the issue's acceptance limits, justified):
 
@@ -32,9 +32,11 @@ import numpy as np
 import pytest
 
 from model import OperatingPoint, build_model, eigen_analysis, load_parameters, mode_character
+from model.analysis.modes import wheelset_yaw_fraction
 from model.analysis.stability import stability_limit
 from model.mechanics.operating_point import adhesion_moment, motor_torque
-from model.studies.calibration import (
+from model.studies.calibration_bounds import FREE_PARAMETERS, constraint_values, on_bound
+from model.studies.calibration_targets import (
     ADHESION_MOMENT,
     DIVERGENCE_RATES,
     DRIVING_SHAFT_HZ,
@@ -47,9 +49,7 @@ from model.studies.calibration import (
     V_REF,
     driving_shaft_mode,
     match_table1_modes,
-    wheelset_yaw_fraction,
 )
-from model.studies.calibration_bounds import FREE_PARAMETERS, constraint_values, on_bound
 
 IM_TOLERANCE = 0.05  # [-] relative, by rank
 RE_TOLERANCE, RE_ABSOLUTE = 0.30, 0.05  # [-] relative; [1/s] where |Re_published| < 0.2 1/s

@@ -17,12 +17,11 @@ from model.studies.calibration import (
     _jacobian_j,
     _to_x,
     calibrate,
-    evaluate_by_rank,
     fit_operating_data,
-    operating_rows,
     real_part_residual,
 )
 from model.studies.calibration_bounds import CREEP_SHAPE_PARAMETERS, SEARCH_PARAMETERS, with_constraints
+from model.studies.calibration_targets import operating_rows
 
 
 def test_stage_a_meets_the_operating_data_for_another_creep_shape():
@@ -41,17 +40,6 @@ def test_real_part_residual_is_one_at_the_acceptance():
     assert real_part_residual(-3.958 / 1.3, -3.958) == pytest.approx(-1.0)
     assert real_part_residual(-0.032 - 0.05, -0.032) == pytest.approx(-1.0)  # |Re| < 0.2: 0.05
     assert abs(real_part_residual(+0.5, -3.958)) > 3  # wrong sign: linear, large
-
-
-def test_evaluation_by_rank_of_the_calibrated_set():
-    """The k-th entry is the k-th pair by Im; the character flags agree with the matching."""
-    e = evaluate_by_rank(load_parameters())
-    assert np.all(np.diff(e.stable.imag) >= 0)
-    assert e.unstable is not None
-    assert len(e.unstable) == 10
-    assert np.all(np.diff(e.unstable_real) <= 0)
-    assert e.max_real_stable < 0
-    assert e.max_real_below_limit < 0
 
 
 # the parameters of the finite-difference check: a creep-shape parameter (its stage-A
