@@ -20,8 +20,8 @@ what the part can physically be), on their logarithms (heights on their values).
   shape (kA, kS, initial slope) the search proposes; the limit is the creep maximum unless a
   flutter mode turns unstable first, which a check just below 0.0082 rules out.
 
-**Stage J** (:func:`jacobian_stage`, issue 27) fits the creep shape, the structure, the dampers
-and the motor slope: scipy's bounded trust-region-reflective least squares on residuals that are
+**Stage J** (:func:`jacobian_stage`) fits the creep shape, the structure, the dampers and the
+motor slope: scipy's bounded trust-region-reflective least squares on residuals that are
 smooth functions of eigenvalues (the comment above :data:`EXTRA_CUT` lists them), with the
 Jacobian from the eigenvalue sensitivities of :mod:`model.analysis.sensitivity` (exact derivative
 matrices, ``dλ/dp = −yᴴ(λ²M′ + λB′ + K′)x / yᴴ(2λM + B)x``), checked against finite differences
@@ -120,7 +120,7 @@ def fit_operating_data(parameters: Parameters) -> Parameters:
     return parameters.replace(**dict(zip(names, np.exp(solution.x).tolist(), strict=True)))
 
 
-# --- stage J: bounded least squares on the analytic Jacobian (issue 27) ---------------------------
+# --- stage J: bounded least squares on the analytic Jacobian --------------------------------------
 # Residuals at a parameter set (scaled so that 1 is the acceptance or a comparable miss), each a
 # smooth function of eigenvalues whose derivatives model/analysis/sensitivity.py gives exactly:
 #   * the frequency of the mode with Table 2's k-th character against Table 1's k-th

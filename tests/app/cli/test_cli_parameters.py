@@ -1,4 +1,4 @@
-"""``bogie parameters`` (issue 27): the set as a table with the calibration's bounds."""
+"""``bogie parameters``: the set as a table with the calibration's bounds."""
 
 from __future__ import annotations
 
