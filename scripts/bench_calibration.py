@@ -1,4 +1,4 @@
-"""Benchmark of the calibration (issue 27): ``bogie calibrate`` against one eigen-analysis call.
+"""Benchmark of the calibration (stages A and J): ``bogie calibrate`` against one eigen-analysis call.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/bench_calibration.py [--repeats 3]
         [--reference assets/parameters/calibrated.toml] [--json FILE]
@@ -7,7 +7,7 @@ In one run, as separate processes (what a user runs; the interpreter's start-up 
 
 * reference: ``bogie eigen --s0 0.005 --json`` (the calibrated set; median of ``--repeats``);
 * ``bogie calibrate --out TMP`` from the estimate (once: it takes a minute or two), wall time;
-* the ratio of the two (the issue's target: at most 150);
+* the ratio of the two (the target: at most 150);
 * reproduction: whether the written set equals ``--reference`` byte for byte (the bundled set
   is the output of this very command).
 

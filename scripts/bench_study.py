@@ -47,7 +47,8 @@ from model.analysis.continuation import continue_line
 from model.analysis.eigen import forget_systems
 from model.mechanics.operating_point import OperatingPoint
 from model.studies.engine import StudyEngine, serial_map_unordered
-from model.studies.maps import MapStudy, dense_line, s0_line
+from model.studies.maps import MapStudy
+from model.studies.s0_line import dense_line, s0_line
 from model.studies.store import open_study, run_into_store
 
 

@@ -30,7 +30,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from model.mechanics.parameters import load_parameters, parameter_hash
-from model.studies.calibration import STABILITY_LIMIT
+from model.studies.calibration_targets import STABILITY_LIMIT
 from model.studies.posterior import linearized_posterior
 from model.studies.uncertainty import UNCERTAIN_PARAMETERS
 
@@ -57,7 +57,7 @@ def main() -> None:
     from model.analysis.eigen import eigen_analysis
     from model.mechanics.assembly import build_model
     from model.mechanics.operating_point import OperatingPoint
-    from model.studies.calibration import S0_STABLE, V_REF
+    from model.studies.calibration_targets import S0_STABLE, V_REF
 
     op = OperatingPoint(S0_STABLE, V_REF, parameters["wheel_force"], parameters["motor_slope"])
     model = build_model(parameters)

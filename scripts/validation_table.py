@@ -32,7 +32,7 @@ from model.mechanics.operating_point import (  # noqa: E402
     creep_coefficients,
     creep_damping,
 )
-from model.studies.calibration import (  # noqa: E402
+from model.studies.calibration_targets import (  # noqa: E402
     MODE_SIGNATURES,
     TABLE1_IM_HZ,
     TABLE1_RE,

@@ -55,6 +55,33 @@ def test_no_import_circles():
     assert _cycles(grimp.build_graph("model", "app")) == []
 
 
+def _long_modules(root, packages=("model", "app"), limit: int = MAX_LINES) -> dict[str, int]:
+    """{path relative to ``root``: line count} of the ``.py`` modules under ``packages`` with more
+    than ``limit`` lines."""
+    found = {}
+    for package in packages:
+        for path in sorted((root / package).rglob("*.py")):
+            count = len(path.read_text(encoding="utf-8").splitlines())
+            if count > limit:
+                found[path.relative_to(root).as_posix()] = count
+    return found
+
+
+def test_no_module_too_long():
+    """No module of ``model`` or ``app`` has more than MAX_LINES lines: a longer one is split
+    along a seam (docs/architecture.md)."""
+    assert _long_modules(ROOT) == {}
+
+
+def test_the_length_check_finds_a_long_module(tmp_path):
+    (tmp_path / "model" / "wing").mkdir(parents=True)
+    (tmp_path / "app").mkdir()
+    (tmp_path / "model" / "wing" / "long.py").write_text("x = 1\n" * (MAX_LINES + 1))
+    (tmp_path / "model" / "wing" / "limit.py").write_text("x = 1\n" * MAX_LINES)
+    (tmp_path / "app" / "notes.txt").write_text("x\n" * (MAX_LINES + 1))
+    assert _long_modules(tmp_path) == {"model/wing/long.py": MAX_LINES + 1}
+
+
 def test_model_in_wings():
     direct = sorted(p.name for p in (ROOT / "model").glob("*.py"))
     assert len(direct) <= MAX_MODULES_DIRECTLY_IN_MODEL, direct

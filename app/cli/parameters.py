@@ -3,12 +3,12 @@
     bogie parameters [--params FILE] [--json]
 
 One row per parameter in schema order: name, value, SI unit, the note of the file (where the
-value comes from), and for the parameters the calibration fits (:data:`model.studies.calibration.
-FREE_PARAMETERS`) its bounds and whether the value sits on one (within 0.1 %,
-:func:`model.studies.calibration.on_bound`).  ``--json`` prints ``{"parameters": [{"name", "value",
-"unit", "note", "lower", "upper", "on_bound"}]}`` (``lower``, ``upper``, ``on_bound`` null for
-parameters the calibration does not fit).  Bad input (a file that is missing or not a valid
-set): one line on stderr, exit status 2.
+value comes from), and for the parameters the calibration fits
+(:data:`model.studies.calibration_bounds.FREE_PARAMETERS`) its bounds and whether the value sits on
+one (within 0.1 %, :func:`model.studies.calibration_bounds.on_bound`).  ``--json`` prints
+``{"parameters": [{"name", "value", "unit", "note", "lower", "upper", "on_bound"}]}`` (``lower``,
+``upper``, ``on_bound`` null for parameters the calibration does not fit).  Bad input (a file
+that is missing or not a valid set): one line on stderr, exit status 2.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ def register(subparsers) -> None:
 
 
 def parameter_table(rows: list[dict], source: str) -> str:
-    """The human-readable table of :func:`model.studies.calibration.parameter_rows`."""
+    """The human-readable table of :func:`model.studies.calibration_bounds.parameter_rows`."""
     calibrated = [row for row in rows if row["lower"] is not None]
     lines = [f"parameter set: {source} ({len(rows)} parameters, {len(calibrated)} fitted by the "
              f"calibration, {sum(1 for row in calibrated if row['on_bound'])} of them on a bound)",
@@ -47,7 +47,7 @@ def parameter_table(rows: list[dict], source: str) -> str:
 
 def cmd_parameters(args: argparse.Namespace) -> None:
     from model.mechanics.parameters import load_parameters
-    from model.studies.calibration import parameter_rows
+    from model.studies.calibration_bounds import parameter_rows
 
     parameters = load_parameters(args.params)
     rows = parameter_rows(parameters)

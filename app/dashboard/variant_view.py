@@ -37,7 +37,7 @@ from app.results.variants import (
 )
 from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest, ignore_outcome
 from model.mechanics.parameters import SCHEMA, ParameterError
-from model.studies.calibration import parameter_rows
+from model.studies.calibration_bounds import parameter_rows
 
 LIMIT_SPEEDS_KMH = (40.0, 80.0, 120.0, 160.0, 200.0)  # speeds of the s0*(v) comparison [km/h]
 CHANGED = 0.005  # relative difference highlighted in the comparison table
@@ -110,7 +110,7 @@ def comparison_html(base: Side, variant: Side, v_kmh: float) -> str:
 
 def bounds_html(rows) -> str:
     """The calibrated parameters of a set with their bounds and whether the value sits on one
-    (the rows of :func:`model.studies.calibration.parameter_rows`; SI units)."""
+    (the rows of :func:`model.studies.calibration_bounds.parameter_rows`; SI units)."""
     lines = "".join(
         f"<tr><td class='text'>{html.escape(r['name'])}</td><td>{r['value']:.4g}</td>"
         f"<td>{r['lower']:.4g} … {r['upper']:.4g}</td><td class='text'>{html.escape(r['unit'])}"

@@ -9,7 +9,7 @@ see :mod:`model.analysis.linear_system`), ``f_mc`` (generalized force per unit s
 ``output_units``, ``output_steady`` (pre-fault values), ``operating_point`` (s0 [-], v [m/s],
 N0 [N], b_M [N m s/rad]).  Strings are numpy unicode arrays: load with ``allow_pickle=False``.
 
-For an independent nonlinear integrator (issue 10, :mod:`model.analysis.nonlinear`):
+For an independent nonlinear integrator (the quantities :mod:`model.analysis.nonlinear` steps with):
 ``B_without_longitudinal_creep`` (n x n, B_nl: ``B`` without eq. 19's b11 terms),
 ``creep_velocity_map`` (contacts x n, rows H_i: ``Δs_i v = H_i Δq̇`` [m/s]), ``creep_force_map``
 (n x contacts, columns of G: a unit longitudinal creep force), ``contacts`` (rim names),

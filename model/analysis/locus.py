@@ -92,12 +92,14 @@ def creep_patterns(model: BogieModel) -> list[np.ndarray]:
     return patterns
 
 
-def _coefficients(model: BogieModel, op: OperatingPoint) -> np.ndarray:
+def pattern_coefficients(model: BogieModel, op: OperatingPoint) -> np.ndarray:
+    """(b11, b22, b23, b33) at ``op``: the coefficients of the four creep patterns of
+    :func:`creep_patterns` (B_ad = Σ b_k P_k)."""
     cc = creep_coefficients(model.parameters, op)
     return np.array([cc.b11, cc.b22, cc.b23, cc.b33])
 
 
-class _Reduced:
+class Reduced:
     """Projected matrices of the sweep on a basis Φ.
 
     The massless coordinates (the Maxwell elements' internal coordinates,
@@ -190,7 +192,7 @@ class _SweepStart:
     model: BogieModel
     first: tuple[np.ndarray, np.ndarray]
     last: tuple[np.ndarray, np.ndarray]
-    reduced: _Reduced
+    reduced: Reduced
     solutions: dict[bytes, tuple[np.ndarray, np.ndarray]]
 
 
@@ -259,7 +261,7 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     if values.ndim != 1 or len(values) < 2 or not np.all(np.isfinite(values)):
         raise ValueError("need at least two finite parameter values")
     points = [replace(op, **{parameter: float(x)}) for x in values]  # validates each point
-    coefficients = np.array([_coefficients(model, p) for p in points])
+    coefficients = np.array([pattern_coefficients(model, p) for p in points])
     patterns = creep_patterns(model)
     radius = 2 * np.pi * max_frequency_hz
     controlled = 1.5 * radius  # accuracy is enforced for branches inside this disc
@@ -289,8 +291,8 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
             last = last_future.result()
         else:
             first, last = exact(0), exact(n_points - 1)
-        reduced = _Reduced(model, op, patterns,
-                           [model.rigid_body_modes, *modes(*first), *modes(*last)])
+        reduced = Reduced(model, op, patterns,
+                          [model.rigid_body_modes, *modes(*first), *modes(*last)])
         start = _SweepStart(model, first, last, reduced, {})
     first, last, reduced = start.first, start.last, start.reduced
     # the reduced eigenproblems of the inner points do not depend on each other: they are solved
@@ -333,7 +335,7 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
                 # refine the few inaccurate branches by Newton's method in the full model
                 C = damping_matrix(model, points[i]) if len(failing) else None
                 for b in failing:
-                    values_i[b], vectors_i[:, b], estimate[b] = _newton(
+                    values_i[b], vectors_i[:, b], estimate[b] = newton(
                         model.M, C, model.K, values_i[b], vectors_i[:, b], rtol)
                 if np.all((estimate <= rtol) | (np.abs(values_i) >= controlled)):
                     refined += len(failing)
@@ -354,8 +356,8 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     return RootLocus(parameter, values, eigenvalues, errors, dense, op, reduced.size, refined)
 
 
-def _newton(M, C, K, lam: complex, x: np.ndarray, rtol: float, iterations: int = 6,
-            floor: float = 1e-300):
+def newton(M, C, K, lam: complex, x: np.ndarray, rtol: float, iterations: int = 6,
+           floor: float = 1e-300):
     """Newton's method (nonlinear inverse iteration) for ``(λ² M + λ C + K) x = 0`` from a close
     start; returns (λ, unit x, size of the last step relative to max(|λ|, ``floor``) [floor in
     1/s]; the default measures it relative to |λ|)."""

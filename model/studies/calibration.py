@@ -1,12 +1,14 @@
 """Calibration (model updating) of the uncertain parameters against the published results.
 
-The free parameters (:data:`FREE_PARAMETERS`) are searched each within documented bounds (the
-reason for each next to it: about x3 around the estimate and within what the part can physically
-be), on their logarithms (heights on their values).  Targets, all at 120 km/h, N0 = 10^5 N:
+The free parameters (:data:`model.studies.calibration_bounds.FREE_PARAMETERS`) are searched each
+within documented bounds (the reason for each next to it: about x3 around the estimate and within
+what the part can physically be), on their logarithms (heights on their values).  Targets, all at
+120 km/h, N0 = 10^5 N:
 
 * **Table 1 by rank**: the k-th complex pair by imaginary part at s0 = 0.005 against the
-  published k-th, k = 1…10, with Table 2's k-th character (:data:`MODE_SIGNATURES`: energy
-  shares, directions and phases, optimal one-to-one assignment over the lowest candidates);
+  published k-th, k = 1…10, with Table 2's k-th character
+  (:data:`model.studies.calibration_targets.MODE_SIGNATURES`: energy shares, directions and
+  phases, optimal one-to-one assignment over the lowest candidates);
 * the real parts of modes 1, 3, 4, 8, 9, 10 at s0 = 0.005 (30 % or 0.05 1/s); mode 2's damping
   is *not* a target (it cannot be reached with an eq.-19 creep block and physical inertias, see
   docs/validation.md);
@@ -18,8 +20,8 @@ be), on their logarithms (heights on their values).  Targets, all at 120 km/h, N
   shape (kA, kS, initial slope) the search proposes; the limit is the creep maximum unless a
   flutter mode turns unstable first, which a check just below 0.0082 rules out.
 
-**Stage J** (:func:`jacobian_stage`, issue 27) fits the creep shape, the structure, the dampers
-and the motor slope: scipy's bounded trust-region-reflective least squares on residuals that are
+**Stage J** (:func:`jacobian_stage`) fits the creep shape, the structure, the dampers and the
+motor slope: scipy's bounded trust-region-reflective least squares on residuals that are
 smooth functions of eigenvalues (the comment above :data:`EXTRA_CUT` lists them), with the
 Jacobian from the eigenvalue sensitivities of :mod:`model.analysis.sensitivity` (exact derivative
 matrices, ``dλ/dp = −yᴴ(λ²M′ + λB′ + K′)x / yᴴ(2λM + B)x``), checked against finite differences
@@ -29,7 +31,10 @@ Everything is deterministic (no random numbers, no time limits, one BLAS thread)
 ``bogie calibrate`` reproduces ``assets/parameters/calibrated.toml`` byte for byte
 (``scripts/bench_calibration.py`` checks it).
 
-The published targets live here, as *targets* of the fit; the model never reads them.
+The published targets and how a set is judged against them live in
+:mod:`model.studies.calibration_targets`, the free parameters and their bounds in
+:mod:`model.studies.calibration_bounds`; this module holds the fit (stages A and J) and
+``bogie calibrate`` (:func:`run`).
 """
 
 from __future__ import annotations
@@ -40,355 +45,49 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares, linear_sum_assignment
+from scipy.optimize import least_squares
 
 from model.analysis.eigen import eigen_analysis
-from model.analysis.modes import characterize, wheelset_yaw_fraction
 from model.analysis.stability import stability_limit
 from model.mechanics.assembly import build_model
-from model.mechanics.operating_point import KMH, OperatingPoint, adhesion_moment, creep_law, motor_torque
 from model.mechanics.parameters import (
     CALIBRATED_FILE,
     ESTIMATE_FILE,
-    SCHEMA,
     Parameters,
     load_parameters,
     save_parameters,
 )
-
-V_REF = 120 * KMH  # [m/s]
-S0_STABLE, S0_UNSTABLE = 0.005, 0.014
-
-# --- published targets (Zeman & Hlaváč; see shared/spec/reference-results.md) -------------------
-TABLE1_IM_HZ = (1.262, 2.694, 5.425, 5.449, 6.176, 8.503, 8.583, 9.183, 12.208, 12.58)
-# Re of the same ten pairs at s0 = 0.005 [1/s]: targets of the literature tests by rank (issue
-# 11); the calibration does not fit them yet
-TABLE1_RE = (-0.032, -0.041, -0.199, -0.056, -1.583, -0.164, -0.289, -3.282, -3.958, -4.010)
-DRIVING_SHAFT_HZ = 298.4
-MOTOR_TORQUE = 12_800.0  # [N m] at both creepages
-ADHESION_MOMENT = 0.52e5  # [N m]
-STABILITY_LIMIT = 0.0082  # [-] at 120 km/h
-DIVERGENCE_RATES = (7.031, 0.062)  # [1/s], the two positive real eigenvalues at s0 = 0.014
-# real parts [1/s] of the ten pairs at s0 = 0.005 and real/imaginary parts at s0 = 0.014
-TABLE1_RE = (-0.032, -0.041, -0.199, -0.056, -1.583, -0.164, -0.289, -3.282, -3.958, -4.010)
-TABLE1_UNSTABLE = ((-0.029, 1.262), (-0.060, 2.689), (0.076, 5.374), (-0.0318, 5.443),
-                   (-1.583, 6.174), (-0.164, 8.505), (0.416, 9.126), (1.111, 9.535),
-                   (0.911, 12.140), (0.809, 12.162))  # (Re [1/s], Im [Hz])
-
-
-def _share(character, component: str, axes: tuple[str, ...]) -> float:
-    kinetic = character.kinetic.get(component, 0.0)
-    directions = character.directions.get(component, {})
-    return kinetic * sum(directions.get(axis, 0.0) for axis in axes)
-
-
-def _in_phase(character, a: str, b: str, axis: str) -> float:
-    return 0.5 * (1 + character.phase_cosine(a, b, axis))
-
-
-_TMS = ("ID1.stator", "ID2.stator")
-_GEARS = ("ID1.gear", "ID2.gear")
-
-
-def _pitch_with_frame(c, component: str) -> float:
-    """1 if ``component`` pitches in phase with the frame, 0 against it, 0.5 if either does not
-    pitch."""
-    return _in_phase(c, "BF", component, "ry")
-
-
-# Table 2 characters as scores in [0, 1] (kinetic/strain energy shares, phase factors); each
-# signature takes the mode's character and its wheelset yaw fractions
-MODE_SIGNATURES: tuple[tuple[str, Callable], ...] = (
-    ("vertical of CB in phase with BF and TMs", lambda c, yaw: _share(c, "CB", ("z",))),
-    ("torsion of ID1 rotor with gears, DC twisting",
-     lambda c, yaw: c.kinetic.get("ID1.rotor", 0) + c.strain.get("ID1.disc_clutch", 0)),
-    # the gear housings (our stators) turn with the frame: a stator pitching against the frame on
-    # its silent blocks is a different mode
-    ("torsion of both gears and BF pitch, gearing",
-     lambda c, yaw: (_share(c, "BF", ("ry",))
-                     + sum(_share(c, part, ("ry",)) for part in _TMS + _GEARS)
-                     + c.strain.get("ID1.gear_mesh", 0) + c.strain.get("ID2.gear_mesh", 0))
-     * _pitch_with_frame(c, "ID1.stator") * _pitch_with_frame(c, "ID2.stator")),
-    ("vertical of BF with both TMs in phase",
-     lambda c, yaw: (_share(c, "BF", ("z",)) + sum(_share(c, tm, ("z",)) for tm in _TMS))
-     * _in_phase(c, "BF", "ID1.stator", "z") * _in_phase(c, "BF", "ID2.stator", "z")),
-    ("lateral and roll of BF with both TMs",
-     lambda c, yaw: (_share(c, "BF", ("y", "rx")) + sum(_share(c, tm, ("y", "rx")) for tm in _TMS))
-     * _in_phase(c, "BF", "ID1.stator", "y") * _in_phase(c, "BF", "ID2.stator", "y")),
-    ("lateral of both TMs in opposite phase",
-     lambda c, yaw: sum(_share(c, tm, ("y", "rz")) for tm in _TMS)
-     * (1 - _in_phase(c, "ID1.stator", "ID2.stator", "y"))),
-    # longitudinal-pitch: the wheelset translates (and rolls); longitudinal-yaw: its journals
-    # move longitudinally in opposite phase
-    ("longitudinal-pitch of WS2",
-     lambda c, yaw: _share(c, "ID2.wheelset", ("x", "ry")) * (1 - yaw["ID2"])),
-    ("longitudinal-pitch of WS1",
-     lambda c, yaw: _share(c, "ID1.wheelset", ("x", "ry")) * (1 - yaw["ID1"])),
-    ("longitudinal-yaw of WS2",
-     lambda c, yaw: _share(c, "ID2.wheelset", ("x", "rz")) * yaw["ID2"]),
-    ("longitudinal-yaw of WS1",
-     lambda c, yaw: _share(c, "ID1.wheelset", ("x", "rz")) * yaw["ID1"]),
+from model.studies.calibration_bounds import (
+    CREEP_PARAMETERS,
+    CREEP_SHAPE_PARAMETERS,
+    FREE_PARAMETERS,
+    SEARCH_PARAMETERS,
+    FreeParameter,
+    constraint_values,
+    with_constraints,
 )
-
-
-@dataclass(frozen=True)
-class FreeParameter:
-    name: str
-    low: float  # calibration bounds [the parameter's unit]
-    high: float
-    reason: str  # the source of the bounds
-    log: bool = True  # searched on its logarithm (False: on its value, e.g. a height)
-
-
-# stage A: creep law and gear ratio against the operating data (exactly determined)
-CREEP_PARAMETERS = (
-    FreeParameter("polach_mu0", 0.3, 0.8, "dry rail friction coefficient"),
-    FreeParameter("polach_A", 0.2, 0.9, "Polach's A (0.4 in his presets)"),
-    FreeParameter("polach_B", 0.05, 3.0, "Polach's B [s/m] (0.2–0.6 in his presets)"),
-    FreeParameter("gear_ratio", 3.0, 4.06, "p <= M_ad/M = 4.06 (spec), > 3 for a 200 km/h loco"),
+from model.studies.calibration_targets import (
+    CANDIDATES,
+    DIVERGENCE_RATES,
+    DRIVING_SHAFT_HZ,
+    LIMIT_CHECK,
+    RE_MODES,
+    S0_STABLE,
+    S0_UNSTABLE,
+    TABLE1_IM_HZ,
+    TABLE1_RE,
+    V_REF,
+    TargetRow,
+    driving_shaft_mode,
+    evaluate,
+    format_table,
+    operating_rows,
+    reference_point,
+    signature_assignment,
 )
-# the creep law's shape, searched with the structure (stage A re-solved for each shape): Polach's
-# reduction factors within his published range (wet 0.3/0.1 … dry 1.0/0.4, kS <= kA), the initial
-# slope between Kalker's value for this contact (~130) and 5x the spec's starting fit
-CREEP_SHAPE_PARAMETERS = (
-    FreeParameter("polach_kA", 0.3, 1.0, "Polach's range: wet 0.3 … dry 1.0"),
-    FreeParameter("polach_kS", 0.1, 0.4, "Polach's range: wet 0.1 … dry 0.4; kS <= kA"),
-    FreeParameter("creep_slope", 130.0, 3000.0, "Kalker's slope for this contact (~130) … 5x the "
-                  "spec's starting fit (600)"),
-)
-# stage J: the structure, the dampers and the motor slope against Table 1.  Inertias and
-# stiffnesses within about x3 of their estimate and within what the part can be; bounds that the
-# previous calibration sat on (frame roll inertia 5 000, stator pitch inertia 557 kg m^2) are
-# tightened to physical limits of the frame (4.9 t with its equipment) and a 2.6 t motor with
-# its gear housing
-STRUCTURAL_PARAMETERS = (
-    FreeParameter("secondary_stiffness_z", 2e5, 1.8e6, "x3 around 0.6 MN/m (1.26 Hz with 28 t)"),
-    FreeParameter("disc_clutch_torsional_stiffness", 2.3e4, 2.1e5, "x3 around 7e4 N m/rad"),
-    FreeParameter("primary_stiffness_z", 3.7e5, 3.3e6, "coil springs per axle box, x3 around "
-                  "1.1 MN/m"),
-    FreeParameter("primary_stiffness_y", 3.3e5, 1e7, "coil spring shear 0.3–1 MN/m up to a "
-                  "rubber-bushed lateral guide 10 MN/m per axle box"),
-    FreeParameter("primary_stiffness_x", 1.7e6, 1.5e7, "longitudinal guide (rubber bushes), x3 "
-                  "around 5 MN/m"),
-    FreeParameter("silent_block_stiffness_x", 2.7e6, 2.4e7, "rubber-metal block, x3 around 8 MN/m"),
-    FreeParameter("silent_block_stiffness_y", 1.3e6, 1.2e7, "rubber-metal block, x3 around 4 MN/m"),
-    FreeParameter("silent_block_stiffness_z", 2.7e6, 2.4e7, "rubber-metal block, x3 around 8 MN/m"),
-    FreeParameter("rim_torsional_stiffness", 6.7e6, 6e7, "rubber-sprung wheel, x3 around "
-                  "2e7 N m/rad"),
-    FreeParameter("driving_shaft_stiffness", 2.1e6, 1.9e7, "steel quill shaft, x3 around "
-                  "6.4 MN m/rad"),
-    # the frame with what it carries, 4.9 t (the rest of the 16 t bogie): a 3.5 t structure
-    # (side members, ~60 % of it, at y = ±1.0 m over x = ±1.75 m; cross members near the centre)
-    # and ~1.4 t of equipment near the wheels; all of it at the outer edges (the physical limit)
-    # would give I_x ≈ 4 900 · 1.1² ≈ 5 900, I_y ≈ 4 900 · 1.6² ≈ 12 500 kg m^2
-    FreeParameter("frame_inertia_x", 1400.0, 4200.0, "4.9 t frame with equipment, 2.2 m wide: "
-                  "~2 800 kg m^2; x½ … x1.5"),
-    FreeParameter("frame_inertia_y", 2300.0, 7000.0, "4.9 t frame with equipment, 3.5 m long: "
-                  "~4 600 kg m^2; x½ … x1.5"),
-    FreeParameter("frame_inertia_z", 3500.0, 11000.0, "~7 000 kg m^2, x½ … x1.6; |I_x − I_y| <= "
-                  "I_z <= I_x + I_y (see constraint_values)"),
-    # 2.6 t: a 0.7 m motor (cylinder, m r²/2 ≈ 160 kg m^2) plus a gear housing reaching to the axle
-    FreeParameter("stator_inertia_y", 90.0, 400.0, "2.6 t motor (~160 kg m^2 as a 0.7 m "
-                  "cylinder) with its gear housing towards the axle (~150 kg m^2)"),
-    # the yaw dampers act between frame and car body (which moves longitudinally and in yaw),
-    # each in series with its end bushes
-    FreeParameter("yaw_damping", 5e4, 1e6, "yaw damper of a 200 km/h loco, 0.05–1 MN s/m"),
-    FreeParameter("yaw_damper_height", 0.05, 0.6, "between the axle height and the car body "
-                  "floor; decides how the yaw dampers couple the frame's pitch"),
-    FreeParameter("yaw_damper_series_stiffness", 3e6, 3e7, "rubber end bushes of a hydraulic "
-                  "damper, 5–15 MN/m, x½ … x2"),
-    FreeParameter("traction_link_stiffness", 3e6, 3e7, "rubber-bushed traction rod, 5–20 MN/m, "
-                  "x0.6 … x1.5"),
-    FreeParameter("anti_roll_bar_stiffness", 3e5, 5e6, "torsion bar of a locomotive or coach, "
-                  "1–3 MN m/rad, x⅓ … x1.7"),
-    FreeParameter("traction_link_height", -0.45, 0.3, "between ~0.2 m above the rail and the "
-                  "frame's upper chord", log=False),
-    FreeParameter("primary_damping_z", 200.0, 3e4, "primary vertical damper per axle box, up to "
-                  "a typical 30 kN s/m"),
-    FreeParameter("secondary_damping_z", 200.0, 3e4, "secondary vertical damper per spring, up "
-                  "to a typical 30 kN s/m"),
-    FreeParameter("secondary_damping_y", 2e3, 1e5, "secondary lateral damper per side"),
-    FreeParameter("rotor_inertia", 6.0, 24.0, "rotor of 550 kg, radius of gyration 0.10–0.21 m; "
-                  "x½ … x2 around 12 kg m^2"),
-    # b_M (docs/validation.md, "The motor slope"): the converter holds the healthy motor's torque
-    # for slow motions — on the constant-power hyperbola M ω = P the slope is M/ω = 12 800 N m /
-    # 212 rad/s ≈ 60 N m s/rad; faster than its torque control the motor shows its natural
-    # characteristic, M/(s_n ω_s) ≈ 12 800 / (0.005 · 214) ≈ 12 000 N m s/rad at 0.5 % slip
-    FreeParameter("motor_slope", 60.0, 12000.0, "asynchronous drive between its controlled "
-                  "characteristic (constant power, M/ω ≈ 60) and its natural one at 0.5 % slip "
-                  "(≈ 12 000 N m s/rad)"),
-)
-SEARCH_PARAMETERS = CREEP_SHAPE_PARAMETERS + STRUCTURAL_PARAMETERS
-FREE_PARAMETERS = CREEP_PARAMETERS + SEARCH_PARAMETERS
-BOUND_TOLERANCE = 1e-3  # a value this close to a bound sits on it (relative; of the range if linear)
-
-
-def on_bound(free: FreeParameter, value: float) -> bool:
-    """Whether ``value`` sits on one of the calibration bounds of ``free``: within 0.1 % of it
-    (log-searched parameters), or within 0.1 % of the range (the others)."""
-    if free.log:
-        return min(abs(math.log(value / free.low)), abs(math.log(value / free.high))) \
-            <= BOUND_TOLERANCE
-    return min(abs(value - free.low), abs(value - free.high)) \
-        <= BOUND_TOLERANCE * (free.high - free.low)
-
-
-# a rigid body's principal inertias obey the triangle inequalities |I_x − I_y| <= I_z <= I_x + I_y
-# (equality on the right for a flat body); Polach's kS <= kA
-def constraint_values(parameters: Parameters) -> np.ndarray:
-    """The constraints as g <= 0 (dimensionless): I_z <= I_x + I_y, I_z >= I_y − I_x,
-    I_z >= I_x − I_y of the frame, kS <= kA."""
-    Ix, Iy, Iz = (parameters[f"frame_inertia_{a}"] for a in "xyz")
-    return np.array([(Iz - Ix - Iy) / (Ix + Iy), (Iy - Ix - Iz) / (Ix + Iy),
-                     (Ix - Iy - Iz) / (Ix + Iy),
-                     (parameters["polach_kS"] - parameters["polach_kA"]) / parameters["polach_kA"]])
-
-
-def with_constraints(parameters: Parameters) -> Parameters:
-    """``parameters`` with the frame's yaw inertia kept within |I_x − I_y| … I_x + I_y and
-    Polach's kS limited to kA."""
-    changes = {}
-    Ix, Iy, Iz = (parameters[f"frame_inertia_{a}"] for a in "xyz")
-    if Iz > Ix + Iy:
-        changes["frame_inertia_z"] = float(Ix + Iy)
-    elif Iz < abs(Ix - Iy):
-        changes["frame_inertia_z"] = float(abs(Ix - Iy))
-    if parameters["polach_kS"] > parameters["polach_kA"]:
-        changes["polach_kS"] = float(parameters["polach_kA"])
-    return parameters.replace(**changes) if changes else parameters
-
-
-@dataclass(frozen=True)
-class TargetRow:
-    name: str
-    target: float
-    achieved: float
-    unit: str
-
-    @property
-    def error(self) -> float:
-        return (self.achieved - self.target) / abs(self.target)
-
-
-CANDIDATES = 14  # lowest complex pairs whose character is computed (Table 1 has ten)
-
-
-def _signature_assignment(model, result, candidates):
-    """Table 2's characters assigned one-to-one to the ``candidates`` (indices of complex pairs
-    in ``result``) by an optimal assignment on their signature scores: (rows: Table 2's
-    characters, columns: positions in ``candidates``, the score matrix (characters x
-    candidates), the characters computed)."""
-    shapes = [result.mode_shape(i) for i in candidates]
-    characters = [characterize(model, result.eigenvalues[i], q)
-                  for i, q in zip(candidates, shapes, strict=True)]
-    yaws = [wheelset_yaw_fraction(model, q) for q in shapes]
-    score = np.array([[signature(c, yaw) for c, yaw in zip(characters, yaws, strict=True)]
-                      for _, signature in MODE_SIGNATURES])
-    rows, columns = linear_sum_assignment(-score)
-    return rows, columns, score, characters
-
-
-def match_table1_modes(model, result, max_modes: int = CANDIDATES):
-    """Indices (into ``result.eigenvalues``) of the modes matching Table 2's characters, by an
-    optimal one-to-one assignment on the signature scores over the ``max_modes`` lowest complex
-    pairs; plus the characters computed."""
-    candidates = result.complex_index[:max_modes]
-    rows, columns, _, characters = _signature_assignment(model, result, candidates)
-    matched = np.empty(len(MODE_SIGNATURES), dtype=int)
-    matched[rows] = candidates[columns]
-    return matched, characters
-
-
-def driving_shaft_mode(model, result) -> int:
-    """Index of the mode with the largest strain share in ID1's driving shaft."""
-    part = model.stiffness_parts["ID1.driving_shaft"]
-    best, best_share = -1, -1.0
-    for i in result.complex_index:
-        q = result.mode_shape(i)
-        x = q[part.index]
-        share = np.real(np.conj(x) @ part.matrix @ x) / np.real(np.conj(q) @ model.K @ q)
-        if share > best_share:
-            best, best_share = i, share
-    return int(best)
-
-
-def frequency_rows(parameters: Parameters, model=None) -> list[TargetRow]:
-    """The imaginary parts of the modes with Table 2's ten characters (matched by character,
-    whatever their rank) and of the driving-shaft mode at s0 = 0.005 — the frequency targets of
-    the linearized posterior (model/studies/posterior.py), whose sensitivities follow a mode, not a rank;
-    ``model`` is the model built from ``parameters`` if the caller has it already."""
-    model = build_model(parameters) if model is None else model
-    stable = eigen_analysis(model, _operating_point(parameters, S0_STABLE))
-    matched, _ = match_table1_modes(model, stable)
-    rows = [TargetRow(f"Im λ{k} [{MODE_SIGNATURES[k - 1][0]}]", target,
-                      stable.eigenvalues[index].imag / (2 * np.pi), "Hz")
-            for k, (index, target) in enumerate(zip(matched, TABLE1_IM_HZ, strict=True), start=1)]
-    ds = driving_shaft_mode(model, stable)
-    rows.append(TargetRow("Im λ58 [ID1 driving shaft twisting]", DRIVING_SHAFT_HZ,
-                          stable.eigenvalues[ds].imag / (2 * np.pi), "Hz"))
-    return rows
-
-def operating_rows(parameters: Parameters) -> list[TargetRow]:
-    """Operating-data targets (no eigen-analysis needed)."""
-    N0, b_M = parameters["wheel_force"], parameters["motor_slope"]
-    rows = [TargetRow(f"M(s0={s0}) motor torque", MOTOR_TORQUE,
-                      motor_torque(parameters, OperatingPoint(s0, V_REF, N0, b_M)), "N m")
-            for s0 in (S0_STABLE, S0_UNSTABLE)]
-    rows.append(TargetRow("M_ad adhesion moment", ADHESION_MOMENT,
-                          adhesion_moment(parameters, V_REF, N0), "N m"))
-    rows.append(TargetRow("creep maximum s (stability-limit proxy)", STABILITY_LIMIT,
-                          creep_law(parameters, N0).maximum(V_REF)[0], "-"))
-    return rows
-
-
-def _operating_point(parameters: Parameters, s0: float) -> OperatingPoint:
-    return OperatingPoint(s0, V_REF, parameters["wheel_force"], parameters["motor_slope"])
-
-
-@dataclass(frozen=True)
-class RankEvaluation:
-    """What the calibration compares, for one parameter set (eigenvalues [1/s])."""
-
-    stable: np.ndarray  # the ten lowest complex pairs at s0 = 0.005, by Im (upper half)
-    character_ok: np.ndarray  # bool per rank: the k-th pair has Table 2's k-th character
-    matched: np.ndarray  # the pair with Table 2's k-th character (by character), per k
-    driving_shaft: complex  # ID1 driving-shaft mode at s0 = 0.005
-    max_real_stable: float  # largest real part at s0 = 0.005
-    unstable: np.ndarray | None = None  # the ten lowest complex pairs at s0 = 0.014
-    unstable_real: np.ndarray | None = None  # real eigenvalues at s0 = 0.014, largest first
-    max_real_below_limit: float | None = None  # largest real part at 0.98 · 0.0082
-
-
-LIMIT_CHECK = 0.98 * STABILITY_LIMIT  # the bogie must still be stable here (no early flutter)
-
-
-def evaluate_by_rank(parameters: Parameters, model=None, complete: Callable | None = None
-                     ) -> RankEvaluation:
-    """The eigen-analyses the calibration needs.  ``complete(partial)`` (optional) is asked after
-    the analysis at s0 = 0.005 whether the others are worth computing (the search skips them
-    when the partial cost is already too high)."""
-    model = build_model(parameters) if model is None else model
-    stable = eigen_analysis(model, _operating_point(parameters, S0_STABLE))
-    matched, _ = match_table1_modes(model, stable)
-    ranked = stable.complex_index[:len(TABLE1_IM_HZ)]
-    ds = driving_shaft_mode(model, stable)
-    result = RankEvaluation(stable.eigenvalues[ranked], matched == ranked[:len(matched)],
-                            stable.eigenvalues[matched], complex(stable.eigenvalues[ds]),
-                            stable.max_real_part)
-    if complete is not None and not complete(result):
-        return result
-    unstable = eigen_analysis(model, _operating_point(parameters, S0_UNSTABLE), vectors=False)
-    below = eigen_analysis(model, _operating_point(parameters, LIMIT_CHECK), vectors=False)
-    return RankEvaluation(result.stable, result.character_ok, result.matched,
-                          result.driving_shaft, result.max_real_stable,
-                          unstable.complex_pairs[:len(TABLE1_IM_HZ)], unstable.real,
-                          below.max_real_part)
-
 
 # --- residual scales -----------------------------------------------------------------------------
 FREQUENCY_SCALE = 0.03  # [-] the literature tests' aim for the imaginary parts (log error)
-RE_MODES = (1, 3, 4, 8, 9, 10)  # Table 1 rows whose real part at s0 = 0.005 is a target
-UNSTABLE_RE_MODES = (7, 8, 9, 10)  # the wheelset modes at s0 = 0.014 (reported)
 
 
 def real_part_residual(achieved: float, published: float) -> float:
@@ -421,7 +120,7 @@ def fit_operating_data(parameters: Parameters) -> Parameters:
     return parameters.replace(**dict(zip(names, np.exp(solution.x).tolist(), strict=True)))
 
 
-# --- stage J: bounded least squares on the analytic Jacobian (issue 27) ---------------------------
+# --- stage J: bounded least squares on the analytic Jacobian --------------------------------------
 # Residuals at a parameter set (scaled so that 1 is the acceptance or a comparable miss), each a
 # smooth function of eigenvalues whose derivatives model/analysis/sensitivity.py gives exactly:
 #   * the frequency of the mode with Table 2's k-th character against Table 1's k-th
@@ -512,7 +211,7 @@ def _assignment(model, result) -> tuple[dict[int, int], list[int]]:
     index = result.complex_index
     frequency = result.eigenvalues[index].imag / (2 * np.pi)
     candidates = index[:max(CANDIDATES, int(np.count_nonzero(frequency < CANDIDATE_HZ)))]
-    rows, columns, _, _ = _signature_assignment(model, result, candidates)
+    rows, columns, _, _ = signature_assignment(model, result, candidates)
     characters = {int(r): int(candidates[c]) for r, c in zip(rows, columns, strict=True)}
     taken = set(characters.values())
     extra = [int(i) for i in candidates
@@ -560,7 +259,7 @@ def _evaluate_j(x: np.ndarray, start: Parameters, free, x_prior: np.ndarray,
     """The residuals of stage J at x (module comment above), the characters assigned at x."""
     p = _from_x(x, start, free)
     model = build_model(p)
-    stable = eigen_analysis(model, _operating_point(p, S0_STABLE))
+    stable = eigen_analysis(model, reference_point(p, S0_STABLE))
     characters, extra = _assignment(model, stable)
     residual, terms = [], []
 
@@ -600,7 +299,7 @@ def _evaluate_j(x: np.ndarray, start: Parameters, free, x_prior: np.ndarray,
     add(math.log(lam[ds].imag / (2 * np.pi) / DRIVING_SHAFT_HZ) / FREQUENCY_SCALE, "logf",
         S0_STABLE, ds, (1.0 / FREQUENCY_SCALE,))
     results = {S0_STABLE: stable}
-    unstable = eigen_analysis(model, _operating_point(p, S0_UNSTABLE), vectors=False)
+    unstable = eigen_analysis(model, reference_point(p, S0_UNSTABLE), vectors=False)
     results[S0_UNSTABLE] = unstable
     for target, i in zip(DIVERGENCE_RATES, unstable.real_index[:2], strict=True):
         value = unstable.eigenvalues[i].real
@@ -614,7 +313,7 @@ def _evaluate_j(x: np.ndarray, start: Parameters, free, x_prior: np.ndarray,
         value = unstable.eigenvalues[i].real
         add(weights.divergence * _hinge(value) / EXTRA_DIVERGENCE_SCALE, "linre", S0_UNSTABLE,
             int(i), (weights.divergence / EXTRA_DIVERGENCE_SCALE if value > 0 else 0.0,))
-    below = eigen_analysis(model, _operating_point(p, LIMIT_CHECK), vectors=False)
+    below = eigen_analysis(model, reference_point(p, LIMIT_CHECK), vectors=False)
     results[LIMIT_CHECK] = below
     top = int(np.argmax(below.eigenvalues.real))
     value = below.eigenvalues[top].real
@@ -686,7 +385,7 @@ def _jacobian_j(e: _Evaluation, start: Parameters, free) -> np.ndarray:
         if not indices:
             continue
         indices = sorted(indices)
-        op = _operating_point(p, s0)
+        op = reference_point(p, s0)
         sens = eigen_sensitivities(model, op, indices=indices, linked=("motor_slope",),
                                    parameters=wanted, result=e.results[s0], describe=False)
         rows = {name: k for k, name in enumerate(sens.names)}
@@ -819,41 +518,6 @@ def calibrate(start: Parameters, progress: Callable = print,
     return calibrated, evaluate(calibrated)
 
 
-def evaluate(parameters: Parameters) -> list[TargetRow]:
-    """All calibration targets with the values the model achieves (Table 1 by rank)."""
-    e = evaluate_by_rank(parameters)
-    rows = []
-    for k, target in enumerate(TABLE1_IM_HZ, start=1):
-        mark = "" if e.character_ok[k - 1] else " OTHER CHARACTER:"  # before the long name
-        rows.append(TargetRow(f"Im λ{k} by rank{mark} [{MODE_SIGNATURES[k - 1][0]}]", target,
-                              e.stable[k - 1].imag / (2 * np.pi), "Hz"))
-    for k in RE_MODES:
-        rows.append(TargetRow(f"Re λ{k} at s0=0.005", TABLE1_RE[k - 1],
-                              e.matched[k - 1].real, "1/s"))
-    rows.append(TargetRow("Im λ58 [ID1 driving shaft twisting]", DRIVING_SHAFT_HZ,
-                          e.driving_shaft.imag / (2 * np.pi), "Hz"))
-    rows += operating_rows(parameters)
-    for k in UNSTABLE_RE_MODES:
-        rows.append(TargetRow(f"Re of pair {k} at s0=0.014 (Im {e.unstable[k - 1].imag / (2 * np.pi):.3f} Hz)",
-                              TABLE1_UNSTABLE[k - 1][0], e.unstable[k - 1].real, "1/s"))
-    for i, target in enumerate(DIVERGENCE_RATES):
-        rows.append(TargetRow(f"real eigenvalue {i + 1} at s0=0.014", target,
-                              float(e.unstable_real[i]), "1/s"))
-    return rows
-
-
-def format_table(rows: list[TargetRow], limit: float | None = None) -> str:
-    lines = [f"{'target':58} {'published':>11} {'achieved':>11} {'error':>8}"]
-    for row in rows:
-        lines.append(f"{row.name[:58]:58} {row.target:>11.5g} {row.achieved:>11.5g} "
-                     f"{100 * row.error:>7.2f}%")
-    if limit is not None:
-        lines.append(f"{'stability limit s0* at 120 km/h (root finding)':58} "
-                     f"{STABILITY_LIMIT:>11.5g} {limit:>11.5g} "
-                     f"{100 * (limit - STABILITY_LIMIT) / STABILITY_LIMIT:>7.2f}%")
-    return "\n".join(lines)
-
-
 def run(start_file=ESTIMATE_FILE, out_file=CALIBRATED_FILE, phases: tuple = PHASES,
         progress: Callable = print) -> tuple[list[TargetRow], str]:
     """The ``bogie calibrate`` command: fit (with one BLAS thread, for a reproducible path) and
@@ -873,19 +537,3 @@ def run(start_file=ESTIMATE_FILE, out_file=CALIBRATED_FILE, phases: tuple = PHAS
     save_parameters(calibrated, out_file, header)
     progress(f"wrote {out_file}")
     return rows, table
-
-
-def parameter_rows(parameters: Parameters) -> list[dict]:
-    """One dict per parameter (schema order): name, value [SI], unit, note, and for the parameters
-    the calibration fits its bounds ``lower``, ``upper`` [SI] and ``on_bound`` (None otherwise):
-    what ``bogie parameters`` and the dashboard's Variant tab show."""
-    free = {f.name: f for f in FREE_PARAMETERS}
-    rows = []
-    for name, (unit, _, _) in SCHEMA.items():
-        value = float(parameters[name])
-        f = free.get(name)
-        rows.append({"name": name, "value": value, "unit": unit,
-                     "note": parameters.notes.get(name, ""),
-                     "lower": None if f is None else f.low, "upper": None if f is None else f.high,
-                     "on_bound": None if f is None else on_bound(f, value)})
-    return rows

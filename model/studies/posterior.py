@@ -9,8 +9,8 @@ keeps what the published numbers say, at the cost of one Jacobian (no re-calibra
 * coordinates: θ = ln p of the d uncertain parameters (all positive scale parameters);
 * prior: Gaussian in θ, centred at the calibrated set's value, standard deviation
   ``(ln high − ln low) / 4`` (the documented range taken as ±2σ, ≈ 95 %);
-* data: the calibration's targets (:func:`model.studies.calibration.frequency_rows` and
-  :func:`model.studies.calibration.operating_rows`) as whitened log residuals
+* data: the calibration's targets (:func:`model.studies.calibration_targets.frequency_rows` and
+  :func:`model.studies.calibration_targets.operating_rows`) as whitened log residuals
   ``r_i = ln(achieved_i / target_i) / σ_i`` with the tolerances the calibration states:
   σ = 0.03 for the eleven frequencies (its 3 % acceptance scale, ``LOSS_SCALE``); for the
   operating data, which it fits exactly, the rounding of the published numbers (half a unit of
@@ -116,7 +116,7 @@ class LinearizedPosterior:
 def calibration_residuals(parameters: Parameters) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
     """(target names, whitened log residuals, relative tolerances) of the calibration's targets
     (the eleven matched frequencies, then the four operating data) for a parameter set."""
-    from model.studies.calibration import frequency_rows
+    from model.studies.calibration_targets import frequency_rows
 
     names, r, sigmas = _operating(parameters)
     rows = frequency_rows(parameters)
@@ -127,7 +127,7 @@ def calibration_residuals(parameters: Parameters) -> tuple[tuple[str, ...], np.n
 
 
 def _operating(parameters: Parameters) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
-    from model.studies.calibration import operating_rows
+    from model.studies.calibration_targets import operating_rows
 
     rows = operating_rows(parameters)
     for row in rows:
@@ -145,7 +145,7 @@ def frequency_jacobian(parameters: Parameters, names: tuple[str, ...]):
     from model.analysis.sensitivity import eigen_sensitivities
     from model.mechanics.assembly import build_model
     from model.mechanics.operating_point import OperatingPoint
-    from model.studies.calibration import (
+    from model.studies.calibration_targets import (
         DRIVING_SHAFT_HZ,
         MODE_SIGNATURES,
         S0_STABLE,

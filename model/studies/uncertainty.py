@@ -18,7 +18,7 @@ distributions only (Sobol indices assume independent inputs).
 Outputs per model run (:func:`output_names`; :data:`OUTPUT_NAMES` for the default speeds):
 s0* at the study's speeds (default 120 and 200 km/h; more speeds give the s0*(v) band); the
 imaginary part [Hz] and damping ratio of the ten Table-1 modes (matched by character at s0 = 0.005, 120 km/h,
-:func:`model.studies.calibration.match_table1_modes`, so that modes do not swap between samples); the peak
+:func:`model.studies.calibration_targets.match_table1_modes`, so that modes do not swap between samples); the peak
 totals of ID1's and ID2's disc-clutch and driving-shaft torques after the short circuit (default
 excitation, 0.5 s at 5 kHz: the oscillating part has died out after 0.2 s).
 
@@ -130,7 +130,7 @@ def sample_outputs(values: Mapping[str, float],
     from model.analysis.stability import NoStabilityLimit, max_real_part, stability_limit
     from model.mechanics.assembly import build_model
     from model.mechanics.operating_point import KMH, OperatingPoint, creep_law
-    from model.studies.calibration import match_table1_modes
+    from model.studies.calibration_targets import match_table1_modes
 
     parameters = Parameters(dict(values))
     model = build_model(parameters)

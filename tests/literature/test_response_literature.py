@@ -79,7 +79,7 @@ def test_id1_torques_are_dominated_by_90_hz_and_the_two_drive_modes(stable, mode
     assert abs(dc[0] - mode_hz["ID1.disc_clutch"]) <= 0.25, dc
 
 
-# documented miss of the set of issue 27 (docs/response.md): with the car body free to move
+# documented miss of the calibrated set (docs/response.md): with the car body free to move
 # longitudinally the half vehicle (28 t + the bogie) decelerates once ID1's traction is gone, and
 # ID2's healthy motor takes up load along its slope b_M over the whole record: ID2's peak |Δy|
 # is at the end of the 2 s (ID1/ID2 = 2.6 on every quantity; 13.6 within the first 0.4 s, the

@@ -4,7 +4,7 @@
 Table 1 is compared **by rank**, as the study lists it ("the first ten pairs of complex conjugate
 eigenvalues sequenced according to magnitude of imaginary parts"): the model's k-th complex pair
 by imaginary part against the published k-th, and it must have Table 2's k-th character
-(``calibration.MODE_SIGNATURES``, optimal one-to-one assignment over the lowest pairs).
+(``calibration_targets.MODE_SIGNATURES``, optimal one-to-one assignment over the lowest pairs).
 
 Tolerances (the issue's acceptance limits, justified):
 
@@ -32,13 +32,14 @@ import numpy as np
 import pytest
 
 from model import OperatingPoint, build_model, eigen_analysis, load_parameters, mode_character
+from model.analysis.modes import wheelset_yaw_fraction
 from model.analysis.stability import stability_limit
 from model.mechanics.operating_point import adhesion_moment, motor_torque
-from model.studies.calibration import (
+from model.studies.calibration_bounds import FREE_PARAMETERS, constraint_values, on_bound
+from model.studies.calibration_targets import (
     ADHESION_MOMENT,
     DIVERGENCE_RATES,
     DRIVING_SHAFT_HZ,
-    FREE_PARAMETERS,
     MOTOR_TORQUE,
     RE_MODES,
     STABILITY_LIMIT,
@@ -46,11 +47,8 @@ from model.studies.calibration import (
     TABLE1_RE,
     TABLE1_UNSTABLE,
     V_REF,
-    constraint_values,
     driving_shaft_mode,
     match_table1_modes,
-    on_bound,
-    wheelset_yaw_fraction,
 )
 
 IM_TOLERANCE = 0.05  # [-] relative, by rank
@@ -174,9 +172,9 @@ def test_wheelset_modes_told_apart_by_journal_phase(calibrated):
 
 def test_calibrated_inertias_are_physical(calibrated):
     """A rigid body's principal inertias obey |I_x − I_y| <= I_z <= I_x + I_y
-    (calibration.constraint_values); the frame's roll inertia cannot exceed all its mass at the
-    frame's outer edges (m · 1.1² m²), its pitch inertia all its mass at the ends (m · 1.75² m²);
-    Polach's kS <= kA."""
+    (calibration_bounds.constraint_values); the frame's roll inertia cannot exceed all its mass
+    at the frame's outer edges (m · 1.1² m²), its pitch inertia all its mass at the ends
+    (m · 1.75² m²); Polach's kS <= kA."""
     parameters = calibrated[0]
     assert np.all(constraint_values(parameters) <= 1e-12)
     assert parameters["frame_inertia_x"] <= parameters["frame_mass"] * 1.1**2
@@ -186,9 +184,9 @@ def test_calibrated_inertias_are_physical(calibrated):
 
 def test_calibrated_values_inside_their_bounds_at_most_two_on_one(calibrated):
     """Every calibrated parameter within the range its source allows (its calibration bounds,
-    calibration.FREE_PARAMETERS, each with its reason), and at most two on a bound (within
-    0.1 %, calibration.on_bound): the issue's target; a set that fits by bending its data sits
-    on many."""
+    calibration_bounds.FREE_PARAMETERS, each with its reason), and at most two on a bound (within
+    0.1 %, calibration_bounds.on_bound): the acceptance limit; a set that fits by bending its data
+    sits on many."""
     parameters = calibrated[0]
     for f in FREE_PARAMETERS:
         assert f.low - 1e-12 * abs(f.low) <= parameters[f.name] <= f.high + 1e-12 * abs(f.high)

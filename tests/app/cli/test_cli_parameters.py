@@ -1,4 +1,4 @@
-"""``bogie parameters`` (issue 27): the set as a table with the calibration's bounds."""
+"""``bogie parameters``: the set as a table with the calibration's bounds."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 
 from app.cli.main import main
 from model.mechanics.parameters import ESTIMATE_FILE, SCHEMA, load_parameters
-from model.studies.calibration import FREE_PARAMETERS, FreeParameter, on_bound
+from model.studies.calibration_bounds import FREE_PARAMETERS, FreeParameter, on_bound
 
 
 def run(argv: list[str], capsys) -> tuple[int, str, str]:

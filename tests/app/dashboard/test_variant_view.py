@@ -1,5 +1,5 @@
 """The Variant tab shows the calibration's bounds of the baseline's fitted parameters, the same
-rows as ``bogie parameters --json`` (model.studies.calibration.parameter_rows)."""
+rows as ``bogie parameters --json`` (model.studies.calibration_bounds.parameter_rows)."""
 
 from __future__ import annotations
 

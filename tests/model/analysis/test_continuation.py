@@ -29,7 +29,7 @@ from model.analysis.continuation import (
 )
 from model.analysis.eigen import state_matrix
 from model.mechanics.operating_point import OperatingPoint
-from model.studies.maps import dense_line, s0_line, spectrum_summary
+from model.studies.s0_line import dense_line, s0_line, spectrum_summary
 
 EIG_RTOL = 8e-8
 GROWTH_ATOL = 1e-7

@@ -132,7 +132,7 @@ def test_concurrent_solves_with_the_cached_factors_are_exact():
     assert not wrong, f"{len(wrong)} wrong solutions, first {wrong[:3]}"
 
 
-# --- massless coordinates (Maxwell elements, issue 27) ------------------------------------------
+# --- massless coordinates (the Maxwell elements' internal coordinates) ---------------------------
 
 def _maxwell_sdof(m=3.0, k1=4.0e3, k2=9.0e3, c=150.0) -> LinearSystem:
     """A mass on a spring k1 to ground and a Maxwell element (damper c in series with a spring

@@ -43,8 +43,8 @@ def test_denser_sweep_reuses_the_start_and_gives_the_same_values(setup, monkeypa
 
     model, op, _, _ = setup
     solves = []
-    solve = locus_module._Reduced.solve
-    monkeypatch.setattr(locus_module._Reduced, "solve",
+    solve = locus_module.Reduced.solve
+    monkeypatch.setattr(locus_module.Reduced, "solve",
                         lambda self, c: solves.append(1) or solve(self, c))
     coarse_s0 = np.linspace(0.002, 0.016, 8)
     dense_s0 = np.concatenate([np.linspace(a, b, 4)[:-1] for a, b in pairwise(coarse_s0)]

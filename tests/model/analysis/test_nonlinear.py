@@ -1,18 +1,19 @@
-"""Nonlinear longitudinal creep (spec §6, issue 10): the maps G and H, Polach's law beyond its
+"""Nonlinear longitudinal creep (spec §6): the maps G and H, Polach's law beyond its
 usual range, and the stepping against the exact closed form, the energy balance and itself.
 
 Tolerances, and why:
 
 * identity ``B == B_nl − G diag(N0 μ'/v) H``: 1e-12 of max|B| (the same sums in another order);
-* tangent law ≡ closed form: 1e-6 of each output's perturbation peak (issue 10); the linear part
-  is stepped exactly, so only rounding separates them (measured 9e-8 stable, 3e-10 unstable);
-* tiny excitation (M_C × 1e-4): 1e-3 (issue 10).  The deviation is the creep law's curvature and
-  scales with the amplitude (measured 9.0e-4 at 1e-4, 9.0e-5 at 1e-5, s0 = 0.005, 2 s); in the
-  unstable case the growth amplifies it, so that case is checked over 0.1 s;
+* tangent law ≡ closed form: 1e-6 of each output's perturbation peak (the accuracy asked); the
+  linear part is stepped exactly, so only rounding separates them (measured 9e-8 stable, 3e-10
+  unstable);
+* tiny excitation (M_C × 1e-4): 1e-3 (the accuracy asked).  The deviation is the creep law's
+  curvature and scales with the amplitude (measured 9.0e-4 at 1e-4, 9.0e-5 at 1e-5, s0 = 0.005,
+  2 s); in the unstable case the growth amplifies it, so that case is checked over 0.1 s;
 * energy balance: the work of the creep forces against ΔE + dissipation − input work, both
   integrated by the trapezoidal rule from samples at 40 kHz: 1e-4 of the creep work's largest
   magnitude (measured 3.5e-6 and 1.4e-6; the quadrature error is O(h²));
-* step halving: 1e-4 of each output's perturbation peak (issue 10's accuracy target).
+* step halving: 1e-4 of each output's perturbation peak (the accuracy asked of the stepping).
 """
 
 from __future__ import annotations

@@ -71,7 +71,7 @@ def _eigenvalues(parameters, model, op, name, value):
 # between neighbouring steps); they are checked at WEAK_TOLERANCE, and their derivative matrices
 # are covered exactly by the Euler checks below.
 # a parameter whose |p|·max|dλ/dp| is below WEAK·min|λ| hardly moves the ten modes: the
-# differences cannot resolve 1e-5 for it (on the set of issue 27 the driving shaft at s0 = 0.008,
+# differences cannot resolve 1e-5 for it (on the calibrated set the driving shaft at s0 = 0.008,
 # influence 1.5e-3: best error 1.1e-5 over the steps, no convergence — rounding)
 WEAK, WEAK_TOLERANCE = 2e-3, 1e-3
 
@@ -85,8 +85,8 @@ def test_against_finite_differences(setup, s0):
     op = _op(parameters, s0)
     sens = eigen_sensitivities(model, op)
     assert sens.reliable.all()
-    # a pair next to an exceptional point (two real eigenvalues about to meet: on the set of
-    # issue 27 the vehicle's longitudinal motion against ID2's disc clutch at s0 = 0.014,
+    # a pair next to an exceptional point (two real eigenvalues about to meet: on the calibrated
+    # set the vehicle's longitudinal motion against ID2's disc clutch at s0 = 0.014,
     # +1.99 ± 0.0056i 1/s, condition 5e10) moves as the square root of a perturbation: the
     # fourth-order differences below are not in their asymptotic range there (2e-4), the
     # analytic derivative is; such a mode is left out of the comparison, at most one

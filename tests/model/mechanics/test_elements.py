@@ -297,7 +297,7 @@ def test_rigid_mass_matrix():
     assert np.count_nonzero(M - np.diag(np.diag(M))) == 0
 
 
-# --- the Maxwell element (yaw damper with end bushes, issue 27) ----------------------------------
+# --- the Maxwell element (a yaw damper in series with its end bushes) ----------------------------
 
 def _maxwell(k=8.0e6, c=4.0e5, c_s=1.6e3):
     names = [f"{body}.{a}" for body in ("A", "B") for a in AXES6] + ["D.stroke"]

@@ -10,9 +10,6 @@ import pytest
 from model import load_parameters
 from model.mechanics.parameters import ESTIMATE_FILE
 from model.studies.calibration import (
-    CREEP_SHAPE_PARAMETERS,
-    FREE_PARAMETERS,
-    SEARCH_PARAMETERS,
     Weights,
     _bounds,
     _evaluate_j,
@@ -20,13 +17,11 @@ from model.studies.calibration import (
     _jacobian_j,
     _to_x,
     calibrate,
-    constraint_values,
-    evaluate_by_rank,
     fit_operating_data,
-    operating_rows,
     real_part_residual,
-    with_constraints,
 )
+from model.studies.calibration_bounds import CREEP_SHAPE_PARAMETERS, SEARCH_PARAMETERS, with_constraints
+from model.studies.calibration_targets import operating_rows
 
 
 def test_stage_a_meets_the_operating_data_for_another_creep_shape():
@@ -40,53 +35,11 @@ def test_stage_a_meets_the_operating_data_for_another_creep_shape():
     assert (fitted["polach_kA"], fitted["polach_kS"]) == (0.7, 0.3)  # the shape is kept
 
 
-def test_constraints_keep_inertias_and_polach_factors_consistent():
-    """A rigid body's principal inertias obey |I_x − I_y| <= I_z <= I_x + I_y; Polach's
-    kS <= kA.  constraint_values is <= 0 exactly when they hold; with_constraints restores
-    them."""
-    p = load_parameters(ESTIMATE_FILE).replace(frame_inertia_x=1000.0, frame_inertia_y=2000.0,
-                                               frame_inertia_z=5000.0, polach_kA=0.35,
-                                               polach_kS=0.4)
-    assert np.count_nonzero(constraint_values(p) > 0) == 2
-    fixed = with_constraints(p)
-    assert fixed["frame_inertia_z"] == 3000.0
-    assert fixed["polach_kS"] == 0.35
-    assert np.all(constraint_values(fixed) <= 0)
-    too_small = with_constraints(p.replace(frame_inertia_z=500.0))
-    assert too_small["frame_inertia_z"] == 1000.0  # I_y − I_x
-    untouched = load_parameters(ESTIMATE_FILE)
-    assert with_constraints(untouched) is untouched
-    assert np.all(constraint_values(untouched) <= 0)
-
-
-def test_every_free_parameter_has_bounds_around_its_estimate():
-    """The estimate lies inside its calibration bounds (the search starts there), each bound
-    with its reason."""
-    estimate = load_parameters(ESTIMATE_FILE)
-    for f in FREE_PARAMETERS:
-        assert f.low < f.high
-        assert f.reason
-        assert f.low <= estimate[f.name] <= f.high, f.name
-        if f.log:
-            assert f.low > 0, f.name
-
-
 def test_real_part_residual_is_one_at_the_acceptance():
     assert real_part_residual(-3.958 * 1.3, -3.958) == pytest.approx(1.0)
     assert real_part_residual(-3.958 / 1.3, -3.958) == pytest.approx(-1.0)
     assert real_part_residual(-0.032 - 0.05, -0.032) == pytest.approx(-1.0)  # |Re| < 0.2: 0.05
     assert abs(real_part_residual(+0.5, -3.958)) > 3  # wrong sign: linear, large
-
-
-def test_evaluation_by_rank_of_the_calibrated_set():
-    """The k-th entry is the k-th pair by Im; the character flags agree with the matching."""
-    e = evaluate_by_rank(load_parameters())
-    assert np.all(np.diff(e.stable.imag) >= 0)
-    assert e.unstable is not None
-    assert len(e.unstable) == 10
-    assert np.all(np.diff(e.unstable_real) <= 0)
-    assert e.max_real_stable < 0
-    assert e.max_real_below_limit < 0
 
 
 # the parameters of the finite-difference check: a creep-shape parameter (its stage-A

@@ -84,7 +84,7 @@ def test_frequency_rows_against_central_differences(posterior, name):
     from model.analysis.eigen import eigen_analysis
     from model.mechanics.assembly import build_model
     from model.mechanics.operating_point import OperatingPoint
-    from model.studies.calibration import S0_STABLE, V_REF, match_table1_modes
+    from model.studies.calibration_targets import S0_STABLE, V_REF, match_table1_modes
 
     parameters = load_parameters()
 
