@@ -28,6 +28,7 @@ starts (it depends on the detection time) and the next block starts there.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import get_lapack_funcs
@@ -94,37 +95,74 @@ class _Blocks:
 
 def step_matrices(W, E, P0, P1, D1, V, n_creep) -> _Blocks:
     """The matrices of a run's step loop (Q = diag(E) P1 + P0; V: outputs x m, y = Re(V ζ);
-    the first ``n_creep`` of the channels are creep channels), built once per run and passed to
-    every :func:`march` call of it (one per output block of 2 048 steps)."""
+    the first ``n_creep`` of the channels are creep channels), built once per run and passed, in
+    the run's :class:`StepInputs`, to every :func:`march` call of it (one per output block of
+    2 048 steps)."""
     return _Blocks(W, E, E[:, None] * P1 + P0, D1, P1, V, np.arange(W.shape[0]) < n_creep)
 
 
-def march(k0, k1, h, zeta, phi, z, u2_now, E, inc_step, cp, cm, g_step, g0, P0, p0_2, p1_2,
-          contact_scale, law_params, s0, v, N0, mu_s0, dmu_s0, tangent,
-          detect_rows, threshold, det_state, M_step, delay, rate, floor, Y_out, z_out,
-          phi_out, u2_out, iterations, blocks):
+@dataclass(frozen=True)
+class StepInputs:
+    """What stays fixed over one run's step loop: built once per run by
+    :func:`model.analysis.nonlinear.nonlinear_response` and passed to each of its :func:`march`
+    calls (modal quantities per kept mode; "channels": the four contacts, then ID2's slope
+    torque)."""
+
+    h: float  # step [s]
+    E: np.ndarray  # m: e^(λh) per kept mode
+    inc_step: np.ndarray  # m: exact modal increment per step of M_C's step part
+    cp: np.ndarray  # m: modal weights of M_C's damped oscillation e^(μt) over a step
+    cm: np.ndarray  # m: the same for its conjugate e^(μ̄t)
+    g_step: complex  # e^(μh): the oscillation's factor per step
+    g0: complex  # the oscillation's factor at step 0
+    P0: np.ndarray  # m x channels: first-order-hold weights (start of the step) of the channels
+    p0_2: np.ndarray  # m: the same for ΔM_2 (ID2's motor torque) at the start of the step
+    p1_2: np.ndarray  # m: … at the end of the step
+    contact_scale: float  # velocity added to |z| in Newton's relative change [m/s]
+    law_params: np.ndarray  # Polach's law: (mu0, A, B, kA, kS, slope) of ``creep_law``
+    s0: float  # steady creepage [-]
+    v: float  # speed [m/s]
+    N0: float  # wheel force [N]
+    mu_s0: float  # μ(s0, v) [-]
+    dmu_s0: float  # ∂μ/∂s at s0 [-]
+    tangent: bool  # μ replaced by its tangent at s0
+    detect_rows: np.ndarray  # channels: weights of ID2's wheelset slip velocity (detection)
+    threshold: float  # |Δ slip velocity| that trips the protection [m/s] (inf: none)
+    M_step: float  # M(s0, v) before the fault [N m]
+    delay: float  # reaction delay after detection [s]
+    rate: float  # torque reduction rate [1/s]
+    floor: float  # torque kept after the reduction [fraction of M(s0, v)]
+    blocks: _Blocks  # the run's :func:`step_matrices`
+
+
+def march(k0, k1, inputs: StepInputs, zeta, phi, z, u2_now, det_state, Y_out, z_out, phi_out,
+          u2_out, iterations):
     """Steps k0 → k1 (exclusive of k0's state, which is given).  Writes the outputs Re(V ζ)
-    (``blocks``' V), contact velocities, remainder forces and ΔM_2 of steps k0+1 … k1 into rows
-    0 … of ``Y_out``, ``z_out``, ``phi_out``, ``u2_out``; updates zeta, phi, z, u2_now, det_state
-    in place; ``blocks``: the run's :func:`step_matrices`.  Returns 0, or the step at which Newton
-    failed (negative)."""
+    (``inputs.blocks``' V), contact velocities, remainder forces and ΔM_2 of steps k0+1 … k1 into
+    rows 0 … of ``Y_out``, ``z_out``, ``phi_out``, ``u2_out``; updates zeta, phi, z, det_state and
+    ``iterations`` in place (``u2_now``: ΔM_2 at step k0 [N m]).  Returns 0, or the step at which
+    Newton failed (negative)."""
+    i = inputs
+    blocks = i.blocks
     nc = z.shape[0]
-    law = tuple(float(x) for x in law_params)
+    law = tuple(float(x) for x in i.law_params)
     creep = blocks.creep
-    detect = np.asarray(detect_rows, dtype=float)
-    scale = float(contact_scale)
+    detect = np.asarray(i.detect_rows, dtype=float)
+    scale = float(i.contact_scale)
     slope = np.zeros(nc)  # r'(z) of the given step (Newton's start of the first block)
-    if not tangent:
-        slope[creep] = N0 / v * (polach_mu_and_slope(s0 + z[creep] / v, v, *law)[1] - dmu_s0)
+    if not i.tangent:
+        slope[creep] = i.N0 / i.v * (polach_mu_and_slope(i.s0 + z[creep] / i.v, i.v, *law)[1]
+                                     - i.dmu_s0)
     state = _LoopState(zeta.copy(), phi.copy(), z.copy(), float(u2_now), float(det_state[0]),
                        slope)
-    basis = np.vstack([cp, cm, p0_2, p1_2]).astype(complex)  # 4 x m
+    basis = np.vstack([i.cp, i.cm, i.p0_2, i.p1_2]).astype(complex)  # 4 x m
     row, L = 0, SUB_STEPS
     while row < k1 - k0:
         L = min(L, k1 - k0 - row)
-        done = _block(state, k0 + row, L, row, h, blocks, E, inc_step, basis, g_step, g0, P0,
-                      law, s0, v, N0, mu_s0, dmu_s0, tangent, creep, detect, threshold, M_step,
-                      delay, rate, floor, scale, Y_out, z_out, phi_out, u2_out, iterations)
+        done = _block(state, k0 + row, L, row, i.h, blocks, i.E, i.inc_step, basis, i.g_step,
+                      i.g0, i.P0, law, i.s0, i.v, i.N0, i.mu_s0, i.dmu_s0, i.tangent, creep,
+                      detect, i.threshold, i.M_step, i.delay, i.rate, i.floor, scale, Y_out,
+                      z_out, phi_out, u2_out, iterations)
         if done == 0:
             if L == 1:
                 return -(k0 + row + 1)

@@ -255,6 +255,21 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     (default 2, the cores of the target machine).  A real eigenvalue inside the disc that meets a
     real one outside it continues as one half of the new complex pair (the other half is not
     tracked); pairs that start complex stay conjugate pairs."""
+    values, points, coefficients = _sweep_points(model, op, parameter, values)
+    radius = 2 * np.pi * max_frequency_hz
+    key = _sweep_start_key(model, points[0], points[-1], radius)
+    start = _sweep_start(model, op, points, radius, workers, key)
+    inner = _InnerSolutions(start, coefficients[1:-1], workers)
+    tracks = _track(model, points, coefficients, start, inner, radius, rtol)
+    _keep_sweep_start(key, model, start, inner)
+    return RootLocus(parameter, values, tracks.eigenvalues, tracks.errors, tracks.dense, op,
+                     start.reduced.size, tracks.refined)
+
+
+def _sweep_points(model: BogieModel, op: OperatingPoint, parameter: str,
+                  values) -> tuple[np.ndarray, list[OperatingPoint], np.ndarray]:
+    """The sweep checked (ValueError otherwise): (values [SI], the operating points, their creep
+    pattern coefficients b11, b22, b23, b33, points x 4)."""
     if parameter not in ("s0", "v"):
         raise ValueError(f"parameter must be 's0' or 'v', got '{parameter}'")
     values = np.asarray(values, dtype=float)
@@ -262,59 +277,91 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
         raise ValueError("need at least two finite parameter values")
     points = [replace(op, **{parameter: float(x)}) for x in values]  # validates each point
     coefficients = np.array([pattern_coefficients(model, p) for p in points])
-    patterns = creep_patterns(model)
-    radius = 2 * np.pi * max_frequency_hz
-    controlled = 1.5 * radius  # accuracy is enforced for branches inside this disc
-    n, n_points = model.n, len(values)
+    return values, points, coefficients
 
-    def exact(i: int):
-        result = eigen_analysis(model, points[i])
-        q = result.vectors[:n]
-        return result.eigenvalues, q / np.linalg.norm(q, axis=0)
 
-    def modes(lam, Q):
-        chosen = Q[:, np.abs(lam) < radius]
-        return [chosen.real, chosen.imag]
+def _exact(model: BogieModel, point: OperatingPoint) -> tuple[np.ndarray, np.ndarray]:
+    """All eigenvalues [1/s] at ``point`` (dense) and their displacement vectors, unit norm."""
+    result = eigen_analysis(model, point)
+    q = result.vectors[:model.n]
+    return result.eigenvalues, q / np.linalg.norm(q, axis=0)
 
-    key = _sweep_start_key(model, points[0], points[-1], radius)
+
+def _modes(lam: np.ndarray, Q: np.ndarray, radius: float) -> list[np.ndarray]:
+    """Real and imaginary parts of the vectors Q of the eigenvalues with |λ| < ``radius`` [1/s]."""
+    chosen = Q[:, np.abs(lam) < radius]
+    return [chosen.real, chosen.imag]
+
+
+def _sweep_start(model: BogieModel, op: OperatingPoint, points: list[OperatingPoint],
+                 radius: float, workers: int, key: tuple) -> _SweepStart:
+    """The kept start of a sweep over this range, or a new one: the exact end points and the
+    reduced model on their modes with |λ| < ``radius`` [1/s] (and the rigid-body modes)."""
     with _SWEEP_STARTS_LOCK:
         start = _SWEEP_STARTS.get(key)
         if start is not None and start.model is model:
             _SWEEP_STARTS.move_to_end(key)
         else:
             start = None
-    if start is None:
-        # the two exact end points at once (they decide the basis; numpy releases the GIL)
-        if workers > 1:
-            last_future = _solver_pool(workers).submit(exact, n_points - 1)
-            first = exact(0)
-            last = last_future.result()
-        else:
-            first, last = exact(0), exact(n_points - 1)
-        reduced = Reduced(model, op, patterns,
-                          [model.rigid_body_modes, *modes(*first), *modes(*last)])
-        start = _SweepStart(model, first, last, reduced, {})
-    first, last, reduced = start.first, start.last, start.reduced
-    # the reduced eigenproblems of the inner points do not depend on each other: they are solved
-    # on ``workers`` threads (numpy's LAPACK calls release the GIL) while this thread tracks and
-    # checks the points in order as their solutions come in (tracking after all the solves left
-    # a core idle for ≈ 0.8 s of a 200-point sweep); a point the kept start has solved already
-    # is not solved again
-    inner = coefficients[1:-1]
-    keys = [c.tobytes() for c in inner]
-    missing = [i for i, k in enumerate(keys) if k not in start.solutions]
+    if start is not None:
+        return start
+    # the two exact end points at once (they decide the basis; numpy releases the GIL)
     if workers > 1:
-        found = _solver_pool(workers).map(reduced.solve, inner[missing])  # in order, as solved
+        last_future = _solver_pool(workers).submit(_exact, model, points[-1])
+        first = _exact(model, points[0])
+        last = last_future.result()
     else:
-        found = (reduced.solve(c) for c in inner[missing])
-    unsolved = set(missing)
-    solutions: list[tuple[np.ndarray, np.ndarray]] = []
+        first, last = _exact(model, points[0]), _exact(model, points[-1])
+    reduced = Reduced(model, op, creep_patterns(model),
+                      [model.rigid_body_modes, *_modes(*first, radius), *_modes(*last, radius)])
+    return _SweepStart(model, first, last, reduced, {})
 
-    def solution(i: int) -> tuple[np.ndarray, np.ndarray]:
-        """The reduced solution of inner point i (asked for in order)."""
-        solutions.append(next(found) if i in unsolved else start.solutions[keys[i]])
-        return solutions[i]
 
+class _InnerSolutions:
+    """The reduced solutions of a sweep's inner points, asked for in order.
+
+    They do not depend on each other: they are solved on ``workers`` threads (numpy's LAPACK calls
+    release the GIL) while the caller tracks and checks the points in order as their solutions
+    come in (tracking after all the solves left a core idle for ≈ 0.8 s of a 200-point sweep); a
+    point the kept start has solved already is not solved again."""
+
+    def __init__(self, start: _SweepStart, inner: np.ndarray, workers: int):
+        self.start = start
+        self.keys = [c.tobytes() for c in inner]  # the inner points' creep coefficients
+        missing = [i for i, k in enumerate(self.keys) if k not in start.solutions]
+        reduced = start.reduced
+        if workers > 1:
+            self._found = _solver_pool(workers).map(reduced.solve, inner[missing])  # in order
+        else:
+            self._found = (reduced.solve(c) for c in inner[missing])
+        self._unsolved = set(missing)
+        self.solutions: list[tuple[np.ndarray, np.ndarray]] = []  # those handed out, in order
+
+    def __call__(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """The reduced solution (Ritz values [1/s], Φ-coordinate vectors) of inner point i."""
+        self.solutions.append(next(self._found) if i in self._unsolved
+                              else self.start.solutions[self.keys[i]])
+        return self.solutions[i]
+
+
+@dataclass
+class _Tracks:
+    """The tracked branches along the sweep (the arrays of :class:`RootLocus`)."""
+
+    eigenvalues: np.ndarray  # (n_points, n_branches) complex [1/s]
+    errors: np.ndarray  # (n_points, n_branches) estimated relative error (0: exact)
+    dense: np.ndarray  # (n_points,) bool: solved densely
+    refined: int  # branch-points refined by Newton's method on the full model
+
+
+def _track(model: BogieModel, points: list[OperatingPoint], coefficients: np.ndarray,
+           start: _SweepStart, solution: _InnerSolutions, radius: float, rtol: float) -> _Tracks:
+    """Continue the branches with |λ| < ``radius`` [1/s] at the first point from point to point:
+    the reduced solution where it is accurate to ``rtol`` (after Newton on a few branches), the
+    dense one otherwise and at the last point."""
+    first, last, reduced = start.first, start.last, start.reduced
+    controlled = 1.5 * radius  # accuracy is enforced for branches inside this disc
+    n_points = len(points)
     tracked = np.flatnonzero(np.abs(first[0]) < radius)
     eigenvalues = np.zeros((n_points, len(tracked)), dtype=complex)
     errors = np.zeros((n_points, len(tracked)))
@@ -322,38 +369,60 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     eigenvalues[0], dense[0] = first[0][tracked], True
     previous_values, previous_vectors = first[0][tracked], first[1][:, tracked]
     refined = 0
-
     for i in range(1, n_points):
         if i != n_points - 1:
-            lam, X = solution(i - 1)
-            X_full = reduced.Phi @ X
-            chosen, ok = _assign(previous_vectors, previous_values, X_full, lam)
-            estimate = reduced.error_estimate(coefficients[i], lam[chosen], X[:, chosen])
-            values_i, vectors_i = lam[chosen], X_full[:, chosen]
-            failing = np.flatnonzero((estimate > rtol) & (np.abs(values_i) < controlled))
-            if ok and len(failing) <= max(2, len(chosen) // 4):
-                # refine the few inaccurate branches by Newton's method in the full model
-                C = damping_matrix(model, points[i]) if len(failing) else None
-                for b in failing:
-                    values_i[b], vectors_i[:, b], estimate[b] = newton(
-                        model.M, C, model.K, values_i[b], vectors_i[:, b], rtol)
-                if np.all((estimate <= rtol) | (np.abs(values_i) >= controlled)):
-                    refined += len(failing)
-                    eigenvalues[i], errors[i] = values_i, estimate
-                    previous_values, previous_vectors = values_i, vectors_i
-                    continue
-        lam, Q = last if i == n_points - 1 else exact(i)  # dense: exact at this point
+            point = _reduced_point(model, points[i], coefficients[i], reduced, solution(i - 1),
+                                   previous_values, previous_vectors, rtol, controlled)
+            if point is not None:
+                values_i, vectors_i, estimate, newton_branches = point
+                refined += newton_branches
+                eigenvalues[i], errors[i] = values_i, estimate
+                previous_values, previous_vectors = values_i, vectors_i
+                continue
+        lam, Q = last if i == n_points - 1 else _exact(model, points[i])  # dense: exact here
         chosen, _ = _assign(previous_vectors, previous_values, Q, lam)
         eigenvalues[i], dense[i] = lam[chosen], True
         previous_values, previous_vectors = lam[chosen], Q[:, chosen]
+    return _Tracks(eigenvalues, errors, dense, refined)
+
+
+def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, reduced: Reduced,
+                   solved: tuple[np.ndarray, np.ndarray], previous_values: np.ndarray,
+                   previous_vectors: np.ndarray, rtol: float, controlled: float):
+    """The branches at an inner point from its reduced solution ``solved`` (creep coefficients c),
+    assigned to the previous point's: (eigenvalues [1/s], full displacement vectors, estimated
+    relative errors, branches refined by Newton), or None where the point must be solved densely
+    (ambiguous assignment, too many or unrefinable inaccurate branches inside |λ| < controlled)."""
+    lam, X = solved
+    X_full = reduced.Phi @ X
+    chosen, ok = _assign(previous_vectors, previous_values, X_full, lam)
+    estimate = reduced.error_estimate(c, lam[chosen], X[:, chosen])
+    values_i, vectors_i = lam[chosen], X_full[:, chosen]
+    failing = np.flatnonzero((estimate > rtol) & (np.abs(values_i) < controlled))
+    if not ok or len(failing) > max(2, len(chosen) // 4):
+        return None
+    # refine the few inaccurate branches by Newton's method in the full model
+    C = damping_matrix(model, point) if len(failing) else None
+    for b in failing:
+        values_i[b], vectors_i[:, b], estimate[b] = newton(
+            model.M, C, model.K, values_i[b], vectors_i[:, b], rtol)
+    if not np.all((estimate <= rtol) | (np.abs(values_i) >= controlled)):
+        return None
+    return values_i, vectors_i, estimate, len(failing)
+
+
+def _keep_sweep_start(key: tuple, model: BogieModel, start: _SweepStart,
+                      inner: _InnerSolutions) -> None:
+    """Keep the sweep's start for the next sweep over the range (with its reduced solutions if
+    it has at most ``_SOLUTIONS_KEPT`` inner points); at most ``_SWEEP_STARTS_KEPT`` are kept."""
     with _SWEEP_STARTS_LOCK:
-        if len(inner) <= _SOLUTIONS_KEPT:
-            start = _SweepStart(model, first, last, reduced, dict(zip(keys, solutions, strict=True)))
+        if len(inner.keys) <= _SOLUTIONS_KEPT:
+            start = _SweepStart(model, start.first, start.last, start.reduced,
+                                dict(zip(inner.keys, inner.solutions, strict=True)))
         _SWEEP_STARTS[key] = start
         _SWEEP_STARTS.move_to_end(key)
         while len(_SWEEP_STARTS) > _SWEEP_STARTS_KEPT:
             _SWEEP_STARTS.popitem(last=False)
-    return RootLocus(parameter, values, eigenvalues, errors, dense, op, reduced.size, refined)
 
 
 def newton(M, C, K, lam: complex, x: np.ndarray, rtol: float, iterations: int = 6,

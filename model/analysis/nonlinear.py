@@ -65,6 +65,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from model.analysis.block_stepper import StepInputs, march, step_matrices
 from model.analysis.eigen import bogie_system
 from model.analysis.load_peaks import LIMITED, LimitCrossing, history_peaks_and_crossings
 from model.analysis.response import (
@@ -73,6 +74,7 @@ from model.analysis.response import (
     ShortCircuit,
     time_grid_points,
 )
+from model.contact.creep import PolachLaw
 from model.mechanics.assembly import DRIVES, RIM_NODES, BogieModel
 from model.mechanics.operating_point import (
     OperatingPoint,
@@ -82,7 +84,8 @@ from model.mechanics.operating_point import (
     longitudinal_creep_pattern,
     motor_torque,
 )
-from model.mechanics.outputs import output_matrices
+from model.mechanics.outputs import OutputMatrices, output_matrices
+from model.mechanics.parameters import Parameters
 
 CREEP_MODELS = ("nonlinear", "tangent")
 BLOCK_STEPS = 2048  # steps per compiled block (modal states of a block: ≈ 6 MB)
@@ -162,17 +165,7 @@ class AntiSlip:
                 raise NonlinearError(f"{label} = {value} is not allowed: must be {allowed}")
 
 
-# --- step loop ---------------------------------------------------------------------------------------
-
-def _kernel():
-    """The step loop (:func:`model.analysis.block_stepper.march`) and the matrices it takes
-    (:func:`model.analysis.block_stepper.step_matrices`)."""
-    from model.analysis.block_stepper import march, step_matrices
-
-    return march, step_matrices
-
-
-
+# --- first-order-hold weights ------------------------------------------------------------------------
 
 def _phi12(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """φ1(x) = (eˣ − 1)/x and φ2(x) = (eˣ − 1 − x)/x² (complex x), with series near 0."""
@@ -248,6 +241,8 @@ class _Setup:
 
 
 def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
+    """The modal pieces of the stepping at step ``h`` [s] (:class:`_Setup`), built once per
+    (model, operating point, h) and kept in the cached system (:func:`bogie_system`)."""
     key = ("nonlinear_setup", h)
     system = bogie_system(model, op)
     cached = system._cache.get(key)
@@ -313,6 +308,36 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     small-amplitude limit; the result's ``M_C`` is the scaled torque).
     """
     excitation = ShortCircuit() if excitation is None else excitation
+    request = _check_inputs(model, op, t_end, fs, creep, anti_slip, outputs, strength, keep_states,
+                            substeps, excitation_scale)
+    run = _set_up_run(model, op, excitation, request)
+    histories = _step(run, request)
+    return _pack_result(model, op, excitation, request, run, histories)
+
+
+@dataclass(frozen=True)
+class _Request:
+    """The checked arguments of one :func:`nonlinear_response` call and the time grid."""
+
+    creep: str  # "nonlinear" or "tangent"
+    protection: AntiSlip | None  # the anti-slip protection, None if absent or disabled
+    strength: float | None  # design strength of the clutches [N m], if given
+    keep_states: bool  # also return the states at the samples
+    excitation_scale: float  # factor on M_C(t) [-]
+    names: list[str]  # the outputs asked for, in order
+    matrices: OutputMatrices  # the output map at the operating point
+    fs: float  # sampling rate of the outputs [Hz]
+    substeps: int  # integration steps per output sample
+    n_points: int  # output samples (t = 0 included)
+    n_steps: int  # integration steps
+    h: float  # integration step [s]
+
+
+def _check_inputs(model: BogieModel, op: OperatingPoint, t_end: float, fs: float, creep: str,
+                  anti_slip: AntiSlip | None, outputs: list[str] | None, strength: float | None,
+                  keep_states: bool, substeps: int, excitation_scale: float) -> _Request:
+    """The arguments of :func:`nonlinear_response` checked (:class:`NonlinearError` with a one-line
+    message otherwise) and the time grid: ``t_end`` [s], ``fs`` [Hz], ``strength`` [N m]."""
     if creep not in CREEP_MODELS:
         raise NonlinearError(f"creep model '{creep}' is not allowed: nonlinear or tangent")
     if anti_slip is not None and not isinstance(anti_slip, AntiSlip):
@@ -335,76 +360,136 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
         if name not in matrices.names:
             raise NonlinearError(f"unknown output '{name}': use an output name "
                                  f"({', '.join(matrices.names[:3])}, …)")
-    h = 1.0 / (fs * substeps)
-    setup = _setup(model, op, h)
-    p = model.parameters
-    law = creep_law(p, op.N0)
-    coefficients = creep_coefficients(p, op)
-    mu_s0, dmu_s0 = coefficients.mu, coefficients.dmu_ds
-    step = motor_torque(p, op)
-    u0, a, mu = excitation.terms(step)
     if isinstance(excitation_scale, bool) or not isinstance(excitation_scale, int | float) \
             or not math.isfinite(excitation_scale):
         raise NonlinearError(f"excitation_scale = {excitation_scale!r} must be a finite number")
-    u0, a = u0 * excitation_scale, a * excitation_scale
-    # exact per-step increments of the excitation (a step and a damped complex exponential)
+    protection = anti_slip if anti_slip is not None and anti_slip.enabled else None
+    return _Request(creep=creep, protection=protection, strength=strength, keep_states=keep_states,
+                    excitation_scale=excitation_scale, names=names, matrices=matrices, fs=fs,
+                    substeps=substeps, n_points=n_points, n_steps=n_steps,
+                    h=1.0 / (fs * substeps))
+
+
+@dataclass(frozen=True)
+class _Run:
+    """The set-up of one run: what the step loop takes and the post-processing needs."""
+
+    inputs: StepInputs  # everything fixed over the step loop (block_stepper.StepInputs)
+    law: PolachLaw  # the creep law at N0
+    rims: list[str]  # contact names, in the order of the creep channels
+    loads: list[str]  # the requested outputs formed in the loop (y = Re(V ζ)), in V's row order
+
+
+def _excitation_increments(setup: _Setup, excitation: ShortCircuit, step: float, scale: float,
+                           h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, complex]:
+    """Exact modal increments per step of M_C(t) (a step and a damped complex exponential, times
+    ``scale``): (M_C's step part [modal units per step], the exponential's and its conjugate's
+    weights, e^(μh)); ``step`` = M(s0, v) [N m], ``h`` [s]."""
+    u0, a, mu = excitation.terms(step)
+    u0, a = u0 * scale, a * scale
     lam = setup.lam
     phi1_step, _ = _phi12(lam * h)
     inc_step = setup.beta_mc * u0 * h * phi1_step
-    if excitation.M0 > 0 and excitation_scale != 0:
+    if excitation.M0 > 0 and scale != 0:
         phi_p, _ = _phi12((mu - lam) * h)
         phi_m, _ = _phi12((np.conj(mu) - lam) * h)
         cp = setup.beta_mc * 0.5 * a * setup.E * h * phi_p
         cm = setup.beta_mc * 0.5 * np.conj(a) * setup.E * h * phi_m
     else:
         cp = cm = np.zeros_like(lam)
-    g_step = complex(np.exp(mu * h))
+    return inc_step, cp, cm, complex(np.exp(mu * h))
+
+
+def _output_map(model: BogieModel, op: OperatingPoint, request: _Request,
+                setup: _Setup) -> tuple[list[str], np.ndarray]:
+    """The requested outputs the loop forms (all but the creep forces and adhesion moments, which
+    come from the contact velocities) and V (rows x m) with y = Re(V ζ) [their units]; with
+    ``keep_states`` V also holds the states x = Re(X ζ) below them."""
+    matrices = request.matrices
+    loads = [name for name in request.names
+             if not name.endswith(("creep_force", "adhesion_moment"))]
+    system = bogie_system(model, op)
+    rows = [matrices.index(nm) for nm in loads]
+    C = system.state_output(matrices.C_q[rows], matrices.C_v[rows]).reshape(len(loads), system.N)
+    V = C @ setup.modal_to_state  # loads x m
+    if request.keep_states:  # the states x = Re(X ζ) as further outputs of the loop
+        V = np.vstack([V, setup.modal_to_state])
+    return loads, V
+
+
+def _set_up_run(model: BogieModel, op: OperatingPoint, excitation: ShortCircuit,
+                request: _Request) -> _Run:
+    """The run's step-loop inputs (modal increments of the excitation, creep law, anti-slip
+    settings, output map, the stepper's block matrices) from the cached per-step set-up."""
+    h = request.h
+    setup = _setup(model, op, h)
+    p = model.parameters
+    law = creep_law(p, op.N0)
+    coefficients = creep_coefficients(p, op)
+    step = motor_torque(p, op)
+    inc_step, cp, cm, g_step = _excitation_increments(setup, excitation, step,
+                                                      request.excitation_scale, h)
     rims = contact_names(model)
     # channels: the four contacts, then ID2's slope torque (not a detection signal)
     detect_rows = np.array([0.5 if rim.startswith("ID2.") else 0.0 for rim in rims] + [0.0])
-    protection = anti_slip if anti_slip is not None and anti_slip.enabled else None
-    threshold = protection.threshold if protection else math.inf
-    delay = protection.delay if protection else 0.0
-    rate = protection.rate if protection else 1.0
-    floor = protection.floor if protection else 0.0
-    law_params = np.array([law.mu0, law.A, law.B, law.kA, law.kS, law.slope])
-    march, step_matrices = _kernel()
-    m = len(lam)
-    nc = len(rims) + 1
+    protection = request.protection
+    loads, V = _output_map(model, op, request, setup)
+    inputs = StepInputs(
+        h=h, E=setup.E, inc_step=inc_step, cp=cp, cm=cm, g_step=g_step, g0=complex(1.0),
+        P0=setup.P0, p0_2=setup.p0_2, p1_2=setup.p1_2, contact_scale=max(op.s0 * op.v, 1e-3),
+        law_params=np.array([law.mu0, law.A, law.B, law.kA, law.kS, law.slope]), s0=op.s0,
+        v=op.v, N0=op.N0, mu_s0=coefficients.mu, dmu_s0=coefficients.dmu_ds,
+        tangent=request.creep == "tangent", detect_rows=detect_rows,
+        threshold=protection.threshold if protection else math.inf, M_step=step,
+        delay=protection.delay if protection else 0.0,
+        rate=protection.rate if protection else 1.0,
+        floor=protection.floor if protection else 0.0,
+        blocks=step_matrices(setup.W, setup.E, setup.P0, setup.P1, setup.D1, V, len(rims)))
+    return _Run(inputs=inputs, law=law, rims=rims, loads=loads)
+
+
+@dataclass(frozen=True)
+class _Histories:
+    """What the step loop leaves at the output samples (samples x …)."""
+
+    Y: np.ndarray  # samples x rows of V: the loads' perturbations Δy [units] (then the states)
+    z: np.ndarray  # samples x channels: contact velocities H Δq̇ [m/s], ID2's slope torque [N m]
+    r: np.ndarray  # samples x channels: remainder forces [N], the protection's cut of the slope
+    # torque [N m]
+    u2: np.ndarray  # samples: ΔM_2, the reduction of ID2's motor torque M(s0, v) [N m]
+    detection: float | None  # when the protection detected the slip [s] (None: never)
+    iterations: int  # Newton iterations summed over the steps
+
+
+def _step(run: _Run, request: _Request) -> _Histories:
+    """Step the run from the pre-fault state to the end, block by block of ≈ BLOCK_STEPS steps
+    (:func:`model.analysis.block_stepper.march`), and keep every ``substeps``-th step."""
+    inputs = run.inputs
+    n_points, n_steps, substeps, h = request.n_points, request.n_steps, request.substeps, request.h
+    m = len(inputs.E)
+    nc = len(run.rims) + 1
     zeta = np.zeros(m, dtype=complex)
     phi = np.zeros(nc)
     z = np.zeros(nc)
     det_state = np.array([-1.0])
     iterations = np.zeros(1, dtype=np.int64)
-    # outputs: y = Re(V ζ) for the loads; the creep forces from z
-    loads = [name for name in names if not name.endswith(("creep_force", "adhesion_moment"))]
-    system = bogie_system(model, op)
-    rows = [matrices.index(nm) for nm in loads]
-    C = system.state_output(matrices.C_q[rows], matrices.C_v[rows]).reshape(len(loads), system.N)
-    V = C @ setup.modal_to_state  # loads x m
-    if keep_states:  # the states x = Re(X ζ) as further outputs of the loop
-        V = np.vstack([V, setup.modal_to_state])
-    Y = np.empty((n_points, V.shape[0]))
+    rows = inputs.blocks.rows_out
+    Y = np.empty((n_points, rows))
     Y[0] = 0.0
     z_hist = np.zeros((n_points, nc))
     r_hist = np.zeros((n_points, nc))
     u2_hist = np.zeros(n_points)
     block = BLOCK_STEPS - BLOCK_STEPS % substeps
-    Y_out = np.empty((block, V.shape[0]))
+    Y_out = np.empty((block, rows))
     z_out = np.empty((block, nc))
     phi_out = np.empty((block, nc))
     u2_out = np.empty(block)
     u2_now = 0.0
-    scale = max(op.s0 * op.v, 1e-3)
-    blocks = step_matrices(setup.W, setup.E, setup.P0, setup.P1, setup.D1, V, len(rims))
     k = 0
     while k < n_steps:
         k1 = min(n_steps, k + block)
-        status = march(k, k1, h, zeta, phi, z, u2_now, setup.E, inc_step, cp, cm, g_step,
-                       complex(1.0), setup.P0, setup.p0_2, setup.p1_2, scale, law_params, op.s0,
-                       op.v, op.N0, mu_s0, dmu_s0, creep == "tangent", detect_rows, threshold,
-                       det_state, step, delay, rate, floor, Y_out, z_out, phi_out, u2_out,
-                       iterations, blocks)
+        status = march(k, k1, inputs, zeta, phi, z, u2_now, det_state, Y_out, z_out, phi_out,
+                       u2_out, iterations)
         if status < 0:
             raise NonlinearError(f"the creep-force iteration did not converge at t = "
                                  f"{-status * h:.6g} s")
@@ -416,21 +501,38 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
         r_hist[samples] = phi_out[sel]
         u2_hist[samples] = u2_out[sel]
         k = k1
-    t = np.arange(n_points) / fs
-    X_hist = Y[:, len(loads):] if keep_states else None
-    if not np.all(np.isfinite(Y)) or not np.all(np.isfinite(z_hist)):
-        raise NonlinearError("the nonlinear response is not finite")
+    detection = float(det_state[0]) if det_state[0] >= 0 else None
+    return _Histories(Y=Y, z=z_hist, r=r_hist, u2=u2_hist, detection=detection,
+                      iterations=int(iterations[0]))
+
+
+def _limits(p: Parameters, op: OperatingPoint, mu_max: float,
+            strength: float | None) -> tuple[dict[str, float], list[tuple[str, str]]]:
+    """The limits the totals are checked against ("M_ad", "M_ad/p" [N m], "mu_max N0" [N], and
+    "strength", "strength/p" [N m] if given) and the (output suffix, limit) pairs to check."""
+    M_ad = adhesion_moment(p, op.v, op.N0)
+    limits = {"M_ad": M_ad, "M_ad/p": M_ad / p["gear_ratio"], "mu_max N0": float(mu_max) * op.N0}
+    checks = list(LIMITED)
+    if strength is not None:
+        limits["strength"] = float(strength)
+        limits["strength/p"] = float(strength) / p["gear_ratio"]
+        checks += [("disc_clutch.torque", "strength"), ("claw_clutch.torque", "strength"),
+                   ("driving_shaft.torque", "strength/p")]
+    return limits, checks
+
+
+def _totals(model: BogieModel, op: OperatingPoint, request: _Request, run: _Run, Y: np.ndarray,
+            creep_total: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, str], dict[str, float]]:
+    """The requested outputs as totals (pre-fault value + Δy; the creep forces N0 μ [N] and the
+    wheelsets' adhesion moments r0 Σ N0 μ [N m] from ``creep_total``, samples x contacts: μ [-]),
+    in the requested order, with their units and pre-fault values."""
+    matrices, names, rims = request.matrices, request.names, run.rims
     totals, units, steady = {}, {}, {}
-    for j, name in enumerate(loads):
+    for j, name in enumerate(run.loads):
         i = matrices.index(name)
         totals[name] = Y[:, j] + matrices.steady[i]
-    slope_torque, slope_cut = z_hist[:, -1], r_hist[:, -1]
-    z_hist, r_hist = z_hist[:, :-1], r_hist[:, :-1]
-    creep_total = np.asarray(law.mu(op.s0 + z_hist / op.v, op.v)) if creep == "nonlinear" \
-        else mu_s0 + dmu_s0 * z_hist / op.v
     forces = op.N0 * creep_total  # N x contacts, totals
-    r0 = p["wheel_radius"]
-    _, mu_max = law.maximum(op.v)
+    r0 = model.parameters["wheel_radius"]
     for i, rim in enumerate(rims):
         totals_name = f"{rim}.creep_force"
         if totals_name in names:
@@ -444,31 +546,47 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     for name in names:
         i = matrices.index(name)
         units[name], steady[name] = matrices.units[i], float(matrices.steady[i])
-    M_C = excitation.torque(t, step) * excitation_scale
+    return outputs_total, units, steady
+
+
+def _pack_result(model: BogieModel, op: OperatingPoint, excitation: ShortCircuit,
+                 request: _Request, run: _Run, histories: _Histories) -> NonlinearResult:
+    """The result from the sampled histories: totals (pre-fault value + Δy) of the loads, creep
+    forces [N] and adhesion moments [N m] from the law, motor torques [N m], creepages [-], slip
+    velocities [m/s], utilisations [-], peaks and limit crossings."""
+    p = model.parameters
+    law, rims = run.law, run.rims
+    inputs = run.inputs
+    mu_s0, dmu_s0, step = inputs.mu_s0, inputs.dmu_s0, inputs.M_step
+    Y, z_hist, r_hist, u2_hist = histories.Y, histories.z, histories.r, histories.u2
+    t = np.arange(request.n_points) / request.fs
+    X_hist = Y[:, len(run.loads):] if request.keep_states else None
+    if not np.all(np.isfinite(Y)) or not np.all(np.isfinite(z_hist)):
+        raise NonlinearError("the nonlinear response is not finite")
+    slope_torque, slope_cut = z_hist[:, -1], r_hist[:, -1]
+    z_hist, r_hist = z_hist[:, :-1], r_hist[:, :-1]
+    creep_total = np.asarray(law.mu(op.s0 + z_hist / op.v, op.v)) if request.creep == "nonlinear" \
+        else mu_s0 + dmu_s0 * z_hist / op.v
+    _, mu_max = law.maximum(op.v)
+    outputs_total, units, steady = _totals(model, op, request, run, Y, creep_total)
+    M_C = excitation.torque(t, step) * request.excitation_scale
     motor = {"ID1.motor.torque": step + M_C,
              "ID2.motor.torque": step + slope_torque + u2_hist + slope_cut}
     creepage = {rim: op.s0 + z_hist[:, i] / op.v for i, rim in enumerate(rims)}
     slip = {rim: creepage[rim] * op.v for rim in rims}
     utilisation = {rim: creep_total[:, i] / mu_max for i, rim in enumerate(rims)}
-    M_ad = adhesion_moment(p, op.v, op.N0)
-    limits = {"M_ad": M_ad, "M_ad/p": M_ad / p["gear_ratio"], "mu_max N0": float(mu_max) * op.N0}
-    checks = list(LIMITED)
-    if strength is not None:
-        limits["strength"] = float(strength)
-        limits["strength/p"] = float(strength) / p["gear_ratio"]
-        checks += [("disc_clutch.torque", "strength"), ("claw_clutch.torque", "strength"),
-                   ("driving_shaft.torque", "strength/p")]
+    limits, checks = _limits(p, op, mu_max, request.strength)
     found = history_peaks_and_crossings(t, outputs_total, steady, limits, checks)
-    detection = float(det_state[0]) if det_state[0] >= 0 else None
+    detection = histories.detection
     return NonlinearResult(
         t=t, outputs=outputs_total, units=units, steady=steady, M_C=M_C, motor_torques=motor,
         creepage=creepage, slip_velocity=slip, utilisation=utilisation, peaks=found.peaks,
         peak_times=found.peak_times, perturbation_peaks=found.perturbation_peaks,
         perturbation_peak_times=found.perturbation_peak_times,
         limit_crossings=found.limit_crossings,
-        limits=limits, operating_point=op, excitation=excitation, creep_model=creep,
-        anti_slip=protection, detection_time=detection,
-        action_time=None if detection is None else detection + delay, motor_torque=step,
-        mu_max=float(mu_max), newton_iterations=float(iterations[0]) / max(n_steps, 1),
+        limits=limits, operating_point=op, excitation=excitation, creep_model=request.creep,
+        anti_slip=request.protection, detection_time=detection,
+        action_time=None if detection is None else detection + inputs.delay, motor_torque=step,
+        mu_max=float(mu_max), newton_iterations=float(histories.iterations) / max(request.n_steps, 1),
         torque_reduction=u2_hist + slope_cut,
         contact_velocity=z_hist, remainder_force=r_hist, states=X_hist)

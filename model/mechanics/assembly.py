@@ -37,9 +37,18 @@ from model.mechanics.connections import MaxwellDamper, Spring, SpringDamper, axi
 from model.mechanics.dofs import AXES6, DofMap
 from model.mechanics.parameters import Parameters
 
-HOLLOW_SHAFT_NODES = (5, 6, 7, 8, 9)
-AXLE_NODES = (10, 11, 12, 13, 14, 15, 16)
-RIM_NODES = (12, 14)
+# Beam nodes of a drive, in the study's numbering 5…16 (docs/model.md, "DOF count and layout"):
+# the coordinates ``IDk.hs<node>.*``, ``IDk.ax<node>.*``, ``IDk.rim<node>.*``
+# (model.mechanics.dofs).  Lateral places y are drive 1's (drive 2 is turned by 180°).
+HOLLOW_SHAFT_NODES = (5, 6, 7, 8, 9)  # hollow shaft, evenly from the gear (5) to the claw end (9)
+AXLE_NODES = (10, 11, 12, 13, 14, 15, 16)  # wheelset axle
+RIM_NODES = (12, 14)  # the wheels (y = −c, +c): wheel discs on the axle, elastic rims on them
+DISC_CLUTCH_NODE = 5  # hollow shaft at the gear: the disc clutch joins it to the gear
+CLAW_CLUTCH_NODE = 9  # hollow shaft's claw end: the claw clutch's hollow-shaft side
+AXLE_CLAW_NODE = 10  # axle under the hollow shaft's claw end: the claw clutch's axle side
+JOURNAL_NODES = (11, 15)  # axle journals (y = −j, +j): axle boxes, primary suspension
+AXLE_CENTRE_NODE = 13  # axle centre (y = 0)
+AXLE_GEAR_NODE = 16  # axle under the gear (and the hollow shaft's gear end)
 DRIVES = ("ID1", "ID2")
 CENTRAL_SYMMETRY = np.diag([-1.0, -1.0, 1.0])  # drive 2 = drive 1 turned 180° about z
 CAR_BODY_AXES = ("x", "z", "rz")  # the half car body's coordinates
@@ -187,24 +196,44 @@ def _parts(store: dict[str, list[tuple[np.ndarray, np.ndarray]]]) -> dict[str, P
     return parts
 
 
-def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.ndarray,
-           axle_x: float, positions: dict[str, np.ndarray]) -> dict[str, Body]:
-    """Add one individual wheelset drive.  ``sign`` maps drive-1 geometry to this drive's."""
+@dataclass(frozen=True)
+class _DriveLayout:
+    """Where a drive's parts sit: drive 1's geometry mapped by ``sign`` (identity for drive 1,
+    the bogie's central symmetry for drive 2); places in m."""
+
+    sign: np.ndarray  # 3 x 3: drive-1 geometry -> this drive's
+    axle_x: float  # longitudinal place of the wheelset axle (drive 1) [m]
+    x_motor: float  # longitudinal place of the motor axis (drive 1), towards the bogie centre [m]
+    r_pinion: float  # pitch radius of the pinion [m]
+    y_gear: float  # lateral place of the gear mesh (pinion, gear, hollow shaft node 5) [m]
+    y_claw: float  # lateral place of the claw clutch (hollow shaft node 9, axle node 10) [m]
+
+    @classmethod
+    def of(cls, p: Parameters, sign: np.ndarray, axle_x: float) -> _DriveLayout:
+        r_gear = p["gear_radius"]
+        r_pinion = r_gear / p["gear_ratio"]
+        return cls(sign, axle_x, axle_x - (r_gear + r_pinion), r_pinion,
+                   p["gear_lateral_position"], p["claw_clutch_lateral_position"])
+
+    def pos(self, x, y, z) -> np.ndarray:
+        """This drive's point for drive 1's point (x, y, z) [m]."""
+        return self.sign @ np.array([x, y, z], dtype=np.result_type(x, y, z, float))
+
+    def direction(self, v) -> np.ndarray:
+        """This drive's direction for drive 1's direction ``v``."""
+        return self.sign @ np.asarray(v, dtype=np.result_type(*v, float))
+
+
+def _motor_and_gear(asm: _Assembler, p: Parameters, prefix: str,
+                    at: _DriveLayout) -> tuple[Body, Body, Body, Body]:
+    """The stator with the gear housing (a free body) and the rotor, pinion and gear it carries,
+    with their masses [kg] and inertias [kg m²]: (stator, rotor, pinion, gear)."""
     dofs = asm.dofs
-    pos = lambda x, y, z: sign @ np.array([x, y, z], dtype=np.result_type(x, y, z, float))  # noqa: E731
-    direction = lambda v: sign @ np.asarray(v, dtype=np.result_type(*v, float))  # noqa: E731
-    loss_rubber, loss_steel = p["rubber_loss_time"], p["shaft_loss_time"]
-
-    ratio, r_gear = p["gear_ratio"], p["gear_radius"]
-    r_pinion = r_gear / ratio
-    y_gear, y_claw = p["gear_lateral_position"], p["claw_clutch_lateral_position"]
-    x_motor = axle_x - (r_gear + r_pinion)  # motor axis towards the bogie centre
-
-    stator = asm.free(f"{prefix}.stator", pos(x_motor + p["stator_offset_x"], 0.0,
-                                              p["stator_offset_z"]))
-    rotor = carried_body(f"{prefix}.rotor", pos(x_motor, 0.0, 0.0), stator, dofs)
-    pinion = carried_body(f"{prefix}.pinion", pos(x_motor, y_gear, 0.0), stator, dofs)
-    gear = carried_body(f"{prefix}.gear", pos(axle_x, y_gear, 0.0), stator, dofs)
+    stator = asm.free(f"{prefix}.stator", at.pos(at.x_motor + p["stator_offset_x"], 0.0,
+                                                 p["stator_offset_z"]))
+    rotor = carried_body(f"{prefix}.rotor", at.pos(at.x_motor, 0.0, 0.0), stator, dofs)
+    pinion = carried_body(f"{prefix}.pinion", at.pos(at.x_motor, at.y_gear, 0.0), stator, dofs)
+    gear = carried_body(f"{prefix}.gear", at.pos(at.axle_x, at.y_gear, 0.0), stator, dofs)
     asm.add_mass(f"{prefix}.stator", stator, rigid_mass_matrix(
         p["stator_mass"], (p["stator_inertia_x"], p["stator_inertia_y"], p["stator_inertia_z"])))
     for body, mass, inertia in ((rotor, "rotor_mass", "rotor_inertia"),
@@ -212,14 +241,22 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
                                 (gear, "gear_mass", "gear_inertia")):
         J = p[inertia]
         asm.add_mass(body.name, body, rigid_mass_matrix(p[mass], (J / 2, J, J / 2)))
+    return stator, rotor, pinion, gear
 
-    # hollow shaft and axle beam nodes
-    hs_y = np.linspace(y_gear, y_claw, len(HOLLOW_SHAFT_NODES))
-    hs = {k: asm.free(f"{prefix}.hs{k}", pos(axle_x, y, 0.0))
+
+def _hollow_shaft_and_axle(asm: _Assembler, p: Parameters, prefix: str,
+                           at: _DriveLayout) -> tuple[dict[int, Body], dict[int, Body]]:
+    """The hollow shaft's and the wheelset axle's beam nodes (free bodies) and beams, the wheel
+    discs [kg, kg m²] and the axle boxes [kg] lumped at their nodes: (hollow shaft nodes, axle
+    nodes) by node number."""
+    hs_y = np.linspace(at.y_gear, at.y_claw, len(HOLLOW_SHAFT_NODES))
+    hs = {k: asm.free(f"{prefix}.hs{k}", at.pos(at.axle_x, y, 0.0))
           for k, y in zip(HOLLOW_SHAFT_NODES, hs_y, strict=True)}
     c, j = p["contact_half_distance"], p["journal_half_distance"]
-    axle_y = {11: -j, 12: -c, 10: y_claw, 13: 0.0, 16: y_gear, 14: c, 15: j}
-    ax = {k: asm.free(f"{prefix}.ax{k}", pos(axle_x, y, 0.0)) for k, y in axle_y.items()}
+    (journal_a, journal_b), (wheel_a, wheel_b) = JOURNAL_NODES, RIM_NODES
+    axle_y = {journal_a: -j, wheel_a: -c, AXLE_CLAW_NODE: at.y_claw, AXLE_CENTRE_NODE: 0.0,
+              AXLE_GEAR_NODE: at.y_gear, wheel_b: c, journal_b: j}  # lateral places (drive 1)
+    ax = {k: asm.free(f"{prefix}.ax{k}", at.pos(at.axle_x, y, 0.0)) for k, y in axle_y.items()}
     hollow = TubeSection(p["hollow_shaft_outer_radius"], p["hollow_shaft_inner_radius"])
     for k1, k2 in pairwise(HOLLOW_SHAFT_NODES):
         asm.add_beam(f"{prefix}.hollow_shaft", f"{prefix}.hollow_shaft", hs[k1], hs[k2], hollow, p)
@@ -231,10 +268,17 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
         Jd = p["wheel_disc_diametral_inertia"]
         asm.add_mass(f"{prefix}.wheelset", ax[k], rigid_mass_matrix(
             p["wheel_disc_mass"], (Jd, p["wheel_disc_polar_inertia"], Jd)))
-    for k in (11, 15):  # axle boxes: translate with the journal, do not spin
+    for k in JOURNAL_NODES:  # axle boxes: translate with the journal, do not spin
         asm.add_mass(f"{prefix}.wheelset", ax[k], np.diag([p["axle_box_mass"]] * 3 + [0, 0, 0]))
+    return hs, ax
 
-    # rims (elastic wheels) and track
+
+def _rims_and_track(asm: _Assembler, p: Parameters, prefix: str,
+                    ax: dict[int, Body]) -> dict[int, Body]:
+    """The elastic wheels' rims (free bodies at the wheel nodes; mass [kg], inertias [kg m²],
+    rim springs [N/m, N m/rad] with rubber damping) and the track under each [N/m, N s/m, kg]:
+    the rims by node number."""
+    loss_rubber = p["rubber_loss_time"]
     rims = {}
     for k in RIM_NODES:
         rim = asm.free(f"{prefix}.rim{k}", ax[k].origin)
@@ -246,10 +290,16 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
         asm.add_connection(SpringDamper(
             f"{prefix}.rim{k}_spring", f"{prefix}.rim_springs", ax[k], rim, rim.origin,
             axis_springs(kt, loss_rubber * kt) + axis_springs(kr, loss_rubber * kr, rotational=True)))
-        asm.add_ground_spring("track", dofs.index(f"{rim.name}.z"), p["track_stiffness"],
+        asm.add_ground_spring("track", asm.dofs.index(f"{rim.name}.z"), p["track_stiffness"],
                               p["track_damping"], p["track_mass"], "track")
+    return rims
 
-    # drive train couplings
+
+def _driving_shaft_and_gear_mesh(asm: _Assembler, p: Parameters, prefix: str, at: _DriveLayout,
+                                 rotor: Body, pinion: Body, gear: Body) -> np.ndarray:
+    """The driving shaft (rotor to pinion, torsion [N m/rad]) and the gear mesh (pinion to gear,
+    a spring along the line of action [N/m]), both with steel damping: the pitch point [m]."""
+    loss_steel = p["shaft_loss_time"]
     asm.add_connection(SpringDamper(
         f"{prefix}.driving_shaft", f"{prefix}.driving_shaft", pinion, rotor, rotor.origin,
         (Spring(np.array([0.0, -1.0, 0.0]), p["driving_shaft_stiffness"],
@@ -257,29 +307,45 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
     # driving-shaft torque in the motor's driving sense (the rotor turns −ry when running forward):
     # M_DS = k_DS (φ_rotor − φ_pinion) with angles counted in that sense, positive in traction
     alpha = p["pressure_angle"]
-    pitch_point = pos(x_motor + r_pinion, y_gear, 0.0)
+    pitch_point = at.pos(at.x_motor + at.r_pinion, at.y_gear, 0.0)
     asm.add_connection(SpringDamper(
         f"{prefix}.gear_mesh", f"{prefix}.gear_mesh", pinion, gear, pitch_point,
-        (Spring(direction([-np.sin(alpha), 0.0, -np.cos(alpha)]), p["gear_mesh_stiffness"],
+        (Spring(at.direction([-np.sin(alpha), 0.0, -np.cos(alpha)]), p["gear_mesh_stiffness"],
                 loss_steel * p["gear_mesh_stiffness"], False, "force"),)))
+    return pitch_point
+
+
+def _clutches(asm: _Assembler, p: Parameters, prefix: str, gear: Body, hs: dict[int, Body],
+              ax: dict[int, Body]) -> None:
+    """The disc clutch (gear to the hollow shaft's gear end) and the claw clutch (the hollow
+    shaft's claw end to the axle): springs [N/m, N m/rad] with rubber damping."""
+    loss_rubber = p["rubber_loss_time"]
     k_dc = np.array([p["disc_clutch_radial_stiffness"], p["disc_clutch_axial_stiffness"],
                      p["disc_clutch_radial_stiffness"]])
     k_dc_rot = np.array([p["disc_clutch_tilt_stiffness"], p["disc_clutch_torsional_stiffness"],
                          p["disc_clutch_tilt_stiffness"]])
+    disc = hs[DISC_CLUTCH_NODE]
     asm.add_connection(SpringDamper(
-        f"{prefix}.disc_clutch", f"{prefix}.disc_clutch", hs[5], gear, hs[5].origin,
+        f"{prefix}.disc_clutch", f"{prefix}.disc_clutch", disc, gear, disc.origin,
         axis_springs(k_dc, loss_rubber * k_dc, channels=("force_x", "force_y", "force_z"))
         + axis_springs(k_dc_rot, loss_rubber * k_dc_rot, True, ("", "torque", ""))))
     k_cc = np.array([p["claw_clutch_radial_stiffness"], p["claw_clutch_axial_stiffness"],
                      p["claw_clutch_radial_stiffness"]])
     k_cc_rot = np.array([p["claw_clutch_tilt_stiffness"], p["claw_clutch_torsional_stiffness"],
                          p["claw_clutch_tilt_stiffness"]])
+    claw = hs[CLAW_CLUTCH_NODE]
     asm.add_connection(SpringDamper(
-        f"{prefix}.claw_clutch", f"{prefix}.claw_clutch", ax[10], hs[9], hs[9].origin,
+        f"{prefix}.claw_clutch", f"{prefix}.claw_clutch", ax[AXLE_CLAW_NODE], claw, claw.origin,
         axis_springs(k_cc, loss_rubber * k_cc)
         + axis_springs(k_cc_rot, loss_rubber * k_cc_rot, True, ("", "torque", ""))))
 
-    # drive to frame: silent blocks A, B, C
+
+def _silent_blocks(asm: _Assembler, p: Parameters, prefix: str, at: _DriveLayout, frame: Body,
+                   stator: Body, positions: dict[str, np.ndarray]) -> None:
+    """The drive hung in the frame: silent blocks A, B (upper) and C (lower) between the frame
+    and the stator [N/m, rubber damping]; their places [m] into ``positions``."""
+    loss_rubber = p["rubber_loss_time"]
+    x_motor, y_gear, pos = at.x_motor, at.y_gear, at.pos
     k_sb = np.array([p["silent_block_stiffness_x"], p["silent_block_stiffness_y"],
                      p["silent_block_stiffness_z"]])
     blocks = {"A": pos(x_motor - p["silent_block_upper_x"], p["silent_block_half_y"], p["silent_block_upper_z"]),
@@ -290,13 +356,31 @@ def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.nd
                                         frame, stator, point, axis_springs(k_sb, loss_rubber * k_sb)))
         positions[f"{prefix}.silent_block_{label}"] = point
 
-    # wheelset to frame: primary suspension and longitudinal wheelset guides at the journals
+
+def _primary_suspension(asm: _Assembler, p: Parameters, prefix: str, frame: Body,
+                        ax: dict[int, Body]) -> None:
+    """Wheelset to frame at the journals: primary springs and longitudinal wheelset guides
+    [N/m], vertical primary dampers [N s/m]."""
     k_p = np.array([p["primary_stiffness_x"], p["primary_stiffness_y"], p["primary_stiffness_z"]])
     c_p = np.array([0.0, 0.0, p["primary_damping_z"]])
-    for k in (11, 15):
+    for k in JOURNAL_NODES:
         asm.add_connection(SpringDamper(f"{prefix}.primary{k}", f"{prefix}.primary", frame, ax[k],
                                         ax[k].origin, axis_springs(k_p, c_p)))
 
+
+def _drive(asm: _Assembler, p: Parameters, prefix: str, frame: Body, sign: np.ndarray,
+           axle_x: float, positions: dict[str, np.ndarray]) -> dict[str, Body]:
+    """Add one individual wheelset drive.  ``sign`` maps drive-1 geometry to this drive's;
+    ``axle_x`` [m]: drive 1's axle place.  Its parts' places [m] go into ``positions``; returns
+    its bodies by part name ("stator", "hs5", "ax10", "rim12", …)."""
+    at = _DriveLayout.of(p, sign, axle_x)
+    stator, rotor, pinion, gear = _motor_and_gear(asm, p, prefix, at)
+    hs, ax = _hollow_shaft_and_axle(asm, p, prefix, at)
+    rims = _rims_and_track(asm, p, prefix, ax)
+    pitch_point = _driving_shaft_and_gear_mesh(asm, p, prefix, at, rotor, pinion, gear)
+    _clutches(asm, p, prefix, gear, hs, ax)
+    _silent_blocks(asm, p, prefix, at, frame, stator, positions)
+    _primary_suspension(asm, p, prefix, frame, ax)
     bodies = {"stator": stator, "rotor": rotor, "pinion": pinion, "gear": gear,
               **{f"hs{k}": b for k, b in hs.items()}, **{f"ax{k}": b for k, b in ax.items()},
               **{f"rim{k}": b for k, b in rims.items()}}
