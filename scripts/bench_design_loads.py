@@ -137,7 +137,7 @@ def nonlinear_scenario(parameters, model, t_end, fs, repeats=3) -> None:
     key = (0,) * 10
     system = bogie_system(model, op)
     outputs = output_matrices(model, op)
-    C = np.hstack([outputs.C_q, outputs.C_v])
+    C = system.state_output(outputs.C_q, outputs.C_v)  # on the state [q; q̇ of the inertial coordinates]
     response = short_circuit_response(model, op, None, t_end, fs)
     cold, warm, lsim = np.inf, np.inf, np.inf
     for _ in range(repeats):

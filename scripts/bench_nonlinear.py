@@ -153,7 +153,7 @@ def main() -> None:
 
     system = bogie_system(model, op)
     outputs = output_matrices(model, op)
-    C = np.hstack([outputs.C_q, outputs.C_v])
+    C = system.state_output(outputs.C_q, outputs.C_v)  # on the state [q; q̇ of the inertial coordinates]
     start = time.perf_counter()
     scipy.signal.lsim((system.A, system.b[:, None], C, np.zeros((C.shape[0], 1))),
                       result.M_C, t)
