@@ -132,6 +132,7 @@ class StudiesView(pn.viewable.Viewer):
         self.owner = getattr(dashboard, "study_owner", None) or secrets.token_hex(8)
         self.map: MapView | None = None  # last map shown
         self.ticket: StudyTicket | None = None  # the session's running / last study
+        self._read_at = -1  # lines finished when the running store was last read
         self.error = ""
         self._poller = None
         settings = self.queue.settings
@@ -274,7 +275,7 @@ class StudiesView(pn.viewable.Viewer):
         except ValueError as error:  # StudyRefused is a ValueError
             self._reject(str(error.args[0] if error.args else error))
             return
-        self.ticket = ticket
+        self.ticket, self._read_at = ticket, -1
         self.notice.visible, self.error = False, ""
         self.start_button.disabled, self.stop_button.disabled = True, False
         self.progress.visible, self.progress.max, self.progress.value = True, ticket.total, 0
@@ -315,7 +316,8 @@ class StudiesView(pn.viewable.Viewer):
         self.status.object = f"{line} — {self._conditions}"
         if ticket.state == WAITING:
             return
-        self._show_running_store(ticket)
+        if ticket.finished != self._read_at or ended:  # read the store when it has grown
+            self._show_running_store(ticket)
         if ended:
             if ticket.state == FAILED:
                 self._reject(f"the study failed: {ticket.message}")
@@ -329,9 +331,11 @@ class StudiesView(pn.viewable.Viewer):
         path = self.queue.folder.root / ticket.name
         if (path / "zarr.json").is_file():
             try:
-                self._show(read_map(path, name=ticket.name))
+                view = read_map(path, name=ticket.name)
             except (ValueError, OSError, KeyError):
-                pass  # the store is being created: next poll
+                return  # the store is being created: next poll
+            self._read_at = view.finished
+            self._show(view)
 
     # --- opening -------------------------------------------------------------------------------
 

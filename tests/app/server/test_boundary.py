@@ -446,7 +446,7 @@ def test_five_sessions_queue_with_one_running(setup, chromium):
                 if text.startswith("done") and index not in done_at:
                     done_at[index] = time.monotonic()
                 assert not text.startswith(("failed", "stopped")), text
-            if len(busy) < 6 and any(t.startswith("running") for t in texts):
+            if len(busy) < 9 and any(t.startswith("running") for t in texts):
                 busy.append(_slider_answer(pages[len(busy) % len(pages)]))
             time.sleep(0.2)
         assert len(done_at) == 5, [_status(page) for page in pages]
@@ -458,7 +458,7 @@ def test_five_sessions_queue_with_one_running(setup, chromium):
         assert sorted(ahead.values()) == [0, 1, 2, 3]
         finish = sorted(done_at, key=done_at.get)
         assert finish[1:] == waited
-        assert len(busy) >= 3
+        assert len(busy) >= 5  # the median of several: one answer may meet a study's start or end
         assert statistics.median(busy) <= 2 * idle, (idle, busy)
         for page in pages:
             assert page.errors == [], page.errors
