@@ -50,7 +50,10 @@ def _has_link(root: Path) -> bool:
     """Whether a symbolic link (or anything but folders and regular files) is inside ``root``."""
     for folder, folders, files in os.walk(root, followlinks=False):
         for entry in itertools.chain(folders, files):
-            mode = os.lstat(os.path.join(folder, entry)).st_mode
+            try:
+                mode = os.lstat(os.path.join(folder, entry)).st_mode
+            except FileNotFoundError:  # a chunk being written (a temporary file renamed away)
+                continue
             if not (stat.S_ISDIR(mode) or stat.S_ISREG(mode)):
                 return True
     return False
