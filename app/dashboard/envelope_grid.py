@@ -33,15 +33,15 @@ from pathlib import Path
 import numpy as np
 import panel as pn
 
+from app.dashboard.queued_study import QueuedStudyControls
 from app.dashboard.url_state import fit_phase, scenario_query
 from app.results import compute
 from app.results.load_plots import EnvelopeMapPlot
 from app.results.tables import format_load
-from app.services.study_queue import FAILED, WAITING, StudyQueue, StudyTicket, study_queue, wait_until_ended
+from app.services.study_queue import StudyQueue, StudyTicket, study_queue
 from model.mechanics.operating_point import KMH
 
 log = logging.getLogger(__name__)
-POLL_MS = 500  # progress refresh of a served session [ms]
 # axis -> (label, display unit, dashboard parameter, SI value per display unit, slider step,
 # slider format, store dimension)
 AXES = {
@@ -142,11 +142,13 @@ def envelope_rows(data: EnvelopeData):
     return envelope(data.study, arrays)
 
 
-class EnvelopeGrid:
+class EnvelopeGrid(QueuedStudyControls):
     """Ask the server for a grid envelope at the dashboard's point; follow it; open a finished
     one.  The dashboard provides ``param`` (its parameters and their bounds), ``nonlinear`` (the
     creep switch and the anti-slip key in use), ``params_path``, ``set_key``, ``study_owner``,
     ``variant`` and ``run_locked``."""
+
+    UNIT, WHAT = "chunks", "envelope"
 
     def __init__(self, dashboard, queue: StudyQueue | None = None):
         self.dashboard = dashboard
@@ -357,50 +359,10 @@ class EnvelopeGrid:
         self.progress.visible, self.progress.max, self.progress.value = True, ticket.total, 0
         self._conditions = (f"{study.scenarios} scenarios, {study.creep} creep, rail "
                             f"{study.rail[0]}; store {html.escape(ticket.name)}")
-        self.poll()
-        doc = pn.state.curdoc
-        if doc is not None and doc.session_context is not None:
-            self._poller = pn.state.add_periodic_callback(self.poll, period=POLL_MS)
+        self._follow()
 
-    def stop(self) -> None:
-        """Stop this view's envelope: a waiting one leaves the queue, a running one stops after
-        the chunk in progress (the store keeps the finished ones)."""
-        if self.ticket is not None:
-            self.queue.stop(self.ticket, self.owner)
-            self.poll()
-
-    def wait(self, timeout: float | None = None) -> None:
-        """Wait for this view's envelope to end (tests, scripts)."""
-        if self.ticket is not None:
-            wait_until_ended(self.ticket, timeout)
-
-    @property
-    def outcome(self) -> str | None:
-        """"done", "stopped", "failed", "dropped" once the envelope ended, else None."""
-        ticket = self.ticket
-        return ticket.state if ticket is not None and ticket.ended.is_set() else None
-
-    def poll(self) -> None:
-        """Show the queue position or the progress and the peaks found so far (a periodic
-        callback when served)."""
-        ticket = self.ticket
-        if ticket is None:
-            return
-        line, ended = self.queue.status_line(ticket, "chunks")
-        self.progress.value = min(ticket.finished, self.progress.max)
-        self.status.object = f"{line} — {self._conditions}"
-        if ticket.state == WAITING:
-            return
-        if ticket.finished != self._read_at or ended:
-            self._show_running_store(ticket)
-        if ended:
-            if ticket.state == FAILED:
-                self._reject(f"the envelope failed: {ticket.message}")
-            self.start_button.disabled, self.stop_button.disabled = False, True
-            self.refresh_list()
-            if self._poller is not None:
-                self._poller.stop()
-                self._poller = None
+    def _after_end(self) -> None:
+        self.refresh_list()
 
     def _show_running_store(self, ticket: StudyTicket) -> None:
         path = self.queue.folder.root / ticket.name

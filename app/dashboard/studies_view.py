@@ -30,14 +30,14 @@ import panel as pn
 from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
 from bokeh.palettes import RdBu10
 
+from app.dashboard.queued_study import QueuedStudyControls
 from app.dashboard.uncertainty_band import BandLayer, UncertaintyBand, band_mismatch, read_band
 from app.results import compute
 from app.results.plots import new_figure
-from app.services.study_queue import FAILED, WAITING, StudyQueue, StudyTicket, study_queue, wait_until_ended
+from app.services.study_queue import StudyQueue, StudyTicket, study_queue
 from model.mechanics.operating_point import KMH
 
 log = logging.getLogger(__name__)
-POLL_MS = 500  # progress refresh of a served session [ms]
 
 
 @dataclass(frozen=True)
@@ -117,11 +117,13 @@ class StudyMapPlot:
         self.limit.data = {"v": view.v_kmh[found].tolist(), "s0": view.s0_limit[found].tolist()}
 
 
-class StudiesView(pn.viewable.Viewer):
+class StudiesView(QueuedStudyControls, pn.viewable.Viewer):
     """Ask the server for a stability map at the dashboard's current N0, b_M and rail; follow it;
     open a finished one.  Where it runs, where it is stored and how large it may be are the
     server's settings (:mod:`app.services.settings`); this view only asks (:mod:`app.services.study_queue`)
     and picks stores and results by name from the server's list (:mod:`app.services.studies_folder`)."""
+
+    UNIT, WHAT = "s0-lines", "study"
 
     def __init__(self, dashboard, queue: StudyQueue | None = None, **params):
         super().__init__(**params)
@@ -282,50 +284,10 @@ class StudiesView(pn.viewable.Viewer):
         self._conditions = (f"N0 = {self.dashboard.N0:g} kN, b_M = {self.dashboard.b_M:g} "
                             f"N m s/rad, rail {self.dashboard.rail}; store "
                             f"{html.escape(ticket.name)}")
-        self.poll()
-        doc = pn.state.curdoc
-        if doc is not None and doc.session_context is not None:
-            self._poller = pn.state.add_periodic_callback(self.poll, period=POLL_MS)
+        self._follow()
 
-    def stop(self) -> None:
-        """Stop this session's study: a waiting one leaves the queue, a running one stops after
-        the chunk in progress (the store keeps the finished ones)."""
-        if self.ticket is not None:
-            self.queue.stop(self.ticket, self.owner)
-            self.poll()
-
-    def wait(self, timeout: float | None = None) -> None:
-        """Wait for this session's study to end (tests, scripts)."""
-        if self.ticket is not None:
-            wait_until_ended(self.ticket, timeout)
-
-    @property
-    def outcome(self) -> str | None:
-        """"done", "stopped", "failed", "dropped" once the study ended, else None."""
-        ticket = self.ticket
-        return ticket.state if ticket is not None and ticket.ended.is_set() else None
-
-    def poll(self) -> None:
-        """Show the queue position or progress, and the lines finished so far (periodic callback
-        when served)."""
-        ticket = self.ticket
-        if ticket is None:
-            return
-        line, ended = self.queue.status_line(ticket, "s0-lines")
-        self.progress.value = min(ticket.finished, self.progress.max)
-        self.status.object = f"{line} — {self._conditions}"
-        if ticket.state == WAITING:
-            return
-        if ticket.finished != self._read_at or ended:  # read the store when it has grown
-            self._show_running_store(ticket)
-        if ended:
-            if ticket.state == FAILED:
-                self._reject(f"the study failed: {ticket.message}")
-            self.start_button.disabled, self.stop_button.disabled = False, True
-            self.refresh_lists()
-            if self._poller is not None:
-                self._poller.stop()
-                self._poller = None
+    def _after_end(self) -> None:
+        self.refresh_lists()
 
     def _show_running_store(self, ticket: StudyTicket) -> None:
         path = self.queue.folder.root / ticket.name
