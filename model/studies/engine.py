@@ -148,6 +148,7 @@ class StudyEngine:
                 with dask.config.set(WORKER_CONFIG):
                     self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
                                                 processes=True, dashboard_address=None,
+                                                scheduler_kwargs=SCHEDULER_HTTP,
                                                 silence_logs=logging.CRITICAL,  # shutdown races log heartbeat errors
                                                 env=dict(BLAS_ENVIRONMENT))
         finally:
@@ -207,6 +208,12 @@ class StudyEngine:
         return results
 
 
+# A scheduler always serves HTTP (health, metrics), by default on port 8787: when that port is
+# taken (another cluster, another server on the machine) Dask warns and moves.  Ours asks for any
+# free port on the loopback interface instead, so that nothing depends on 8787 being free and
+# nothing listens beyond this machine.
+SCHEDULER_HTTP = {"dashboard_address": "127.0.0.1:0"}
+
 # environment of the plain worker subprocesses (inherited): one BLAS thread, quiet logs
 PLAIN_WORKER_ENVIRONMENT = {**BLAS_ENVIRONMENT, "DASK_LOGGING__DISTRIBUTED": "error"}
 
@@ -223,8 +230,8 @@ def _plain_worker_cluster(workers: int):
               "options": {"worker_class": "distributed.Worker",
                           "worker_kwargs": {"nthreads": 1, "death_timeout": 60,
                                             "host": "127.0.0.1"}}}
-    scheduler = {"cls": Scheduler, "options": {"host": "127.0.0.1", "port": 0,
-                                               "dashboard": False, "dashboard_address": None}}
+    scheduler = {"cls": Scheduler, "options": {"host": "127.0.0.1", "port": 0, "dashboard": False,
+                                               **SCHEDULER_HTTP}}
     return SpecCluster(workers={i: worker for i in range(workers)}, scheduler=scheduler,
                        worker=worker, silence_logs=logging.CRITICAL, name="bogie-local")
 

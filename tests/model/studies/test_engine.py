@@ -260,3 +260,33 @@ def test_a_local_cluster_whose_workers_do_not_join_in_time_is_unavailable():
         engine.start()
     assert engine.client is None
     assert engine.cluster is None
+
+
+@pytest.mark.parametrize("supervised", [False, True], ids=["plain-workers", "nannies"])
+def test_a_local_cluster_starts_when_port_8787_is_taken(supervised):
+    """A scheduler serves HTTP (health, metrics) on 8787 unless told otherwise; with that port
+    held by someone else (another cluster, another server: CI ran into it) Dask warns and moves,
+    which the suite treats as an error.  The engine's local cluster takes any free loopback port,
+    so it starts silently whoever holds 8787, and its HTTP server listens on 127.0.0.1 only."""
+    holder = socket.socket()
+    try:
+        holder.bind(("127.0.0.1", 8787))
+    except OSError:
+        holder.close()
+        holder = None  # 8787 is already taken here, which is the case under test anyway
+    else:
+        holder.listen()
+    engine = StudyEngine(None, workers=1, use_environment=False, supervised=supervised)
+    try:
+        engine.start()  # a warning here fails the test (filterwarnings = error)
+        http = engine.client.scheduler_info()["services"]
+        assert set(http) == {"dashboard"}
+        assert http["dashboard"] != 8787
+        assert engine.map(abs, [-1, 2, -3]) == [1, 2, 3]
+        address = engine.client.run_on_scheduler(
+            lambda dask_scheduler: dask_scheduler.http_server.address)
+        assert address == "127.0.0.1"
+    finally:
+        engine.close()
+        if holder is not None:
+            holder.close()
