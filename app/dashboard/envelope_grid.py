@@ -181,27 +181,9 @@ class EnvelopeGrid(QueuedStudyControls):
                                             css_classes=["loads-points-y"])
         self.fault = pn.widgets.Select(label="fault instant", options=FAULTS, value="roots",
                                        width=420, css_classes=["loads-fault"])
-        self.where = pn.pane.HTML(
-            f"runs on {html.escape(settings.engine_description, quote=False)}; at most "
-            f"{settings.max_study_points} scenarios (grid points × fault instants), "
-            f"{settings.max_running_studies} stud{'y' if settings.max_running_studies == 1 else 'ies'} "
-            "at a time, one per session (the server's settings)", css_classes=["loads-where"],
-            sizing_mode="stretch_width")
-        self.start_button = pn.widgets.Button(label="Start envelope", color="primary",
-                                              css_classes=["loads-start"], width=140)
-        self.stop_button = pn.widgets.Button(label="Stop", css_classes=["loads-stop"], width=80,
-                                             disabled=True)
-        self.store_select = pn.widgets.Select(label="finished envelope (server's studies folder)",
-                                              options=[], css_classes=["loads-store"], width=360)
-        self.open_button = pn.widgets.Button(label="Open envelope", css_classes=["loads-open"],
-                                             width=130)
-        self.refresh_button = pn.widgets.Button(label="↻", css_classes=["loads-refresh"],
-                                                width=45, description="update the list")
-        self.progress = pn.indicators.Progress(value=0, max=1, css_classes=["loads-progress"],
-                                               width=360, visible=False)
-        self.status = pn.pane.HTML("", css_classes=["loads-status"], sizing_mode="stretch_width")
-        self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
-                                    css_classes=["loads-notice"], sizing_mode="stretch_width")
+        self._build_queue_controls("loads", "scenarios (grid points × fault instants)",
+                                   "Start envelope", "finished envelope (server's studies folder)",
+                                   "Open envelope", "update the list")
         parts = {f"{name.split('.')[0]} {compute.PART_LABELS[name.split('.', 1)[1]]}": name
                  for name in compute.DRIVE_PARTS}
         self.map_output = pn.widgets.Select(label="heat map of", options=parts,

@@ -150,27 +150,9 @@ class StudiesView(QueuedStudyControls, pn.viewable.Viewer):
         self.v_points = pn.widgets.IntInput(label="v points", value=20, start=1,
                                             end=settings.max_study_points,
                                             css_classes=["study-v-points"], width=110)
-        self.where = pn.pane.HTML(
-            f"runs on {html.escape(settings.engine_description, quote=False)}; at most "
-            f"{settings.max_study_points} points (s0 × v), "
-            f"{settings.max_running_studies} stud{'y' if settings.max_running_studies == 1 else 'ies'} "
-            "at a time (the server's settings)", css_classes=["study-where"],
-            sizing_mode="stretch_width")
-        self.start_button = pn.widgets.Button(label="Start map", color="primary",
-                                              css_classes=["study-start"], width=120)
-        self.stop_button = pn.widgets.Button(label="Stop", css_classes=["study-stop"], width=80,
-                                             disabled=True)
-        self.store_select = pn.widgets.Select(label="finished map (server's studies folder)",
-                                              options=[], css_classes=["study-store"], width=360)
-        self.open_button = pn.widgets.Button(label="Open map", css_classes=["study-open"],
-                                             width=120)
-        self.refresh_button = pn.widgets.Button(label="↻", css_classes=["study-refresh"],
-                                                width=45, description="update both lists")
-        self.progress = pn.indicators.Progress(value=0, max=1, css_classes=["study-progress"],
-                                               width=360, visible=False)
-        self.status = pn.pane.HTML("", css_classes=["study-status"], sizing_mode="stretch_width")
-        self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
-                                    css_classes=["study-notice"], sizing_mode="stretch_width")
+        self._build_queue_controls("study", "points (s0 × v)", "Start map",
+                                   "finished map (server's studies folder)", "Open map",
+                                   "update both lists")
         self.plot = StudyMapPlot()
         # an uncertainty result's s0*(v) band over the map (app/dashboard/uncertainty_band.py)
         self.uncertainty: UncertaintyBand | None = None
