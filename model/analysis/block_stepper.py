@@ -143,26 +143,23 @@ def march(k0, k1, inputs: StepInputs, zeta, phi, z, u2_now, det_state, Y_out, z_
     ``iterations`` in place (``u2_now``: ΔM_2 at step k0 [N m]).  Returns 0, or the step at which
     Newton failed (negative)."""
     i = inputs
-    blocks = i.blocks
+    creep = i.blocks.creep
     nc = z.shape[0]
-    law = tuple(float(x) for x in i.law_params)
-    creep = blocks.creep
-    detect = np.asarray(i.detect_rows, dtype=float)
-    scale = float(i.contact_scale)
+    fixed = _MarchConstants(basis=np.vstack([i.cp, i.cm, i.p0_2, i.p1_2]).astype(complex),
+                            law=tuple(float(x) for x in i.law_params),
+                            detect=np.asarray(i.detect_rows, dtype=float),
+                            scale=float(i.contact_scale))
     slope = np.zeros(nc)  # r'(z) of the given step (Newton's start of the first block)
     if not i.tangent:
-        slope[creep] = i.N0 / i.v * (polach_mu_and_slope(i.s0 + z[creep] / i.v, i.v, *law)[1]
+        slope[creep] = i.N0 / i.v * (polach_mu_and_slope(i.s0 + z[creep] / i.v, i.v, *fixed.law)[1]
                                      - i.dmu_s0)
     state = _LoopState(zeta.copy(), phi.copy(), z.copy(), float(u2_now), float(det_state[0]),
                        slope)
-    basis = np.vstack([i.cp, i.cm, i.p0_2, i.p1_2]).astype(complex)  # 4 x m
+    out = _Buffers(Y_out, z_out, phi_out, u2_out)
     row, L = 0, SUB_STEPS
     while row < k1 - k0:
         L = min(L, k1 - k0 - row)
-        done = _block(state, k0 + row, L, row, i.h, blocks, i.E, i.inc_step, basis, i.g_step,
-                      i.g0, i.P0, law, i.s0, i.v, i.N0, i.mu_s0, i.dmu_s0, i.tangent, creep,
-                      detect, i.threshold, i.M_step, i.delay, i.rate, i.floor, scale, Y_out,
-                      z_out, phi_out, u2_out, iterations)
+        done = _block(state, k0 + row, L, row, i, fixed, out, iterations)
         if done == 0:
             if L == 1:
                 return -(k0 + row + 1)
@@ -200,103 +197,157 @@ class _LoopState:
         self.slope = slope  # r'(z) of the creep channels at the step [N s/m]
 
 
-def _block(state, kb, L, row0, h, blocks, E, inc_step, basis, g_step, g0, P0, law, s0, v, N0,
-           mu_s0, dmu_s0, tangent, creep, detect, threshold, M_step, delay, rate, floor, scale,
-           Y_out, z_out, phi_out, u2_out, iterations) -> int:
+@dataclass(frozen=True)
+class _MarchConstants:
+    """What :func:`march` prepares once for its blocks from the run's :class:`StepInputs`."""
+
+    basis: np.ndarray  # 4 x m: cp, cm, p0_2, p1_2 (the weights of the block's inputs)
+    law: tuple  # Polach's law parameters as floats
+    detect: np.ndarray  # channels: weights of ID2's wheelset slip velocity
+    scale: float  # velocity added to |z| in Newton's relative change [m/s]
+
+
+@dataclass(frozen=True)
+class _Buffers:
+    """The rows of one :func:`march` call: outputs, channel values, remainders, ΔM_2."""
+
+    Y: np.ndarray
+    z: np.ndarray
+    phi: np.ndarray
+    u2: np.ndarray
+
+
+def _block(state: _LoopState, kb: int, L: int, row0: int, inputs: StepInputs,
+           fixed: _MarchConstants, out: _Buffers, iterations) -> int:
     """Solve steps kb+1 … kb+L from ``state``; returns the number of accepted steps (0: Newton
-    did not converge) and advances ``state`` to the last of them."""
+    did not converge) and advances ``state`` to the last of them, whose rows from ``row0`` on it
+    writes into ``out``."""
     nc = state.z.shape[0]
-    t1 = (kb + 1 + np.arange(L)) * h  # ends of the steps
-    # ΔM_2 and the slope channel's scaling ρ at the end of each step (detection known so far)
+    t1, reduction, u2, forced, projected = _forced_block(state, kb, L, inputs, fixed.basis)
+    solved = _solve_remainders(state, L, inputs, fixed, projected[:, :nc].reshape(-1), reduction)
+    if solved is None:
+        return 0
+    zf, r, dr, count = solved
+    zb, rb = zf.reshape(L, nc), r.reshape(L, nc)
+    accepted = L
+    if state.detection < 0.0:
+        accepted = _cut_at_detection(state, zb, t1, inputs, fixed.detect)
+    _accept(state, accepted, row0, inputs.blocks, forced, projected, zb, rb, dr, u2, out)
+    iterations[0] += count * accepted  # every accepted step took part in `count` iterations
+    return accepted
+
+
+def _forced_block(state: _LoopState, kb: int, L: int, i: StepInputs, basis: np.ndarray):
+    """The block's steps without their remainders: the ends of the steps t1 [s], the torque
+    reduction's fraction and ΔM_2 [N m] at each (from the detection known so far), the forced
+    modal states and their projection on the channels and outputs (L x (channels, outputs))."""
+    t1 = (kb + 1 + np.arange(L)) * i.h
     reduction = np.zeros(L)
     if state.detection >= 0.0:
-        reduction = (1.0 - floor) * np.clip(rate * (t1 - state.detection - delay), 0.0, 1.0)
-    u2 = -M_step * reduction
+        reduction = (1.0 - i.floor) * np.clip(i.rate * (t1 - state.detection - i.delay), 0.0, 1.0)
+    u2 = -i.M_step * reduction
     u2_before = np.concatenate([[state.u2], u2[:-1]])
     # forced modal states without the block's remainders: b_0 = E ζ + F + P0 φ, b_(i+1) = E b_i + …
     inputs = np.empty((L, 4), dtype=complex)  # the weights of cp, cm, p0_2, p1_2 (``basis``)
-    inputs[:, 0] = g0 * np.power(complex(g_step), np.arange(kb, kb + L))
+    inputs[:, 0] = i.g0 * np.power(complex(i.g_step), np.arange(kb, kb + L))
     inputs[:, 1] = inputs[:, 0].conj()
     inputs[:, 2] = u2_before
     inputs[:, 3] = u2
     forcing = inputs @ basis
-    forcing += inc_step
-    forcing[0] += E * state.zeta + P0 @ state.phi
-    forced = _recurrence(blocks.doubling, forcing)
-    projected = (forced @ blocks.projection).real  # L x (channels, outputs)
-    a = projected[:, :nc].reshape(-1)  # L·nc
+    forcing += i.inc_step
+    forcing[0] += i.E * state.zeta + i.P0 @ state.phi
+    forced = _recurrence(i.blocks.doubling, forcing)
+    projected = (forced @ i.blocks.projection).real
+    return t1, reduction, u2, forced, projected
+
+
+def _solve_remainders(state: _LoopState, L: int, i: StepInputs, fixed: _MarchConstants,
+                      a: np.ndarray, reduction: np.ndarray):
+    """Newton on ``z = a + T r(z)`` for the block's L·nc channel values (``a``: the forced
+    values); (z, r, r'(z), iterations), or None when it does not converge."""
+    blocks = i.blocks
+    nc = state.z.shape[0]
     T = blocks.full[:L * nc, :L * nc]
     is_creep = blocks.is_creep[:L * nc]
     slope_scale = -np.repeat(reduction, nc)[~is_creep]
     dr = np.zeros(L * nc)
     dr[~is_creep] = slope_scale
-    tangent_slope = N0 * dmu_s0 / v
+    tangent_slope = i.N0 * i.dmu_s0 / i.v
     trtrs = blocks.trtrs
     # Newton's start: the block solved with the remainders linearized about the last step,
     # r ≈ r_last + r'_last (z − z_last) (one triangular solve, no evaluation of the law)
-    dr[is_creep] = np.tile(state.slope[creep], L)
+    dr[is_creep] = np.tile(state.slope[blocks.creep], L)
     offset = np.tile(state.phi - state.slope * state.z, L)
     offset[~is_creep] = 0.0
     zf, info = trtrs(blocks.newton_matrix(L, dr), -(a + T @ offset), lower=1)
     if info != 0:
-        return 0
+        return None
     r = np.empty(L * nc)
     count = 0
     while True:
         zc = zf[is_creep]
-        if tangent:
-            r[is_creep] = N0 * ((mu_s0 + dmu_s0 * (zc / v)) - mu_s0) - tangent_slope * zc
+        if i.tangent:
+            r[is_creep] = i.N0 * ((i.mu_s0 + i.dmu_s0 * (zc / i.v)) - i.mu_s0) - tangent_slope * zc
         else:
-            mu_v, dmu_v = polach_mu_and_slope(s0 + zc / v, v, *law)
-            r[is_creep] = N0 * (mu_v - mu_s0) - tangent_slope * zc
-            dr[is_creep] = N0 / v * (dmu_v - dmu_s0)
+            mu_v, dmu_v = polach_mu_and_slope(i.s0 + zc / i.v, i.v, *fixed.law)
+            r[is_creep] = i.N0 * (mu_v - i.mu_s0) - tangent_slope * zc
+            dr[is_creep] = i.N0 / i.v * (dmu_v - i.dmu_s0)
         r[~is_creep] = slope_scale * zf[~is_creep]
         residual = a + T @ r - zf
         step, info = trtrs(blocks.newton_matrix(L, dr), residual, lower=1)
         if info != 0:
-            return 0
+            return None
         zf = zf - step
         r = r - dr * step  # the remainders at the new values to first order (O(step²) ≈ 1e-24)
         count += 1
-        change = float(np.max(np.abs(step) / (np.abs(zf) + scale)))
+        change = float(np.max(np.abs(step) / (np.abs(zf) + fixed.scale)))
         if not math.isfinite(change):
-            return 0
+            return None
         if change <= TOLERANCE:
-            break
+            return zf, r, dr, count
         if count >= MAX_ITERATIONS:
-            return 0
-    zb = zf.reshape(L, nc)
-    rb = r.reshape(L, nc)
-    # detection on ID2's wheelset slip velocity (mean of its wheels); the block is cut where the
-    # torque reduction that follows from it starts
-    accepted = L
-    if state.detection < 0.0:
-        slip = zb @ detect
-        over = np.flatnonzero(np.abs(slip) > threshold)
-        if len(over):
-            i = int(over[0])
-            before = abs(float(state.z @ detect)) if i == 0 else abs(float(slip[i - 1]))
-            fraction = (threshold - before) / (abs(slip[i]) - before) if before < threshold else 0.0
-            state.detection = float(t1[i] - h + h * min(1.0, max(0.0, fraction)))
-            late = np.flatnonzero(t1[i + 1:] > state.detection + delay)
-            if len(late):
-                accepted = i + 1 + int(late[0])
+            return None
+
+
+def _cut_at_detection(state: _LoopState, zb: np.ndarray, t1: np.ndarray, i: StepInputs,
+                      detect: np.ndarray) -> int:
+    """Detection on ID2's wheelset slip velocity (mean of its wheels) in a block solved without
+    it: sets ``state.detection`` [s] where the slip first exceeds the threshold (interpolated
+    within the step) and returns the steps to accept, up to where the torque reduction that
+    follows from it starts (all L if the slip stays below)."""
+    L = len(t1)
+    slip = zb @ detect
+    over = np.flatnonzero(np.abs(slip) > i.threshold)
+    if not len(over):
+        return L
+    k = int(over[0])
+    before = abs(float(state.z @ detect)) if k == 0 else abs(float(slip[k - 1]))
+    fraction = (i.threshold - before) / (abs(slip[k]) - before) if before < i.threshold else 0.0
+    state.detection = float(t1[k] - i.h + i.h * min(1.0, max(0.0, fraction)))
+    late = np.flatnonzero(t1[k + 1:] > state.detection + i.delay)
+    return k + 1 + int(late[0]) if len(late) else L
+
+
+def _accept(state: _LoopState, accepted: int, row0: int, blocks: _Blocks, forced, projected, zb,
+            rb, dr, u2, out: _Buffers) -> None:
+    """Write the first ``accepted`` steps of the block into ``out`` from ``row0`` on and carry its
+    last one in ``state``."""
     # outputs with the remainders: y_i = Re(V ζ_forced,i) + Σ_j Re(V E^(i−1−j) Q) r_j + Re(V P1) r_i;
     # the last state: ζ_(n−1) = ζ_forced,(n−1) + Σ_(j < n−1) E^(n−2−j) Q r_j + P1 r_(n−1)
+    nc = zb.shape[1]
     n_out = blocks.rows_out
-    Y_out[row0:row0 + accepted] = projected[:accepted, nc:] + (
+    r = rb.reshape(-1)
+    out.Y[row0:row0 + accepted] = projected[:accepted, nc:] + (
         blocks.outputs[:accepted * n_out, :accepted * nc] @ r[:accepted * nc]).reshape(accepted, n_out)
     last = forced[accepted - 1] + blocks.P1 @ rb[accepted - 1]
     if accepted > 1:
         weights = blocks.powers[accepted - 2::-1].T @ rb[:accepted - 1]  # m x nc
         last += (blocks.Q * weights).sum(axis=1)
-    z_out[row0:row0 + accepted] = zb[:accepted]
-    phi_out[row0:row0 + accepted] = rb[:accepted]
-    u2_out[row0:row0 + accepted] = u2[:accepted]
+    out.z[row0:row0 + accepted] = zb[:accepted]
+    out.phi[row0:row0 + accepted] = rb[:accepted]
+    out.u2[row0:row0 + accepted] = u2[:accepted]
     state.zeta = last
     state.phi = rb[accepted - 1].copy()
-    state.slope = np.where(creep, dr.reshape(L, nc)[accepted - 1], 0.0)
+    state.slope = np.where(blocks.creep, dr.reshape(len(zb), nc)[accepted - 1], 0.0)
     state.z = zb[accepted - 1].copy()
     state.u2 = float(u2[accepted - 1])
-    iterations[0] += count * accepted  # every accepted step took part in `count` iterations
-    return accepted
