@@ -62,7 +62,6 @@ from model.studies.calibration_bounds import (
     CREEP_SHAPE_PARAMETERS,
     FREE_PARAMETERS,
     SEARCH_PARAMETERS,
-    FreeParameter,
     constraint_values,
     with_constraints,
 )
@@ -85,6 +84,7 @@ from model.studies.calibration_targets import (
     reference_point,
     signature_assignment,
 )
+from model.studies.parameter_ranges import ParameterRange
 
 # --- residual scales -----------------------------------------------------------------------------
 FREQUENCY_SCALE = 0.03  # [-] the literature tests' aim for the imaginary parts (log error)
@@ -478,7 +478,7 @@ def _phase(x0: np.ndarray, start: Parameters, free, x_prior: np.ndarray, weights
 
 
 def jacobian_stage(start: Parameters, progress: Callable = print,
-                   free: tuple[FreeParameter, ...] | None = None,
+                   free: tuple[ParameterRange, ...] | None = None,
                    phases: tuple = PHASES) -> Parameters:
     """Stage J (see above) from ``start`` (its values are the prior; stage A is solved inside
     every evaluation): for each of ``phases`` (trial sets, :class:`Weights`) scipy's bounded

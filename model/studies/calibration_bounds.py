@@ -1,45 +1,32 @@
-"""The calibration's free parameters: each with its bounds and the reason for them, the
-physical constraints between them (a rigid body's principal inertias, Polach's kS <= kA), whether
-a value sits on a bound, and the parameter table that ``bogie parameters`` and the dashboard's
-Variant tab show.  Plain data and arithmetic: no model is built here.
+"""The calibration's free parameters: each with its bounds and the reason for them (a
+:class:`~model.studies.parameter_ranges.ParameterRange`), the physical constraints between them (a
+rigid body's principal inertias, Polach's kS <= kA), and the parameter table that
+``bogie parameters`` and the dashboard's Variant tab show (with whether a value sits on a bound).
+Plain data and arithmetic: no model is built here.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
-
 import numpy as np
 
 from model.mechanics.parameters import SCHEMA, Parameters
-
-
-@dataclass(frozen=True)
-class FreeParameter:
-    """A parameter the calibration fits, within bounds whose source ``reason`` names."""
-
-    name: str
-    low: float  # calibration bounds [the parameter's unit]
-    high: float
-    reason: str  # the source of the bounds
-    log: bool = True  # searched on its logarithm (False: on its value, e.g. a height)
-
+from model.studies.parameter_ranges import ParameterRange
 
 # stage A: creep law and gear ratio against the operating data (exactly determined)
 CREEP_PARAMETERS = (
-    FreeParameter("polach_mu0", 0.3, 0.8, "dry rail friction coefficient"),
-    FreeParameter("polach_A", 0.2, 0.9, "Polach's A (0.4 in his presets)"),
-    FreeParameter("polach_B", 0.05, 3.0, "Polach's B [s/m] (0.2–0.6 in his presets)"),
-    FreeParameter("gear_ratio", 3.0, 4.06, "p <= M_ad/M = 4.06 (spec), > 3 for a 200 km/h loco"),
+    ParameterRange("polach_mu0", 0.3, 0.8, "dry rail friction coefficient"),
+    ParameterRange("polach_A", 0.2, 0.9, "Polach's A (0.4 in his presets)"),
+    ParameterRange("polach_B", 0.05, 3.0, "Polach's B [s/m] (0.2–0.6 in his presets)"),
+    ParameterRange("gear_ratio", 3.0, 4.06, "p <= M_ad/M = 4.06 (spec), > 3 for a 200 km/h loco"),
 )
 # the creep law's shape, searched with the structure (stage A re-solved for each shape): Polach's
 # reduction factors within his published range (wet 0.3/0.1 … dry 1.0/0.4, kS <= kA), the initial
 # slope between Kalker's value for this contact (~130) and 5x the spec's starting fit
 CREEP_SHAPE_PARAMETERS = (
-    FreeParameter("polach_kA", 0.3, 1.0, "Polach's range: wet 0.3 … dry 1.0"),
-    FreeParameter("polach_kS", 0.1, 0.4, "Polach's range: wet 0.1 … dry 0.4; kS <= kA"),
-    FreeParameter("creep_slope", 130.0, 3000.0, "Kalker's slope for this contact (~130) … 5x the "
-                  "spec's starting fit (600)"),
+    ParameterRange("polach_kA", 0.3, 1.0, "Polach's range: wet 0.3 … dry 1.0"),
+    ParameterRange("polach_kS", 0.1, 0.4, "Polach's range: wet 0.1 … dry 0.4; kS <= kA"),
+    ParameterRange("creep_slope", 130.0, 3000.0, "Kalker's slope for this contact (~130) … 5x the "
+                   "spec's starting fit (600)"),
 )
 # stage J: the structure, the dampers and the motor slope against Table 1.  Inertias and
 # stiffnesses within about x3 of their estimate and within what the part can be; bounds that the
@@ -47,75 +34,64 @@ CREEP_SHAPE_PARAMETERS = (
 # tightened to physical limits of the frame (4.9 t with its equipment) and a 2.6 t motor with
 # its gear housing
 STRUCTURAL_PARAMETERS = (
-    FreeParameter("secondary_stiffness_z", 2e5, 1.8e6, "x3 around 0.6 MN/m (1.26 Hz with 28 t)"),
-    FreeParameter("disc_clutch_torsional_stiffness", 2.3e4, 2.1e5, "x3 around 7e4 N m/rad"),
-    FreeParameter("primary_stiffness_z", 3.7e5, 3.3e6, "coil springs per axle box, x3 around "
-                  "1.1 MN/m"),
-    FreeParameter("primary_stiffness_y", 3.3e5, 1e7, "coil spring shear 0.3–1 MN/m up to a "
-                  "rubber-bushed lateral guide 10 MN/m per axle box"),
-    FreeParameter("primary_stiffness_x", 1.7e6, 1.5e7, "longitudinal guide (rubber bushes), x3 "
-                  "around 5 MN/m"),
-    FreeParameter("silent_block_stiffness_x", 2.7e6, 2.4e7, "rubber-metal block, x3 around 8 MN/m"),
-    FreeParameter("silent_block_stiffness_y", 1.3e6, 1.2e7, "rubber-metal block, x3 around 4 MN/m"),
-    FreeParameter("silent_block_stiffness_z", 2.7e6, 2.4e7, "rubber-metal block, x3 around 8 MN/m"),
-    FreeParameter("rim_torsional_stiffness", 6.7e6, 6e7, "rubber-sprung wheel, x3 around "
-                  "2e7 N m/rad"),
-    FreeParameter("driving_shaft_stiffness", 2.1e6, 1.9e7, "steel quill shaft, x3 around "
-                  "6.4 MN m/rad"),
+    ParameterRange("secondary_stiffness_z", 2e5, 1.8e6, "x3 around 0.6 MN/m (1.26 Hz with 28 t)"),
+    ParameterRange("disc_clutch_torsional_stiffness", 2.3e4, 2.1e5, "x3 around 7e4 N m/rad"),
+    ParameterRange("primary_stiffness_z", 3.7e5, 3.3e6, "coil springs per axle box, x3 around "
+                   "1.1 MN/m"),
+    ParameterRange("primary_stiffness_y", 3.3e5, 1e7, "coil spring shear 0.3–1 MN/m up to a "
+                   "rubber-bushed lateral guide 10 MN/m per axle box"),
+    ParameterRange("primary_stiffness_x", 1.7e6, 1.5e7, "longitudinal guide (rubber bushes), x3 "
+                   "around 5 MN/m"),
+    ParameterRange("silent_block_stiffness_x", 2.7e6, 2.4e7, "rubber-metal block, x3 around 8 MN/m"),
+    ParameterRange("silent_block_stiffness_y", 1.3e6, 1.2e7, "rubber-metal block, x3 around 4 MN/m"),
+    ParameterRange("silent_block_stiffness_z", 2.7e6, 2.4e7, "rubber-metal block, x3 around 8 MN/m"),
+    ParameterRange("rim_torsional_stiffness", 6.7e6, 6e7, "rubber-sprung wheel, x3 around "
+                   "2e7 N m/rad"),
+    ParameterRange("driving_shaft_stiffness", 2.1e6, 1.9e7, "steel quill shaft, x3 around "
+                   "6.4 MN m/rad"),
     # the frame with what it carries, 4.9 t (the rest of the 16 t bogie): a 3.5 t structure
     # (side members, ~60 % of it, at y = ±1.0 m over x = ±1.75 m; cross members near the centre)
     # and ~1.4 t of equipment near the wheels; all of it at the outer edges (the physical limit)
     # would give I_x ≈ 4 900 · 1.1² ≈ 5 900, I_y ≈ 4 900 · 1.6² ≈ 12 500 kg m^2
-    FreeParameter("frame_inertia_x", 1400.0, 4200.0, "4.9 t frame with equipment, 2.2 m wide: "
-                  "~2 800 kg m^2; x½ … x1.5"),
-    FreeParameter("frame_inertia_y", 2300.0, 7000.0, "4.9 t frame with equipment, 3.5 m long: "
-                  "~4 600 kg m^2; x½ … x1.5"),
-    FreeParameter("frame_inertia_z", 3500.0, 11000.0, "~7 000 kg m^2, x½ … x1.6; |I_x − I_y| <= "
-                  "I_z <= I_x + I_y (see constraint_values)"),
+    ParameterRange("frame_inertia_x", 1400.0, 4200.0, "4.9 t frame with equipment, 2.2 m wide: "
+                   "~2 800 kg m^2; x½ … x1.5"),
+    ParameterRange("frame_inertia_y", 2300.0, 7000.0, "4.9 t frame with equipment, 3.5 m long: "
+                   "~4 600 kg m^2; x½ … x1.5"),
+    ParameterRange("frame_inertia_z", 3500.0, 11000.0, "~7 000 kg m^2, x½ … x1.6; |I_x − I_y| <= "
+                   "I_z <= I_x + I_y (see constraint_values)"),
     # 2.6 t: a 0.7 m motor (cylinder, m r²/2 ≈ 160 kg m^2) plus a gear housing reaching to the axle
-    FreeParameter("stator_inertia_y", 90.0, 400.0, "2.6 t motor (~160 kg m^2 as a 0.7 m "
-                  "cylinder) with its gear housing towards the axle (~150 kg m^2)"),
+    ParameterRange("stator_inertia_y", 90.0, 400.0, "2.6 t motor (~160 kg m^2 as a 0.7 m "
+                   "cylinder) with its gear housing towards the axle (~150 kg m^2)"),
     # the yaw dampers act between frame and car body (which moves longitudinally and in yaw),
     # each in series with its end bushes
-    FreeParameter("yaw_damping", 5e4, 1e6, "yaw damper of a 200 km/h loco, 0.05–1 MN s/m"),
-    FreeParameter("yaw_damper_height", 0.05, 0.6, "between the axle height and the car body "
-                  "floor; decides how the yaw dampers couple the frame's pitch"),
-    FreeParameter("yaw_damper_series_stiffness", 3e6, 3e7, "rubber end bushes of a hydraulic "
-                  "damper, 5–15 MN/m, x½ … x2"),
-    FreeParameter("traction_link_stiffness", 3e6, 3e7, "rubber-bushed traction rod, 5–20 MN/m, "
-                  "x0.6 … x1.5"),
-    FreeParameter("anti_roll_bar_stiffness", 3e5, 5e6, "torsion bar of a locomotive or coach, "
-                  "1–3 MN m/rad, x⅓ … x1.7"),
-    FreeParameter("traction_link_height", -0.45, 0.3, "between ~0.2 m above the rail and the "
-                  "frame's upper chord", log=False),
-    FreeParameter("primary_damping_z", 200.0, 3e4, "primary vertical damper per axle box, up to "
-                  "a typical 30 kN s/m"),
-    FreeParameter("secondary_damping_z", 200.0, 3e4, "secondary vertical damper per spring, up "
-                  "to a typical 30 kN s/m"),
-    FreeParameter("secondary_damping_y", 2e3, 1e5, "secondary lateral damper per side"),
-    FreeParameter("rotor_inertia", 6.0, 24.0, "rotor of 550 kg, radius of gyration 0.10–0.21 m; "
-                  "x½ … x2 around 12 kg m^2"),
+    ParameterRange("yaw_damping", 5e4, 1e6, "yaw damper of a 200 km/h loco, 0.05–1 MN s/m"),
+    ParameterRange("yaw_damper_height", 0.05, 0.6, "between the axle height and the car body "
+                   "floor; decides how the yaw dampers couple the frame's pitch"),
+    ParameterRange("yaw_damper_series_stiffness", 3e6, 3e7, "rubber end bushes of a hydraulic "
+                   "damper, 5–15 MN/m, x½ … x2"),
+    ParameterRange("traction_link_stiffness", 3e6, 3e7, "rubber-bushed traction rod, 5–20 MN/m, "
+                   "x0.6 … x1.5"),
+    ParameterRange("anti_roll_bar_stiffness", 3e5, 5e6, "torsion bar of a locomotive or coach, "
+                   "1–3 MN m/rad, x⅓ … x1.7"),
+    ParameterRange("traction_link_height", -0.45, 0.3, "between ~0.2 m above the rail and the "
+                   "frame's upper chord", log=False),
+    ParameterRange("primary_damping_z", 200.0, 3e4, "primary vertical damper per axle box, up to "
+                   "a typical 30 kN s/m"),
+    ParameterRange("secondary_damping_z", 200.0, 3e4, "secondary vertical damper per spring, up "
+                   "to a typical 30 kN s/m"),
+    ParameterRange("secondary_damping_y", 2e3, 1e5, "secondary lateral damper per side"),
+    ParameterRange("rotor_inertia", 6.0, 24.0, "rotor of 550 kg, radius of gyration 0.10–0.21 m; "
+                   "x½ … x2 around 12 kg m^2"),
     # b_M (docs/validation.md, "The motor slope"): the converter holds the healthy motor's torque
     # for slow motions — on the constant-power hyperbola M ω = P the slope is M/ω = 12 800 N m /
     # 212 rad/s ≈ 60 N m s/rad; faster than its torque control the motor shows its natural
     # characteristic, M/(s_n ω_s) ≈ 12 800 / (0.005 · 214) ≈ 12 000 N m s/rad at 0.5 % slip
-    FreeParameter("motor_slope", 60.0, 12000.0, "asynchronous drive between its controlled "
-                  "characteristic (constant power, M/ω ≈ 60) and its natural one at 0.5 % slip "
-                  "(≈ 12 000 N m s/rad)"),
+    ParameterRange("motor_slope", 60.0, 12000.0, "asynchronous drive between its controlled "
+                   "characteristic (constant power, M/ω ≈ 60) and its natural one at 0.5 % slip "
+                   "(≈ 12 000 N m s/rad)"),
 )
 SEARCH_PARAMETERS = CREEP_SHAPE_PARAMETERS + STRUCTURAL_PARAMETERS
 FREE_PARAMETERS = CREEP_PARAMETERS + SEARCH_PARAMETERS
-BOUND_TOLERANCE = 1e-3  # a value this close to a bound sits on it (relative; of the range if linear)
-
-
-def on_bound(free: FreeParameter, value: float) -> bool:
-    """Whether ``value`` sits on one of the calibration bounds of ``free``: within 0.1 % of it
-    (log-searched parameters), or within 0.1 % of the range (the others)."""
-    if free.log:
-        return min(abs(math.log(value / free.low)), abs(math.log(value / free.high))) \
-            <= BOUND_TOLERANCE
-    return min(abs(value - free.low), abs(value - free.high)) \
-        <= BOUND_TOLERANCE * (free.high - free.low)
 
 
 # a rigid body's principal inertias obey the triangle inequalities |I_x − I_y| <= I_z <= I_x + I_y
@@ -155,5 +131,5 @@ def parameter_rows(parameters: Parameters) -> list[dict]:
         rows.append({"name": name, "value": value, "unit": unit,
                      "note": parameters.notes.get(name, ""),
                      "lower": None if f is None else f.low, "upper": None if f is None else f.high,
-                     "on_bound": None if f is None else on_bound(f, value)})
+                     "on_bound": None if f is None else f.on_bound(value)})
     return rows

@@ -1,8 +1,9 @@
 """Uncertainty of the verdicts from the unpublished parameters: quasi-Monte-Carlo and Sobol indices.
 
 Every parameter in :data:`UNCERTAIN_PARAMETERS` is an estimate (nothing about it was published);
-each gets a documented **prior range** (the reason next to it), sampled log-uniformly (uniform
-for the loss time) by a scrambled Sobol' sequence (``scipy.stats.qmc`` through
+each gets a documented **prior range** (a :class:`~model.studies.parameter_ranges.ParameterRange`,
+the reason next to it; for a parameter the calibration fits, within its calibration bounds),
+sampled log-uniformly (uniform for the loss time) by a scrambled Sobol' sequence (``scipy.stats.qmc`` through
 ``scipy.stats.sobol_indices``, Saltelli 2010 estimators, bootstrap confidence intervals).  The
 other parameters stay at the calibrated set's values.
 
@@ -45,6 +46,7 @@ from scipy import stats
 
 from model.analysis.sensitivity import MODE_COUNT
 from model.mechanics.parameters import ParameterError, Parameters
+from model.studies.parameter_ranges import ParameterRange
 
 V_SPEEDS_KMH = (120.0, 200.0)
 S0_MODES = 0.005  # creepage of the mode table and the short circuit [-]
@@ -74,49 +76,35 @@ class UncertaintyError(ValueError):
     """Bad input for an uncertainty study (one-line message)."""
 
 
-@dataclass(frozen=True)
-class UncertainParameter:
-    """An unpublished parameter and its prior range [schema unit]."""
-
-    name: str
-    low: float
-    high: float
-    reason: str
-    log: bool = True  # log-uniform (scale parameters) or uniform
-
-    def distribution(self):
-        return stats.loguniform(self.low, self.high) if self.log else stats.uniform(
-            self.low, self.high - self.low)
-
-
-UNCERTAIN_PARAMETERS: tuple[UncertainParameter, ...] = (
-    UncertainParameter("creep_slope", 445.0, 890.0, "the calibrated creep shape (kA 0.89, kS "
-                       "0.23) needs ~670 (docs/validation.md); Hertz+Kalker would give ~130, "
-                       "so ±1/3 around the fit"),
-    # over this box (a grid of 7 values each of slope, A and B) the creep law has a maximum
-    # below s = 1 everywhere at 40–120 km/h (the response at 120 km/h needs it for M_ad); at 160,
-    # 200, 250 km/h not at 7, 28, 58 of the 343 points (small slope, large A and B): there s0*
-    # takes the full search
-    UncertainParameter("polach_A", 0.4, 0.6, "Polach's presets 0.4; calibrated 0.53"),
-    UncertainParameter("polach_B", 2.0, 4.0, "Polach's presets 0.2–0.6 s/m; calibrated 3.0 (the "
-                       "calibration's bound), ÷ 1.5 … x1.33"),
-    UncertainParameter("motor_slope", 1000.0, 12000.0, "torque falls 12.8 kN m over 0.5–6 % of "
-                       "213 rad/s (converter control unknown); calibrated 1 140"),
-    UncertainParameter("rubber_loss_time", 1e-4, 4e-4, "rubber loss factor 0.05–0.2 at ~80 Hz",
-                       log=False),
-    UncertainParameter("disc_clutch_torsional_stiffness", 3.5e4, 1e5, "rubber disc clutch; "
-                       "calibrated 5.7e4 from the 2.7 Hz mode"),
-    UncertainParameter("driving_shaft_stiffness", 6e6, 1.2e7, "quill shaft; calibrated 8.5e6 "
-                       "from the 298 Hz mode"),
-    UncertainParameter("rotor_inertia", 8.0, 18.0, "550 kg rotor, radius of gyration 0.12–0.18 m"),
-    UncertainParameter("silent_block_stiffness_x", 1.03e7, 2.4e7, "rubber-metal block, "
-                       "calibrated 2.06e7 (÷ 2; up to the calibration's bound 2.4e7)"),
-    UncertainParameter("primary_stiffness_x", 1.8e6, 7.3e6, "longitudinal guide, calibrated "
-                       "3.6e6 (×/÷ 2)"),
-    UncertainParameter("yaw_damping", 4.3e5, 1.72e6, "yaw damper, calibrated 8.6e5 (×/÷ 2)"),
-    UncertainParameter("yaw_damper_series_stiffness", 9.4e6, 3.7e7, "the yaw dampers' end "
-                       "bushes, calibrated 1.87e7 (×/÷ 2)"),
-    UncertainParameter("gear_mesh_stiffness", 7.5e8, 3e9, "~7–30 N/(µm mm) × 100 mm face width"),
+UNCERTAIN_PARAMETERS: tuple[ParameterRange, ...] = (
+    ParameterRange("creep_slope", 445.0, 890.0, "the calibrated creep shape (kA 0.89, kS "
+                   "0.23) needs ~670 (docs/validation.md); Hertz+Kalker would give ~130, "
+                   "so ±1/3 around the fit"),
+    # over this box (a grid of 7 values each of slope, A and B, geometric) the creep law has a
+    # maximum below s = 1 everywhere at 40–160 km/h (the response at 120 km/h needs it for M_ad);
+    # at 200 and 250 km/h not at 6 and 31 of the 343 points (small slope, large A and B): there
+    # s0* takes the full search
+    ParameterRange("polach_A", 0.4, 0.6, "Polach's presets 0.4; calibrated 0.53"),
+    ParameterRange("polach_B", 2.0, 3.0, "Polach's presets 0.2–0.6 s/m; calibrated 3.0, on the "
+                   "calibration's upper bound: ÷ 1.5 … that bound"),
+    ParameterRange("motor_slope", 1000.0, 12000.0, "torque falls 12.8 kN m over 0.5–6 % of "
+                   "213 rad/s (converter control unknown); calibrated 1 140"),
+    ParameterRange("rubber_loss_time", 1e-4, 4e-4, "rubber loss factor 0.05–0.2 at ~80 Hz",
+                   log=False),
+    ParameterRange("disc_clutch_torsional_stiffness", 3.5e4, 1e5, "rubber disc clutch; "
+                   "calibrated 5.7e4 from the 2.7 Hz mode"),
+    ParameterRange("driving_shaft_stiffness", 6e6, 1.2e7, "quill shaft; calibrated 8.5e6 "
+                   "from the 298 Hz mode"),
+    ParameterRange("rotor_inertia", 8.0, 18.0, "550 kg rotor, radius of gyration 0.12–0.18 m"),
+    ParameterRange("silent_block_stiffness_x", 1.03e7, 2.4e7, "rubber-metal block, "
+                   "calibrated 2.06e7 (÷ 2; up to the calibration's bound 2.4e7)"),
+    ParameterRange("primary_stiffness_x", 1.8e6, 7.3e6, "longitudinal guide, calibrated "
+                   "3.6e6 (×/÷ 2)"),
+    ParameterRange("yaw_damping", 4.3e5, 1e6, "yaw damper, calibrated 8.6e5: ÷ 2 … the "
+                   "calibration's bound 1 MN s/m"),
+    ParameterRange("yaw_damper_series_stiffness", 9.4e6, 3e7, "the yaw dampers' end bushes, "
+                   "calibrated 1.87e7: ÷ 2 … the calibration's bound 3e7"),
+    ParameterRange("gear_mesh_stiffness", 7.5e8, 3e9, "~7–30 N/(µm mm) × 100 mm face width"),
 )
 
 
@@ -347,7 +335,7 @@ def qmc_study(evaluate: Callable[[np.ndarray], np.ndarray], transform: Callable,
     return samples, np.vstack(parts), clipped
 
 
-def run_uncertainty(parameters: Parameters, n: int, uncertain: Iterable[UncertainParameter] = UNCERTAIN_PARAMETERS,
+def run_uncertainty(parameters: Parameters, n: int, uncertain: Iterable[ParameterRange] = UNCERTAIN_PARAMETERS,
                     seed: int = 12, map_fn: Callable = map, chunk_size: int = 4,
                     progress: Callable[[int, int], None] | None = None,
                     n_resamples: int = 999, method: str = "prior", indices: bool | None = None,
@@ -458,7 +446,7 @@ def creep_maximum_chunk(samples: np.ndarray, base: Mapping[str, float], names: S
 
 
 def creep_maximum_study(parameters: Parameters, n: int,
-                        uncertain: Iterable[UncertainParameter] = UNCERTAIN_PARAMETERS,
+                        uncertain: Iterable[ParameterRange] = UNCERTAIN_PARAMETERS,
                         seed: int = 12, n_resamples: int = 999):
     """Sobol indices of the creep maximum s_max(v) at :data:`V_SPEEDS_KMH` over the same prior
     (the creep law only: milliseconds per sample).  Where the full study finds s0* = s_max for

@@ -35,7 +35,7 @@ from model import OperatingPoint, build_model, eigen_analysis, load_parameters, 
 from model.analysis.modes import wheelset_yaw_fraction
 from model.analysis.stability import stability_limit
 from model.mechanics.operating_point import adhesion_moment, motor_torque
-from model.studies.calibration_bounds import FREE_PARAMETERS, constraint_values, on_bound
+from model.studies.calibration_bounds import FREE_PARAMETERS, constraint_values
 from model.studies.calibration_targets import (
     ADHESION_MOMENT,
     DIVERGENCE_RATES,
@@ -190,7 +190,7 @@ def test_calibrated_values_inside_their_bounds_at_most_two_on_one(calibrated):
     parameters = calibrated[0]
     for f in FREE_PARAMETERS:
         assert f.low - 1e-12 * abs(f.low) <= parameters[f.name] <= f.high + 1e-12 * abs(f.high)
-    on = [f.name for f in FREE_PARAMETERS if on_bound(f, parameters[f.name])]
+    on = [f.name for f in FREE_PARAMETERS if f.on_bound(parameters[f.name])]
     assert len(on) <= 2, on
 
 

@@ -22,10 +22,10 @@ import pytest
 
 from app.cli.main import main
 from model.mechanics.parameters import load_parameters, parameter_hash
+from model.studies.parameter_ranges import ParameterRange
 from model.studies.posterior import PosteriorError, calibration_residuals, linearized_posterior
 from model.studies.uncertainty import (
     UNCERTAIN_PARAMETERS,
-    UncertainParameter,
     UncertaintyError,
     output_names,
     run_uncertainty,
@@ -64,7 +64,7 @@ def test_transform_centre_and_clipping(posterior):
 
 def test_value_outside_its_range_is_refused():
     parameters = load_parameters()
-    narrow = (UncertainParameter("creep_slope", 1.0, 2.0, "test"),)
+    narrow = (ParameterRange("creep_slope", 1.0, 2.0, "test"),)
     with pytest.raises(PosteriorError, match="outside its documented range"):
         linearized_posterior(parameters, narrow)
 
