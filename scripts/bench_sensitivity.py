@@ -140,8 +140,14 @@ def main() -> None:
     start = time.perf_counter()
     creep = creep_maximum_study(parameters, args.creep_n, n_resamples=499)
     seconds = time.perf_counter() - start
-    _, _, _, _, total, _, total_ci = creep
+    _, _, outputs, _, total, _, total_ci = creep
     for j, v_kmh in enumerate((120, 200)):
+        missing = int(np.count_nonzero(np.isnan(outputs[:, j])))
+        if missing:
+            print(f"s0*({v_kmh} km/h): {missing} of the {len(outputs)} samples A, B have no creep "
+                  "maximum below s = 1 (a corner of the prior box): no indices from the creep law")
+            report[f"creep_n{args.creep_n}_missing_{v_kmh}"] = missing
+            continue
         k = int(np.nanargmax(total[j]))
         width = total_ci[1, j] - total_ci[0, j]
         leading = np.argsort(-np.nan_to_num(total[j]))[:3]
