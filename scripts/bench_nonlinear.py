@@ -43,6 +43,11 @@ from bench_response import best_of, run_radau  # the same Radau loop and timing 
 
 from model import build_model, default_operating_point, load_parameters
 from model.analysis.eigen import bogie_system, forget_systems
+from model.analysis.linear_system import (
+    first_order_matrix,
+    inertial_inverse_mass,
+    massless_coordinates,
+)
 from model.analysis.nonlinear import (
     creep_force_map,
     creep_velocity_map,
@@ -55,41 +60,51 @@ from model.mechanics.outputs import output_matrices
 
 
 def radau_system(model, op, excitation, step):
-    """ẋ = F(t, x) and its Jacobian for x = [q; q̇], built from the model's matrices alone."""
+    """ẋ = F(t, x) and its Jacobian for the state x = [q; q̇ of the inertial coordinates] (the
+    massless coordinates of the Maxwell elements are first order,
+    :mod:`model.analysis.linear_system`), built from the model's matrices alone; returns (F, its
+    Jacobian, the creep law, the velocity map V with q̇ = V x)."""
     n = model.n
-    Minv = np.linalg.inv(model.M)
+    massless = massless_coordinates(model.M)
+    inertial = np.setdiff1d(np.arange(n), massless)
+    Minv = inertial_inverse_mass(model.M, inertial)
     B_nl = damping_without_longitudinal_creep(model, op)
     G, H = creep_force_map(model), creep_velocity_map(model)
+    if np.any(G[massless]) or np.any(model.short_circuit_force[massless]):
+        raise ValueError("an input acts on a massless coordinate")
     law = creep_law(model.parameters, op.N0)
     mu0 = float(law.mu(op.s0, op.v))
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ model.K, -Minv @ B_nl]])
-    b = np.concatenate([np.zeros(n), Minv @ model.short_circuit_force])
-    MG = Minv @ G
+    A = first_order_matrix(Minv, B_nl, model.K, inertial, massless)
+    V = A[:n]  # q̇ = V x (no input acts on a massless coordinate)
+    b = np.concatenate([np.zeros(n), Minv @ model.short_circuit_force[inertial]])
+    MG = Minv @ G[inertial]
+    HV = H @ V  # contact velocities from the state
     u0, a, mu = excitation.terms(step)
 
     def fun(t, x):
-        z = H @ x[n:]
+        z = HV @ x
         force = op.N0 * (np.asarray(law.mu(op.s0 + z / op.v, op.v)) - mu0)
         dx = A @ x + b * (u0 + (a * np.exp(mu * t)).real)
         dx[n:] += MG @ force
         return dx
 
     def jac(t, x):
-        z = H @ x[n:]
+        z = HV @ x
         slope = op.N0 * np.asarray(law.dmu_ds(op.s0 + z / op.v, op.v)) / op.v
         J = A.copy()
-        J[n:, n:] += (MG * slope) @ H
+        J[n:] += (MG * slope) @ HV
         return J
 
-    return fun, jac, law
+    return fun, jac, law, V
 
 
-def outputs_from_states(model, op, X, law, names):
-    """The result's outputs from states [q; q̇] (totals)."""
+def outputs_from_states(model, op, X, law, names, V):
+    """The result's outputs from states [q; q̇ of the inertial coordinates] (totals; q̇ = V x)."""
     n = model.n
     matrices = output_matrices(model, op)
     H = creep_velocity_map(model)
-    forces = op.N0 * np.asarray(law.mu(op.s0 + (X[:, n:] @ H.T) / op.v, op.v))
+    velocities = X @ V.T
+    forces = op.N0 * np.asarray(law.mu(op.s0 + (velocities @ H.T) / op.v, op.v))
     rims = list(model.rims)
     r0 = model.parameters["wheel_radius"]
     out = {}
@@ -101,7 +116,7 @@ def outputs_from_states(model, op, X, law, names):
             out[name] = r0 * sum(forces[:, rims.index(f"{drive}.rim{k}")] for k in (12, 14))
         else:
             i = matrices.index(name)
-            out[name] = X[:, :n] @ matrices.C_q[i] + X[:, n:] @ matrices.C_v[i] \
+            out[name] = X[:, :n] @ matrices.C_q[i] + velocities @ matrices.C_v[i] \
                 + matrices.steady[i]
     return out
 
@@ -179,14 +194,14 @@ def main() -> None:
 
     radau_note = ""
     if not args.skip_radau:
-        fun, jac, law = radau_system(model, op, excitation, result.motor_torque)
-        size = 2 * model.n
+        fun, jac, law, V = radau_system(model, op, excitation, result.motor_torque)
+        size = V.shape[1]
         # accuracy 1: tight Radau on a short horizon
         k_ref = round(args.reference_t_end * args.fs) + 1
         start = time.process_time()
         _, X_ref, _ = run_radau(fun, jac, size, t[:k_ref], 1e-10, 1e-12, args.reference_budget)
         t_reference = time.process_time() - start
-        reference = outputs_from_states(model, op, X_ref, law, list(result.outputs))
+        reference = outputs_from_states(model, op, X_ref, law, list(result.outputs), V)
         error_ref, which_ref = relative_error(result.outputs, reference, result.steady,
                                               rows=slice(0, len(X_ref)))
         report["radau_reference"] = {"t_end": float(t[len(X_ref) - 1]), "error": error_ref,

@@ -119,7 +119,7 @@ def main() -> None:
         lambda: short_circuit_response(model, op, excitation, args.t_end, args.fs), 5)
     system = bogie_system(model, op)
     outputs = output_matrices(model, op)
-    C = np.hstack([outputs.C_q, outputs.C_v])
+    C = system.state_output(outputs.C_q, outputs.C_v)  # on the state [q; q̇ of the inertial coordinates]
     u0, a, mu = excitation.terms(result.motor_torque)
     t_solve, (y_solve, method, estimate) = best_of(
         lambda: solve_linear(system, C, u0, a, mu, steps, dt), 5)
