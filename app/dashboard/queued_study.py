@@ -4,10 +4,10 @@ it runs), stopping it, waiting for it.
 
 A view that mixes :class:`QueuedStudyControls` in builds its common widgets with
 :meth:`~QueuedStudyControls._build_queue_controls`, holds ``queue``, ``owner``, ``ticket``,
-``_conditions`` (the study's
-conditions shown after the status), ``_read_at`` (chunks finished when the running store was
-last read) and ``_poller``, and defines ``_show_running_store(ticket)`` (read and show the store,
-set ``_read_at``), ``_reject(message)`` and ``_after_end()`` (refresh the folder's lists).
+``_conditions`` (the study's conditions shown after the status), ``_read_at`` (chunks finished
+when the running store was last read) and ``_poller``, and defines
+``_show_running_store(ticket)`` (read and show the store, set ``_read_at``), ``_reject(message)``
+and ``_after_end()`` (refresh the folder's lists).
 """
 
 from __future__ import annotations
