@@ -39,7 +39,7 @@ log = logging.getLogger(__name__)
 WAITING, RUNNING, DONE, STOPPED, FAILED, DROPPED = (
     "waiting", "running", "done", "stopped", "failed", "dropped")
 ENDED = (DONE, STOPPED, FAILED, DROPPED)
-STUDY_NICENESS = 19  # the local cluster's workers: the sessions' first answers come first
+STUDY_NICENESS = 10  # the local cluster's workers: the sessions' first answers come first
 
 
 class StudyRefused(ValueError):
