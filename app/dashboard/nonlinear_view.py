@@ -45,8 +45,10 @@ REACTION_DELAYS = np.linspace(0.0, 0.5, 11)  # [s] delay grid of the dashboard's
 REACTION_FS = 5_000.0  # [Hz] its sampling (the CLI's default is 10 kHz)
 REACTION_QUIET_MS = 1000  # [ms] the search starts when the operating point has stayed this long
 # the views alive in this process: a reaction search that no view wants any more (superseded by
-# another operating point, or its session closed) stops between its runs instead of holding the
-# shared worker and the CPU for tens of seconds
+# another operating point, a slider already moved on, or its session closed) stops within one
+# block of its nonlinear runs instead of holding the shared worker and the CPU for seconds: its
+# step loop is mostly Python and holds the GIL, which thread priorities cannot take away, so a
+# search left running slows every session's next answer
 _VIEWS: weakref.WeakSet = weakref.WeakSet()
 
 
@@ -58,7 +60,7 @@ _WATCHED: ContextVar[bool] = ContextVar("bogie_reaction_watched", default=False)
 
 
 def _stop_unless_wanted(key: tuple) -> None:
-    if _WATCHED.get() and not any(view._reaction_key == key for view in list(_VIEWS)):
+    if _WATCHED.get() and not any(view.wants_reaction(key) for view in list(_VIEWS)):
         raise ReactionSuperseded(key)
 
 
@@ -104,7 +106,7 @@ def reaction(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
         m, op, compute.excitation(M0_kNm, f, D, dt_ms),
         anti_slip=AntiSlip(True, 0.1, threshold, rate),
         delays=REACTION_DELAYS, t_end=2.0, fs=max(REACTION_FS, 20.0 * float(f)),
-        progress=lambda _text: _stop_unless_wanted(key))  # after each run of the delay grid
+        checkpoint=lambda: _stop_unless_wanted(key))  # between blocks of every run
     return Reaction(result.required_delay, result.reason, result.detection_time,
                     result.reaction_after_fault, result.limit)
 
@@ -257,13 +259,23 @@ class NonlinearView:
         self._request_reaction()
         self._render_status()
 
+    def _reaction_key_of(self, state) -> tuple:
+        """The reaction search's cache key at the dashboard ``state``."""
+        return (*state.point, state.M0, state.f, state.D, state.dt, self.valid[2], self.valid[3])
+
+    def wants_reaction(self, key: tuple) -> bool:
+        """Whether this view still waits for the reaction search ``key`` (any thread): the one it
+        asked for, its session open, and the sliders not moved on since (a change whose linear
+        answer is still being computed stops the search at once, not when that answer is shown)."""
+        return (key == self._reaction_key and self.dash.alive()
+                and self._reaction_key_of(self.dash.state()) == key)
+
     def _request_reaction(self) -> None:
         point = self.dash.point
         if point is None or point.stable:
             self.reaction, self._reaction_key = None, None
             return
-        s = self._state
-        key = (*s.point, s.M0, s.f, s.D, s.dt, self.valid[2], self.valid[3])
+        key = self._reaction_key_of(self._state)
         if key == self._reaction_key and self.reaction is not None:
             return
         self._reaction_key = key

@@ -87,12 +87,15 @@ def required_reaction_time(model: BogieModel, op: OperatingPoint,
                            anti_slip: AntiSlip | None = None,
                            delays: np.ndarray | None = None, drives: tuple[str, ...] = ("ID2",),
                            t_end: float = 2.0, fs: float = 10_000.0,
-                           progress: Callable[[str], None] | None = None) -> ReactionTime:
+                           progress: Callable[[str], None] | None = None,
+                           checkpoint: Callable[[], None] | None = None) -> ReactionTime:
     """The required reaction time of the protection and the curve peak(τ) (module docstring).
 
     ``limit`` [N m] wheel-side torque (default M_ad); ``anti_slip`` the protection whose delay is
     varied (default :class:`AntiSlip()`); ``delays`` [s] increasing, ≥ 0 (default 0 … 0.5 s in
-    20 ms); ``drives`` whose disc clutch and driving shaft torques are limited.
+    20 ms); ``drives`` whose disc clutch and driving shaft torques are limited; ``progress``
+    gets a line after each delay of the grid; ``checkpoint`` is handed to every run
+    (:func:`model.analysis.nonlinear.nonlinear_response`: what it raises ends the search).
     """
     excitation = ShortCircuit() if excitation is None else excitation
     base = AntiSlip() if anti_slip is None else anti_slip
@@ -123,7 +126,7 @@ def required_reaction_time(model: BogieModel, op: OperatingPoint,
         nonlocal evaluations
         evaluations += 1
         return nonlinear_response(model, op, excitation, t_end, fs, anti_slip=protection,
-                                  outputs=outputs)
+                                  outputs=outputs, checkpoint=checkpoint)
 
     def peak(delay: float) -> tuple[float, str, float | None]:
         result = run(AntiSlip(True, float(delay), base.threshold, base.rate, base.floor))

@@ -61,6 +61,7 @@ controls, so the protection cannot act on it.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -294,7 +295,8 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
                        fs: float = 10_000.0, creep: str = "nonlinear",
                        anti_slip: AntiSlip | None = None, outputs: list[str] | None = None,
                        strength: float | None = None, keep_states: bool = False,
-                       substeps: int = 1, excitation_scale: float = 1.0) -> NonlinearResult:
+                       substeps: int = 1, excitation_scale: float = 1.0,
+                       checkpoint: Callable[[], None] | None = None) -> NonlinearResult:
     """Time histories after the short circuit of ID1's motor with nonlinear longitudinal creep.
 
     ``creep``: "nonlinear" (the law) or "tangent" (its tangent at s0, through the same loop);
@@ -305,13 +307,16 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     ``keep_states``: also return the states [Δq; Δq̇_inertial] at the samples (memory samples x N,
     N states: :class:`model.analysis.linear_system.LinearSystem`);
     ``excitation_scale``: M_C(t) (step and oscillation) multiplied by this factor (checks of the
-    small-amplitude limit; the result's ``M_C`` is the scaled torque).
+    small-amplitude limit; the result's ``M_C`` is the scaled torque);
+    ``checkpoint``: called between blocks of BLOCK_STEPS integration steps; whatever it raises
+    ends the run and reaches the caller (a caller's cancellation: an interactive session that no
+    longer wants the result stops it within one block, not at the end of the run).
     """
     excitation = ShortCircuit() if excitation is None else excitation
     request = _check_inputs(model, op, t_end, fs, creep, anti_slip, outputs, strength, keep_states,
                             substeps, excitation_scale)
     run = _set_up_run(model, op, excitation, request)
-    histories = _step(run, request)
+    histories = _step(run, request, checkpoint)
     return _pack_result(model, op, excitation, request, run, histories)
 
 
@@ -461,9 +466,11 @@ class _Histories:
     iterations: int  # Newton iterations summed over the steps
 
 
-def _step(run: _Run, request: _Request) -> _Histories:
+def _step(run: _Run, request: _Request,
+          checkpoint: Callable[[], None] | None = None) -> _Histories:
     """Step the run from the pre-fault state to the end, block by block of ≈ BLOCK_STEPS steps
-    (:func:`model.analysis.block_stepper.march`), and keep every ``substeps``-th step."""
+    (:func:`model.analysis.block_stepper.march`), and keep every ``substeps``-th step;
+    ``checkpoint`` is called before each block."""
     inputs = run.inputs
     n_points, n_steps, substeps, h = request.n_points, request.n_steps, request.substeps, request.h
     m = len(inputs.E)
@@ -487,6 +494,8 @@ def _step(run: _Run, request: _Request) -> _Histories:
     u2_now = 0.0
     k = 0
     while k < n_steps:
+        if checkpoint is not None:
+            checkpoint()
         k1 = min(n_steps, k + block)
         status = march(k, k1, inputs, zeta, phi, z, u2_now, det_state, Y_out, z_out, phi_out,
                        u2_out, iterations)

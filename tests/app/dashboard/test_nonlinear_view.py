@@ -125,3 +125,30 @@ def test_a_reaction_search_no_session_wants_stops_at_once():
         wanted_reaction("", "calibrated", 0.01371, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None,
                         0.3, 10.0)
     assert time.perf_counter() - start < 5.0  # no nonlinear run (each ≈ 0.5 s) was started
+
+
+def test_a_reaction_search_stops_inside_a_run_once_its_view_moves_on():
+    """The search asks whether it is still wanted before every block of every nonlinear run (not
+    only between runs): a view whose sliders moved on stops it within one block."""
+    from app.dashboard.nonlinear_view import _VIEWS, ReactionSuperseded, wanted_reaction
+
+    key = ("", "calibrated", 0.01372, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None, 0.3, 10.0)
+
+    class MovingView:  # wants the search for its first three questions
+        asked = 0
+
+        def wants_reaction(self, asked_key):
+            assert asked_key == key
+            self.asked += 1
+            return self.asked <= 3
+
+    view = MovingView()
+    _VIEWS.add(view)
+    try:
+        with pytest.raises(ReactionSuperseded):
+            wanted_reaction(*key)
+    finally:
+        _VIEWS.discard(view)
+    # asked before the search and before each block of the first run (2 s at 5 kHz: 5 blocks);
+    # the fourth question, the first run's third block, stopped it
+    assert view.asked == 4

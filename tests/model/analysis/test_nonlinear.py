@@ -24,6 +24,7 @@ import pytest
 from model import build_model, default_operating_point, load_parameters
 from model.analysis.eigen import bogie_system
 from model.analysis.nonlinear import (
+    BLOCK_STEPS,
     AntiSlip,
     NonlinearError,
     creep_force_map,
@@ -235,6 +236,38 @@ def test_bad_input(bogie):
         AntiSlip(floor=1.0)
     with pytest.raises(NonlinearError, match="unknown output"):
         nonlinear_response(model, op, outputs=["ID3.rotor.torque"])
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_a_checkpoint_is_called_before_each_block_and_may_end_the_run(bogie):
+    """The caller's cancellation hook: called once before each block of BLOCK_STEPS steps, the
+    histories unchanged by it; what it raises ends the run before the next block."""
+    parameters, model = bogie
+    op = default_operating_point(parameters)
+    fs, t_end = 5_000.0, 1.0  # 5 000 steps: blocks of 2048, 2048, 904
+    blocks = -(-round(fs * t_end) // BLOCK_STEPS)
+    assert blocks == 3
+    calls = []
+    plain = nonlinear_response(model, op, t_end=t_end, fs=fs, outputs=["ID2.disc_clutch.torque"])
+    checked = nonlinear_response(model, op, t_end=t_end, fs=fs,
+                                 outputs=["ID2.disc_clutch.torque"],
+                                 checkpoint=lambda: calls.append(1))
+    assert len(calls) == blocks
+    np.testing.assert_array_equal(checked.outputs["ID2.disc_clutch.torque"],
+                                  plain.outputs["ID2.disc_clutch.torque"])
+
+    def stop_at_second_block():
+        calls.append(1)
+        if len(calls) == 2:
+            raise _Stop
+
+    calls.clear()
+    with pytest.raises(_Stop):
+        nonlinear_response(model, op, t_end=t_end, fs=fs, checkpoint=stop_at_second_block)
+    assert len(calls) == 2
 
 
 def test_tangent_at_the_creep_maximum(bogie):
