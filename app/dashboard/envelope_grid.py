@@ -100,7 +100,7 @@ def read_envelope(path: str | Path, name: str) -> EnvelopeData:
     path = Path(path)
     if not (path / "zarr.json").is_file():
         raise ValueError(f"'{name}' is not a Zarr store")
-    with xr.open_zarr(str(path), consolidated=False) as dataset:
+    with xr.open_zarr(str(path), consolidated=False, chunks=None) as dataset:  # numpy, not Dask
         if dataset.attrs.get("study") != "envelope":
             raise ValueError(f"'{name}' is not a design-load envelope store")
         arguments = json.loads(dataset.attrs.get("arguments", "{}"))

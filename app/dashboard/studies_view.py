@@ -65,9 +65,13 @@ def read_map(path: str | Path, n0_index: int = 0, bm_index: int = 0,
     name = str(path) if name is None else name
     if not (path / "zarr.json").is_file():
         raise ValueError(f"'{name}' is not a Zarr store")
-    with xr.open_zarr(str(path), consolidated=False) as dataset:
+    # read on the session's main thread (every poll of a running study): numpy arrays, not Dask
+    # ones, and only the variables shown: 0.05-0.07 s against 0.3-0.9 s for the whole store
+    # through Dask, time in which no session's slider change is answered
+    with xr.open_zarr(str(path), consolidated=False, chunks=None) as dataset:
         if dataset.attrs.get("study") != "map":
             raise ValueError(f"'{name}' is not a stability-map store")
+        dataset = dataset[["largest_real_part", "s0_limit", "chunk_done"]]
         sliced = dataset.isel(N0=n0_index, b_M=bm_index).load()
         done = dataset["chunk_done"].values
         growth = np.where(sliced["chunk_done"].values[None, :] == 1,

@@ -464,11 +464,9 @@ def test_five_sessions_queue_with_one_running(setup, chromium):
         finish = sorted(done_at, key=done_at.get)
         assert finish[1:] == waited
         assert len(busy) >= 5  # the median of several: one answer may meet a study's start or end
-        # The target, an answer within 2x the idle one while the studies run, is missed
-        # when the answers are compared like for like (each to a value not computed before):
-        # medians 0.50-0.69 s against 0.23 s idle, 2.2-3x (2026-12-03; BENCHMARKS.md).  What
-        # this asserts is that no session starves: the median within 4x the idle answer.
-        assert statistics.median(busy) <= 4 * idle, (idle, busy)
+        # an answer within 2x the idle one while the studies run, compared like for like (each
+        # to a value not computed before): medians 1.2-1.5x measured (2026-12-03, BENCHMARKS.md)
+        assert statistics.median(busy) <= 2 * idle, (idle, busy)
         for page in pages:
             assert page.errors == [], page.errors
     finally:
