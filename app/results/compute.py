@@ -31,6 +31,10 @@ RAIL_CONDITIONS = ("calibrated", "dry", "wet")  # "calibrated": the creep law of
 N_COMPLEX_TABLE = 10  # complex pairs in the eigenvalue / mode tables (Table 1 and 2 layout)
 N_REAL_TABLE = 10  # real eigenvalues in the eigenvalue table
 LOCUS_MAX_HZ = 20.0  # branches tracked up to this frequency [Hz]
+# the locus's eigenvalues to 1e-6 relative, or 1e-6 1/s absolute below |λ| = 1 1/s (a pixel of
+# the plot is ≈ 0.1 1/s): a drivetrain spin passing through λ = 0 is then not solved densely at
+# every point near its zero (model.analysis.locus)
+LOCUS_LAMBDA_FLOOR = 1.0  # [1/s]
 LOCUS_POINTS = 25  # points of the coarse root-locus sweep (shown first, brackets s0*)
 LOCUS_DENSE_POINTS = 200  # points of the dense sweep that replaces it
 LOCUS_UNIFORM_SHARE = 0.3  # share of the dense points spread evenly (the rest follow the motion)
@@ -295,10 +299,12 @@ def _sweep(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: flo
     m = model(params_path, rail)
     if parameter == "s0":
         op = operating_point(params_path, rail, float(shown[0]), fixed, N0_kN, b_M)
-        locus = root_locus(m, op, "s0", shown, max_frequency_hz=LOCUS_MAX_HZ)
+        locus = root_locus(m, op, "s0", shown, max_frequency_hz=LOCUS_MAX_HZ,
+                           lambda_floor=LOCUS_LAMBDA_FLOOR)
     else:
         op = operating_point(params_path, rail, fixed, float(shown[0]), N0_kN, b_M)
-        locus = root_locus(m, op, "v", shown * KMH, max_frequency_hz=LOCUS_MAX_HZ)
+        locus = root_locus(m, op, "v", shown * KMH, max_frequency_hz=LOCUS_MAX_HZ,
+                           lambda_floor=LOCUS_LAMBDA_FLOOR)
     upper = np.flatnonzero(locus.eigenvalues[0].imag >= 0)
     lam = locus.eigenvalues[:, upper]
     return LocusResult(parameter, shown, lam, np.asarray(locus.stable), dense, locus_jumps(shown, lam))

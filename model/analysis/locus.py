@@ -17,6 +17,9 @@ Method — a reduced model whose error is estimated at every point and bounded b
    exceeds ``rtol·|λ|`` for a few branches, those are refined by Newton's method on the full
    model (quadratic convergence; the last step size is the recorded error); where it fails for
    many, or the MAC tracking is ambiguous, the point is solved densely (exact there).
+   ``lambda_floor`` [1/s] measures the errors relative to max(|λ|, lambda_floor) instead: a
+   branch passing through λ = 0 (a drivetrain spin near the creep maximum) has no relative
+   accuracy to reach, and without a floor every point near its zero is solved densely.
    The reduced eigenproblems of the inner points are independent of each other and are solved
    first, on ``workers`` threads; tracking and error control then run through them in order.
    The start of a sweep (the exact end points, the basis and the projected matrices) and the
@@ -33,6 +36,7 @@ The naive reference (:func:`dense_generalized_eigenvalues`) solves the generaliz
 
 from __future__ import annotations
 
+import math
 import os
 import threading
 from collections import OrderedDict
@@ -57,11 +61,13 @@ class RootLocus:
     parameter: str  # "s0" [-] or "v" [m/s]
     values: np.ndarray  # (n_points,) parameter values, SI
     eigenvalues: np.ndarray  # (n_points, n_branches) complex [1/s]; column = one tracked branch
-    error_estimate: np.ndarray  # (n_points, n_branches) estimated relative error (0: exact)
+    # (n_points, n_branches) estimated error relative to max(|λ|, lambda_floor) (0: exact)
+    error_estimate: np.ndarray
     dense_points: np.ndarray  # (n_points,) bool: solved densely (exact) at that point
     operating_point: OperatingPoint  # the fixed quantities of the sweep
     basis_size: int  # columns of the reduction basis Φ
     newton_refinements: int  # branch-points refined by Newton's method on the full model
+    lambda_floor: float = 0.0  # [1/s] errors relative to max(|λ|, this) (0: relative to |λ|)
 
     @property
     def max_real_part(self) -> np.ndarray:
@@ -170,9 +176,9 @@ class Reduced:
         return self.C0_Phi + sum(ck * P for ck, P in zip(c, self.P_Phi, strict=True))
 
     def error_estimate(self, c: np.ndarray, lam: np.ndarray, X: np.ndarray,
-                       C_Phi: np.ndarray | None = None) -> np.ndarray:
-        """First-order relative eigenvalue error from the full-model residual (``C_Phi``:
-        :meth:`damping_Phi` at c, if already formed)."""
+                       C_Phi: np.ndarray | None = None, floor: float = 1e-300) -> np.ndarray:
+        """First-order eigenvalue error from the full-model residual, relative to
+        max(|λ|, ``floor`` [1/s]) (``C_Phi``: :meth:`damping_Phi` at c, if already formed)."""
         if C_Phi is None:
             C_Phi = self.damping_Phi(c)
         CX = C_Phi @ X
@@ -180,7 +186,7 @@ class Reduced:
         residual = lam**2 * MX + lam * CX + self.K_Phi @ X
         derivative = 2 * lam * MX + CX
         return (np.linalg.norm(residual, axis=0) / np.linalg.norm(derivative, axis=0)
-                / np.maximum(np.abs(lam), 1e-300))
+                / np.maximum(np.abs(lam), floor))
 
 
 @dataclass
@@ -248,22 +254,28 @@ def _solver_pool(workers: int) -> ThreadPoolExecutor:
 
 
 def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
-               max_frequency_hz: float = 20.0, rtol: float = 1e-6, workers: int = 2) -> RootLocus:
+               max_frequency_hz: float = 20.0, rtol: float = 1e-6, workers: int = 2,
+               lambda_floor: float = 0.0) -> RootLocus:
     """Track the non-rigid eigenvalues with |λ| < 2π·max_frequency_hz (at the first value) while
     ``parameter`` ("s0" [-] or "v" [m/s]) runs through ``values``; the other quantities of the
     operating point ``op`` stay fixed.  ``workers`` threads solve the reduced eigenproblems
     (default 2, the cores of the target machine).  A real eigenvalue inside the disc that meets a
     real one outside it continues as one half of the new complex pair (the other half is not
-    tracked); pairs that start complex stay conjugate pairs."""
+    tracked); pairs that start complex stay conjugate pairs.  ``rtol``: the tolerance of every
+    tracked eigenvalue inside the controlled disc, relative to max(|λ|, ``lambda_floor`` [1/s])
+    (default 0: relative to |λ|; the module docstring says when a floor is wanted)."""
+    if not (math.isfinite(lambda_floor) and lambda_floor >= 0):
+        raise ValueError(f"lambda_floor must be a finite value >= 0 [1/s], got {lambda_floor!r}")
     values, points, coefficients = _sweep_points(model, op, parameter, values)
     radius = 2 * np.pi * max_frequency_hz
     key = _sweep_start_key(model, points[0], points[-1], radius)
     start = _sweep_start(model, op, parameter, points, radius, workers, key)
     inner = _InnerSolutions(start, coefficients[1:-1], workers)
-    tracks = _track(model, points, coefficients, start, inner, radius, rtol)
+    tracks = _track(model, points, coefficients, start, inner, radius, rtol,
+                    max(lambda_floor, 1e-300))
     _keep_sweep_start(key, model, start, inner)
     return RootLocus(parameter, values, tracks.eigenvalues, tracks.errors, tracks.dense, op,
-                     start.reduced.size, tracks.refined)
+                     start.reduced.size, tracks.refined, float(lambda_floor))
 
 
 def _sweep_points(model: BogieModel, op: OperatingPoint, parameter: str,
@@ -366,7 +378,8 @@ class _Tracks:
 
 
 def _track(model: BogieModel, points: list[OperatingPoint], coefficients: np.ndarray,
-           start: _SweepStart, solution: _InnerSolutions, radius: float, rtol: float) -> _Tracks:
+           start: _SweepStart, solution: _InnerSolutions, radius: float, rtol: float,
+           floor: float) -> _Tracks:
     """Continue the branches with |λ| < ``radius`` [1/s] at the first point from point to point:
     the reduced solution where it is accurate to ``rtol`` (after Newton on a few branches), the
     dense one otherwise and at the last point."""
@@ -383,7 +396,7 @@ def _track(model: BogieModel, points: list[OperatingPoint], coefficients: np.nda
     for i in range(1, n_points):
         if i != n_points - 1:
             point = _reduced_point(model, points[i], coefficients[i], reduced, solution(i - 1),
-                                   previous_values, previous_vectors, rtol, controlled)
+                                   previous_values, previous_vectors, rtol, controlled, floor)
             if point is not None:
                 values_i, vectors_i, estimate, newton_branches = point
                 refined += newton_branches
@@ -399,15 +412,22 @@ def _track(model: BogieModel, points: list[OperatingPoint], coefficients: np.nda
 
 def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, reduced: Reduced,
                    solved: tuple[np.ndarray, np.ndarray], previous_values: np.ndarray,
-                   previous_vectors: np.ndarray, rtol: float, controlled: float):
+                   previous_vectors: np.ndarray, rtol: float, controlled: float,
+                   floor: float = 1e-300):
     """The branches at an inner point from its reduced solution ``solved`` (creep coefficients c),
     assigned to the previous point's: (eigenvalues [1/s], full displacement vectors, estimated
     relative errors, branches refined by Newton), or None where the point must be solved densely
     (ambiguous assignment, too many or unrefinable inaccurate branches inside |λ| < controlled)."""
     lam, X = solved
+    # the basis holds the rigid-body modes (K r = 0): the reduced problem has their λ = 0, which
+    # the tracked branches never are (the dense solutions deflate them).  A drivetrain spin whose
+    # eigenvalue passes through 0 at the creep maximum has the same vector; with a floor on the
+    # error measure it could be assigned to the rigid one's exact 0 and stay there
+    keep = np.sort(np.argsort(np.abs(lam))[model.rigid_body_modes.shape[1]:])
+    lam, X = lam[keep], X[:, keep]
     X_full = reduced.Phi @ X
     chosen, ok = _assign(previous_vectors, previous_values, X_full, lam)
-    estimate = reduced.error_estimate(c, lam[chosen], X[:, chosen])
+    estimate = reduced.error_estimate(c, lam[chosen], X[:, chosen], floor=floor)
     values_i, vectors_i = lam[chosen], X_full[:, chosen]
     failing = np.flatnonzero((estimate > rtol) & (np.abs(values_i) < controlled))
     if not ok or len(failing) > max(2, len(chosen) // 4):
@@ -416,7 +436,7 @@ def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, redu
     C = damping_matrix(model, point) if len(failing) else None
     for b in failing:
         values_i[b], vectors_i[:, b], estimate[b] = newton(
-            model.M, C, model.K, values_i[b], vectors_i[:, b], rtol)
+            model.M, C, model.K, values_i[b], vectors_i[:, b], rtol, floor=floor)
     if not np.all((estimate <= rtol) | (np.abs(values_i) >= controlled)):
         return None
     return values_i, vectors_i, estimate, len(failing)

@@ -101,7 +101,9 @@ def test_fig6_series_splits_complex_and_real_branches():
 def test_dense_locus_is_the_models_eigenvalues():
     """The dense sweep has LOCUS_DENSE_POINTS points and contains the coarse grid; at sample
     points every tracked eigenvalue is an eigenvalue of the full model (model.analysis.eigen) — within
-    1e-5 relative: root_locus controls its estimated error to 1e-6 inside the tracked disc."""
+    1e-5 of max(|λ|, 1 1/s): root_locus controls its estimated error to 1e-6 of
+    max(|λ|, LOCUS_LAMBDA_FLOOR) inside the tracked disc (the estimate is conservative)."""
+    assert compute.LOCUS_LAMBDA_FLOOR <= 1.0
     from model import eigen_analysis
 
     key = ("", "calibrated", "s0", 120.0, 100.0, 3000.0)

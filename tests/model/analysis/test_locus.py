@@ -3,12 +3,13 @@ the speed sweep, bad input."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from itertools import pairwise
 
 import numpy as np
 import pytest
 
-from model import OperatingPointError, build_model, default_operating_point, load_parameters
+from model import OperatingPointError, build_model, default_operating_point, eigen_analysis, load_parameters
 from model.analysis.locus import clear_sweep_starts, dense_generalized_eigenvalues, root_locus
 
 CONTROLLED = 1.5 * 2 * np.pi * 20.0  # |λ| inside which the tolerance is enforced [1/s]
@@ -123,3 +124,41 @@ def test_bad_input(setup, parameter, values, error):
     model, op, _, _ = setup
     with pytest.raises(error):
         root_locus(model, op, parameter, values)
+
+
+def test_a_floor_keeps_the_sweep_reduced_through_a_zero_eigenvalue():
+    """The dashboard's sweep (s0 = 0.001…0.02 at 151 km/h) passes a drivetrain spin through
+    λ = 0 near s0 ≈ 0.0075 (the creep maximum): relative to |λ| its error cannot be controlled,
+    and each point there was solved densely.  With ``lambda_floor`` the errors are measured
+    relative to max(|λ|, floor): fewer dense points, and at every point of the sweep each tracked
+    eigenvalue inside the controlled disc is an eigenvalue of the deflated dense solution
+    (``eigen_analysis``, without the rigid-body λ = 0 that the spin's vector shares) within
+    1e-5·max(|λ|, 1 1/s) (the estimate is conservative; rtol 1e-6)."""
+    parameters = load_parameters()
+    model = build_model(parameters)
+    op = replace(default_operating_point(parameters), v=151.0 / 3.6)
+    s0 = np.concatenate([np.linspace(0.001, 0.0074, 8), np.linspace(0.00745, 0.0078, 8),
+                         np.linspace(0.0085, 0.02, 8)])
+    clear_sweep_starts()
+    plain = root_locus(model, replace(op, s0=s0[0]), "s0", s0)
+    clear_sweep_starts()
+    floored = root_locus(model, replace(op, s0=s0[0]), "s0", s0, lambda_floor=1.0)
+    clear_sweep_starts()
+    assert floored.lambda_floor == 1.0
+    assert plain.lambda_floor == 0.0
+    assert floored.dense_points.sum() < plain.dense_points.sum(), (
+        plain.dense_points, floored.dense_points)
+    for i, s0_i in enumerate(s0):
+        reference = eigen_analysis(model, replace(op, s0=s0_i), vectors=False).eigenvalues
+        for value in floored.eigenvalues[i]:
+            if abs(value) < CONTROLLED:
+                assert np.min(np.abs(reference - value)) <= 1e-5 * max(abs(value), 1.0), (
+                    s0_i, value)
+
+
+def test_a_negative_floor_is_refused():
+    parameters = load_parameters()
+    model = build_model(parameters)
+    with pytest.raises(ValueError, match="lambda_floor"):
+        root_locus(model, default_operating_point(parameters), "s0", [0.005, 0.006],
+                   lambda_floor=-1.0)
