@@ -412,12 +412,12 @@ def _track(model: BogieModel, points: list[OperatingPoint], coefficients: np.nda
 
 def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, reduced: Reduced,
                    solved: tuple[np.ndarray, np.ndarray], previous_values: np.ndarray,
-                   previous_vectors: np.ndarray, rtol: float, controlled: float,
-                   floor: float = 1e-300):
+                   previous_vectors: np.ndarray, rtol: float, controlled: float, floor: float):
     """The branches at an inner point from its reduced solution ``solved`` (creep coefficients c),
     assigned to the previous point's: (eigenvalues [1/s], full displacement vectors, estimated
-    relative errors, branches refined by Newton), or None where the point must be solved densely
-    (ambiguous assignment, too many or unrefinable inaccurate branches inside |λ| < controlled)."""
+    errors relative to max(|λ|, ``floor`` [1/s]), branches refined by Newton), or None where the
+    point must be solved densely (ambiguous assignment, too many or unrefinable inaccurate
+    branches inside |λ| < controlled)."""
     lam, X = solved
     # the basis holds the rigid-body modes (K r = 0): the reduced problem has their λ = 0, which
     # the tracked branches never are (the dense solutions deflate them).  A drivetrain spin whose

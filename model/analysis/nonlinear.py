@@ -466,8 +466,7 @@ class _Histories:
     iterations: int  # Newton iterations summed over the steps
 
 
-def _step(run: _Run, request: _Request,
-          checkpoint: Callable[[], None] | None = None) -> _Histories:
+def _step(run: _Run, request: _Request, checkpoint: Callable[[], None] | None) -> _Histories:
     """Step the run from the pre-fault state to the end, block by block of ≈ BLOCK_STEPS steps
     (:func:`model.analysis.block_stepper.march`), and keep every ``substeps``-th step;
     ``checkpoint`` is called before each block."""
