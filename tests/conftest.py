@@ -39,6 +39,69 @@ def _one_blas_thread():
 
     with threadpool_limits(1):
         yield
+
+
+# --- running in parallel (pytest-xdist, ``-n 2 --dist loadgroup``, as ``bash run.sh test`` does) --------
+#
+# A work unit goes to one worker as a whole.  Tests that share something expensive built once per
+# worker run in one unit: every test that uses the dashboard server in this process or a browser
+# (one server, one Chromium), the attacks on a ``bogie serve`` process of their own and its
+# reliability runs (servers with their own cluster workers: two at once would overload two cores),
+# the image build, the Dask cluster of the engine tests.  The other test modules go as one unit
+# each (their module fixtures are built once), but for the few whose tests are long and share
+# nothing costly: those go test by test, so that both cores work on them.
+SERVED_FIXTURES = {"app_server", "chromium", "own_server"}
+GROUPS = {  # module -> group
+    "tests/app/server/test_boundary.py": "served",
+    "tests/app/server/test_reliability.py": "served",
+    "tests/image/test_docker_image.py": "image",
+    "tests/model/studies/test_engine.py": "dask-cluster",
+}
+TEST_BY_TEST = {
+    "tests/model/analysis/test_response_model.py",
+    "tests/model/analysis/test_sensitivity.py",
+    "tests/model/analysis/test_continuation.py",
+    "tests/model/studies/test_s0_line.py",
+    "tests/app/cli/test_cli_antislip.py",
+    "tests/test_benchmark_scripts.py",
+}
+FIRST = ("image", "served", "dask-cluster")  # the longest units start first
+
+
+def _group(item) -> str | None:
+    module = item.nodeid.split("::", 1)[0]
+    if module in GROUPS:
+        return GROUPS[module]
+    if SERVED_FIXTURES & set(item.fixturenames):
+        return "served"
+    return None if module in TEST_BY_TEST else module
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Mark each test with its work unit (``xdist_group``) and order the collection so that the
+    longest units come first: the image build (mostly waiting for downloads) and the served
+    tests start at once beside the rest, and no core idles at the end waiting for one of them.
+    Within a unit and a module the order is the file's (module fixtures are built once)."""
+    def rank(item) -> int:
+        group = _group(item)
+        if group in FIRST:
+            return FIRST.index(group)
+        return len(FIRST) + (0 if item.get_closest_marker("slow") else 1)
+
+    units: dict[str, tuple[int, int]] = {}  # unit -> (rank, first position)
+    for position, item in enumerate(items):
+        group = _group(item)
+        if group is not None:
+            item.add_marker(pytest.mark.xdist_group(group))
+        unit = group or item.nodeid
+        best, first = units.get(unit, (rank(item), position))
+        units[unit] = (min(best, rank(item)), first)
+    order = {id(item): (*units[_group(item) or item.nodeid], position)
+             for position, item in enumerate(items)}
+    items.sort(key=lambda item: order[id(item)])
+
+
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update",
                  "--disable-sync"]
