@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The project's two commands (see README.md):
 #   bash run.sh app    -> install into .venv (first time) and serve the dashboard on http://localhost:5006/app
-#   bash run.sh test   -> install into .venv (+ Debian's chromium) and run ruff, the import contract and
-#                         the whole test suite
+#   bash run.sh test   -> install into .venv (+ Debian's chromium, buildah, debootstrap) and run ruff, the
+#                         import contract and the whole test suite on every core
 set -euo pipefail
 cd "$(dirname "$0")"
 PY=${PYTHON:-python3}
@@ -39,7 +39,12 @@ case "${1:-}" in
         fi
         "$VENV/bin/ruff" check model app tests scripts
         "$VENV/bin/lint-imports"  # the import contract of pyproject.toml (docs/architecture.md)
-        exec "$VENV/bin/python" -m pytest "$@"
+        # one pytest worker per core (pytest-xdist; tests/conftest.py says which tests share one),
+        # the 25 slowest tests and the total at the end
+        status=0
+        "$VENV/bin/python" -m pytest -n auto --dist loadgroup --durations=25 "$@" || status=$?
+        echo "run.sh: test: ${SECONDS} s in all (install included), exit status ${status}" >&2
+        exit "$status"
         ;;
     *)
         echo "usage: bash run.sh app [bogie serve options] | bash run.sh test [pytest options]" >&2
