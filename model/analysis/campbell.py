@@ -228,17 +228,21 @@ def campbell(model: BogieModel, op: OperatingPoint, v_values, orders: tuple[Orde
 
 def _oscillating_branches(eigenvalues: np.ndarray) -> np.ndarray:
     """The tracked branches (columns) that oscillate somewhere, one of each conjugate pair: the
-    branch whose Im is positive where it is largest in magnitude (a branch that stays real is no
-    line of a Campbell diagram)."""
+    branch whose Im is positive where it is largest in magnitude, and one with a negative Im
+    there whose conjugate is not tracked where it oscillates (a pair that splits into two real
+    eigenvalues along the sweep is tracked as two branches: one line).  A branch that stays real
+    is no line of a Campbell diagram."""
     keep = []
     for b in range(eigenvalues.shape[1]):
         lam = eigenvalues[:, b]
         at = int(np.argmax(np.abs(lam.imag)))
         if lam.imag[at] > 0:
             keep.append(b)
-        elif lam.imag[at] < 0:  # keep it only if its conjugate is not tracked
-            partner = np.abs(eigenvalues - lam.conj()[:, None]).max(axis=0)
-            if partner.min() > 1e-6 * np.abs(lam).max():
+        elif lam.imag[at] < 0:
+            complex_points = lam.imag != 0
+            others = np.delete(eigenvalues[complex_points], b, axis=1)
+            distance = np.abs(others - lam[complex_points].conj()[:, None]).max(axis=0)
+            if distance.min() > 1e-6 * np.abs(lam).max():
                 keep.append(b)
     return eigenvalues[:, keep]
 

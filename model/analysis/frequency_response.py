@@ -54,7 +54,9 @@ EPS = np.finfo(float).eps
 # what is rigid in it (gear wheels, wheel discs, the stator housing, bogie frame and car body)
 # and one constant gear mesh stiffness: docs/resonance.md, "Limits".
 MODEL_FREQUENCY_LIMIT_HZ = 1000.0
+RIGID_FREE_RTOL = 1e-10  # an output row with |C₁| below this x |C| does not see rigid motion
 MODAL_TOLERANCE = 1e-8  # a modal value whose rounding estimate exceeds this x max|H| is solved directly
+STATIC_GAIN_RTOL = 1e-6  # a static gain below this x the output's largest |H| counts as zero
 DEFAULT_MIN_PEAK = 0.01  # peaks below this fraction of an output's largest |H| are not listed
 RESONANCE_OFFSETS = (-3.0, -2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0, 3.0)  # in half-power half-widths
 GOLDEN_ITERATIONS = 60  # golden-section steps: the bracket shrinks by 0.618^60 ≈ 3e-13
@@ -128,8 +130,7 @@ class ModalTransfer:
         deflection); infinite for an output with a rigid-body drift."""
         keep = non_neutral(self.eigenvalues)
         gain = -(self.residues[:, keep] @ (1.0 / self.eigenvalues[keep]))
-        drifting = np.abs(self.drift) > 1e3 * EPS * np.abs(self.magnitudes).sum(axis=1)
-        return np.where(drifting, np.inf, gain)
+        return np.where(self.drift != 0, np.inf, gain)
 
     def rounding_estimate(self, f_hz: np.ndarray) -> np.ndarray:
         """ε · cond(Y) · Σ_j |terms_j| / |s − λ_j| (p x F): the size of the cancelling terms."""
@@ -148,7 +149,12 @@ def modal_transfer(system: LinearSystem, C: np.ndarray, b: np.ndarray) -> ModalT
     bz = deflation.apply_transpose(b)
     CQ = deflation.apply_transpose(C.T).T
     b1, b2 = bz[:r], bz[r:]
-    C1, C2 = CQ[:, :r], CQ[:, r:]
+    C1, C2 = CQ[:, :r], CQ[:, r:].copy()
+    # an output that a rigid-body motion does not change (every element load) has C₁ = 0 but for
+    # the rounding of the deflation (≈ 1e-17 of the row): it is set to 0, so that the output has
+    # no drift g/s of rounding size (which would make its static gain infinite)
+    rigid_free = np.linalg.norm(C1, axis=1) <= RIGID_FREE_RTOL * np.linalg.norm(C, axis=1)
+    C1 = np.where(rigid_free[:, None], 0.0, C1)
     right = system.solve_eigenvectors(b2 / scale)  # Y⁻¹ T⁻¹ b₂  (m,)
     left = (C2 * scale[None, :]) @ Y  # C₂ T Y  (p, m)
     magnitudes = np.abs(left) * np.abs(right)[None, :]
@@ -343,7 +349,10 @@ def _peaks(model_transfer: ModalTransfer, grid: np.ndarray, H_grid: np.ndarray,
         if h < min_peak * largest[p]:
             continue
         static = abs(gain[p])
-        amplification = float(h / static) if math.isfinite(static) and static > 0 else None
+        # a static gain that is zero but for rounding (a yaw damper's force: the vehicle settles)
+        # has no amplification to state
+        meaningful = math.isfinite(static) and static > STATIC_GAIN_RTOL * largest[p]
+        amplification = float(h / static) if meaningful else None
         out[p].append(Peak(float(f), float(h), amplification))
     return tuple(tuple(sorted(row, key=lambda peak: peak.f_hz)) for row in out)
 
