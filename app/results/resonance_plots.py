@@ -65,8 +65,9 @@ class CampbellPlot:
             TapTool(renderers=[points]))
         self.figure.add_layout(ColorBar(color_mapper=self.mapper, title="damping ratio ζ [-] "
                                         "(red: growing)", width=10), "right")
-        self.figure.legend.location = "top_left"
-        self.figure.legend.label_text_font_size = "9pt"
+        legend = self.figure.legend[0]
+        legend.label_text_font_size = "9pt"
+        self.figure.add_layout(legend, "right")  # beside the plot: it hides no crossing
         self.speed = Span(location=np.nan, dimension="height", line_color="black",
                           line_dash="dotted")
         self.figure.add_layout(self.speed)
@@ -137,10 +138,9 @@ class FrfPlot:
                            "gain": ["—" if p.amplification is None else f"{p.amplification:.3g}"
                                     for p in peaks]}
         op = frf.operating_point
-        self.magnitude.title.text = (f"{output} per {frf.input} at s0 = {op.s0:g}, "
-                                     f"v = {op.v_kmh:g} km/h; static gain "
-                                     f"{abs(frf.static_gain[row]):.4g} {unit}")
-        self.magnitude.yaxis.axis_label = f"|H| [{unit}]"
+        self.magnitude.title.text = (f"{output} at s0 = {op.s0:g}, v = {op.v_kmh:g} km/h "
+                                     f"(static gain {abs(frf.static_gain[row]):.4g})")
+        self.magnitude.yaxis.axis_label = f"|H| [{unit}] from {frf.input}"
 
 
 class RipplePlot:
@@ -168,7 +168,7 @@ class RipplePlot:
         colors = ["black"] + [Category10_10[k % 10] for k in range(len(ripple.orders))]
         self.source.data = {"xs": [ripple.v_kmh] * len(series), "ys": series, "label": labels,
                             "color": colors}
-        self.figure.title.text = f"{output} under the torque ripple of {ripple.key[-1]}"
+        self.figure.title.text = f"{output} under a torque ripple of {ripple.key[-1]}"
         self.figure.yaxis.axis_label = f"steady amplitude [{ripple.units[row]}]"
 
     def mark_speed(self, v_kmh: float) -> None:

@@ -74,6 +74,7 @@ def test_output_choice_redraws_frf_and_ripple(dash):
     dash.tabs.active = dash.view_tabs.names.index("resonances")
     view.output.value = "ID1.disc_clutch.torque"
     assert view.frf_plot.magnitude.title.text.startswith("ID1.disc_clutch.torque")
+    assert view.frf_plot.magnitude.yaxis.axis_label == "|H| [N m/N m] from ID1.motor.torque"
     row = view.frf.output("ID1.disc_clutch.torque")
     np.testing.assert_array_equal(view.frf_plot.source.data["abs"], view.frf.magnitude[row, 1:])
     view.output.value = resonance.DEFAULT_OUTPUT
