@@ -106,6 +106,7 @@ def main() -> None:
         "eigen_s": best["eigen"], "frf_s": best["frf"], "frf_over_eigen": best["frf"] / best["eigen"],
         "campbell_modes": len(diagram.modes), "campbell_basis": diagram.basis_size,
         "campbell_dense_points": diagram.dense_points, "campbell_crossings": len(diagram.crossings),
+        "campbell_newton_refinements": diagram.newton_refinements,
         "campbell_max_error": worst_campbell, "frf_frequencies": len(frf.f_hz),
         "frf_outputs": len(frf.names), "frf_max_error": worst_frf,
         "frf_direct_points": frf.direct_points,
@@ -119,7 +120,8 @@ def main() -> None:
     print(f"{f'FRF of {len(frf.names)} outputs at {len(frf.f_hz)} frequencies':<58} "
           f"{best['frf']:>8.3f}s {numbers['frf_over_eigen']:>6.2f}x   (target <= 5)")
     print(f"Campbell: {len(diagram.modes)} modes, basis {diagram.basis_size}, "
-          f"{diagram.dense_points} speeds solved densely, {len(diagram.crossings)} crossings; "
+          f"{diagram.dense_points} speeds solved densely, {diagram.newton_refinements} Newton "
+          f"refinements, {len(diagram.crossings)} crossings; "
           f"largest deviation from eigen_analysis {worst_campbell:.2e}")
     print(f"FRF: largest deviation from direct solves {worst_frf:.2e} of each output's "
           f"largest |H|; {frf.direct_points} grid values solved directly")

@@ -173,6 +173,7 @@ class CampbellDiagram:
     max_frequency_hz: float  # modes with |λ| < 2π this are tracked
     basis_size: int  # the root locus's reduced basis
     dense_points: int  # speeds solved densely by the root locus
+    newton_refinements: int  # branch-points the root locus refined by Newton's method
 
     @property
     def v_kmh(self) -> np.ndarray:
@@ -227,7 +228,8 @@ def campbell(model: BogieModel, op: OperatingPoint, v_values, orders: tuple[Orde
     crossings.sort(key=lambda c: -c.worst[1] if c.severity else 0.0)
     return CampbellDiagram(op, input, v, tuple(modes), tuple(orders), lines, tuple(crossings),
                            float(participation_threshold), float(max_frequency_hz),
-                           locus.basis_size, int(locus.dense_points.sum()))
+                           locus.basis_size, int(locus.dense_points.sum()),
+                           locus.newton_refinements)
 
 
 def _oscillating_branches(eigenvalues: np.ndarray) -> np.ndarray:
