@@ -140,12 +140,11 @@ def _speeds(args: argparse.Namespace) -> np.ndarray:
 
 def _sweep_model(args: argparse.Namespace):
     """(model, operating point at the middle of the speed range, speeds [m/s])."""
-    speeds = _speeds(args)
-    args.v_reference = float(0.5 * (speeds[0] + speeds[-1]))
     from model.mechanics.operating_point import KMH
 
-    namespace = argparse.Namespace(**{**vars(args), "v": args.v_reference / KMH})
-    model, op, _ = load_model(namespace)
+    speeds = _speeds(args)
+    middle = float(0.5 * (speeds[0] + speeds[-1]))  # [m/s]: the modes are named there
+    model, op, _ = load_model(argparse.Namespace(**{**vars(args), "v": middle / KMH}))
     return model, op, speeds
 
 

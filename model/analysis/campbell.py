@@ -45,7 +45,6 @@ from model.analysis.eigen import bogie_system, eigen_analysis
 from model.analysis.frequency_response import (
     DEFAULT_INPUT,
     MODEL_FREQUENCY_LIMIT_HZ,
-    FrequencyResponseError,
     input_force,
     modal_transfer,
     output_rows,
@@ -272,7 +271,7 @@ def _name_modes(model: BogieModel, op: OperatingPoint, v: np.ndarray,
         seen[description] = seen.get(description, 0) + 1
         name = description if seen[description] == 1 else f"{description} #{seen[description]}"
         lam = branches[:, b].copy()
-        lam.imag = np.abs(lam.imag) * np.sign(lam.imag[np.argmax(np.abs(lam.imag))])
+        lam.imag = np.abs(lam.imag)  # the upper eigenvalue of each pair (its conjugate is one too)
         modes.append(CampbellMode(name, lam, index))
     return modes
 
@@ -452,7 +451,3 @@ def speeds_kmh(start: float, stop: float, count: int) -> np.ndarray:
                             "below stop")
     return check_speeds(np.linspace(start, stop, count) * KMH)
 
-
-__all__ = ["CampbellDiagram", "CampbellError", "CampbellMode", "Crossing", "DriveModes",
-           "FrequencyResponseError", "RippleResponse", "campbell", "intersections",
-           "participation", "ripple_response", "severity", "speeds_kmh"]

@@ -456,22 +456,22 @@ def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, redu
     # matrices are real, so a complex pair's two branches are exact conjugates: the second is
     # the conjugate of the first's refinement (one full-model solve per pair, not two)
     C = damping_matrix(model, point) if len(failing) else None
-    refined: dict[int, int] = {}  # refined branch -> its conjugate partner among the failing
+    partner_of: dict[int, int] = {}  # conjugate branch -> the refined one it copies
     for b in failing:
-        partner = next((a for a, c in refined.items() if c == b), None)
-        if partner is not None:
-            values_i[b], vectors_i[:, b] = values_i[partner].conjugate(), vectors_i[:, partner].conj()
-            estimate[b] = estimate[partner]
+        if b in partner_of:
+            a = partner_of[b]
+            values_i[b], vectors_i[:, b] = values_i[a].conjugate(), vectors_i[:, a].conj()
+            estimate[b] = estimate[a]
             continue
-        conjugates = [c for c in failing if c != b and values_i[b].imag != 0
-                      and values_i[c] == values_i[b].conjugate()]
+        conjugates = [other for other in failing if other != b and values_i[b].imag != 0
+                      and values_i[other] == values_i[b].conjugate()]
         if conjugates:
-            refined[b] = conjugates[0]
+            partner_of[conjugates[0]] = b
         values_i[b], vectors_i[:, b], estimate[b] = newton(
             model.M, C, model.K, values_i[b], vectors_i[:, b], rtol, floor=floor)
     if not np.all((estimate <= rtol) | (np.abs(values_i) >= controlled)):
         return None
-    return values_i, vectors_i, estimate, len(failing) - len(refined)
+    return values_i, vectors_i, estimate, len(failing) - len(partner_of)
 
 
 def _keep_sweep_start(key: tuple, model: BogieModel, start: _SweepStart,
