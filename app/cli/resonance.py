@@ -172,7 +172,7 @@ def _check_motor_input(model, name: str) -> None:
 def cmd_campbell(args: argparse.Namespace) -> None:
     from model.analysis.campbell import campbell
     from model.analysis.frequency_response import MODEL_FREQUENCY_LIMIT_HZ
-    from model.mechanics.excitation import Order, parse_orders
+    from model.mechanics.excitation import MAX_ORDERS, Order, parse_orders
 
     model, op, speeds = _sweep_model(args)
     _check_motor_input(model, args.input)
@@ -180,6 +180,9 @@ def cmd_campbell(args: argparse.Namespace) -> None:
     if args.freq is not None:
         fixed = parse_values(args.freq, "--freq (Hz)", 1e-3, MODEL_FREQUENCY_LIMIT_HZ, "Hz (the "
                              "model's validity)")
+        if len(orders) + len(fixed) > MAX_ORDERS:
+            raise UsageError(f"--orders and --freq: {len(orders) + len(fixed)} lines, at most "
+                             f"{MAX_ORDERS}")
         orders = orders + tuple(Order("fixed", f) for f in fixed if Order("fixed", f) not in orders)
     diagram = campbell(model, op, speeds, orders, _excitation(args), input=args.input,
                        participation_threshold=args.participation)

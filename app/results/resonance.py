@@ -18,8 +18,20 @@ import panel as pn
 
 from app.results import compute
 from model.analysis.campbell import campbell, ripple_response, speeds_kmh
-from model.analysis.frequency_response import DEFAULT_INPUT, FrequencyResponse, frequency_response
-from model.mechanics.excitation import DEFAULT_ORDERS, Order, load_excitation, parse_amplitudes, parse_orders
+from model.analysis.frequency_response import (
+    DEFAULT_INPUT,
+    MODEL_FREQUENCY_LIMIT_HZ,
+    FrequencyResponse,
+    frequency_response,
+)
+from model.mechanics.excitation import (
+    DEFAULT_ORDERS,
+    MAX_ORDERS,
+    Order,
+    load_excitation,
+    parse_amplitudes,
+    parse_orders,
+)
 from model.mechanics.outputs import output_matrices
 
 SPEEDS_KMH = (10.0, 250.0)  # the dashboard's speed range [km/h]
@@ -143,12 +155,11 @@ def output_names(params_path: str, rail: str) -> tuple[tuple[str, str], ...]:
 def parse_fixed(text: str) -> tuple[float, ...]:
     """Fixed frequencies [Hz] from "450, 900" (empty: none); a bad text raises ValueError with
     a one-line message."""
-    from model.analysis.frequency_response import MODEL_FREQUENCY_LIMIT_HZ
-
     values = []
-    for token in text.replace(";", ",").split(","):
-        if not token.strip():
-            continue
+    tokens = [token for token in text.replace(";", ",").split(",") if token.strip()]
+    if len(tokens) > MAX_ORDERS:
+        raise ValueError(f"{len(tokens)} fixed frequencies given: at most {MAX_ORDERS}")
+    for token in tokens:
         try:
             value = float(token)
         except ValueError:

@@ -36,6 +36,7 @@ FAMILY_WORDS = {"wheel": "per wheel revolution", "rotor": "per rotor revolution"
                 "mesh": "gear mesh harmonic", "el": "electrical harmonic", "fixed": "fixed"}
 DEFAULT_ORDERS = "wheel:1,rotor:1,mesh:1,el:1,el:2,el:6,el:12"
 MAX_ORDER = 1000.0  # orders above this are refused (a typo, not an excitation)
+MAX_ORDERS = 24  # orders in one list (each is a line, and a column of solves in a ripple)
 _SCHEMA = {"motor_pole_pairs": ("1", "pole pairs P of the traction motor"),
            "pinion_teeth": ("1", "teeth z of the pinion (the driving gear)")}
 
@@ -143,6 +144,8 @@ def parse_orders(text: str) -> tuple[Order, ...]:
     tokens = [token for token in text.split(",") if token.strip()]
     if not tokens:
         raise ExcitationError("no excitation orders given")
+    if len(tokens) > MAX_ORDERS:
+        raise ExcitationError(f"{len(tokens)} orders given: at most {MAX_ORDERS}")
     for token in tokens:
         match = _TOKEN.match(token)
         if match is None:
@@ -166,6 +169,8 @@ def parse_amplitudes(text: str) -> dict[Order, float]:
     tokens = [token for token in text.split(",") if token.strip()]
     if not tokens:
         raise ExcitationError("no ripple given: write order=amplitude, e.g. el:6=250")
+    if len(tokens) > MAX_ORDERS:
+        raise ExcitationError(f"{len(tokens)} orders given: at most {MAX_ORDERS}")
     for token in tokens:
         if token.count("=") != 1:
             raise ExcitationError(f"'{token.strip()}' is not order=amplitude (e.g. el:6=250)")

@@ -130,6 +130,8 @@ def test_ripple_json(capsys):
     ["campbell", "--orders", "wheel:0"],
     ["campbell", "--orders", "gear:1"],
     ["campbell", "--orders", ""],
+    ["campbell", "--orders", ",".join(f"el:{k}" for k in range(1, 26))],  # too many lines
+    ["campbell", "--orders", "el:1", "--freq", ",".join(str(k) for k in range(1, 25))],
     ["campbell", "--freq", "5000"],  # beyond the model's validity
     ["campbell", "--freq", "-50"],
     ["campbell", "--participation", "2"],

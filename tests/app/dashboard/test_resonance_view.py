@@ -56,7 +56,9 @@ def test_a_bad_text_gives_a_notice_and_keeps_the_previous_settings(dash):
     view = dash.resonances
     dash.tabs.active = dash.view_tabs.names.index("resonances")
     before = (view.settings, view.campbell)
-    for widget, text in ((view.orders, "el:-6"), (view.fixed, "5000"), (view.ripple, "el:6")):
+    many = ",".join(f"el:{k}" for k in range(1, 26))  # more lines than a session may ask for
+    for widget, text in ((view.orders, "el:-6"), (view.orders, many), (view.fixed, "5000"),
+                         (view.ripple, "el:6")):
         dash.input_notice.visible = False
         widget.value = text
         assert dash.input_notice.visible

@@ -52,6 +52,7 @@ def test_order_grammar():
     ("el:six", "must be a number"),
     ("el:5000", "at most 1000"),
     ("el:1:2", "not an order"),
+    (",".join(f"el:{k}" for k in range(1, 26)), "at most 24"),
 ])
 def test_bad_orders(text, message):
     with pytest.raises(ExcitationError, match=message):
