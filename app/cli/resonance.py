@@ -20,6 +20,7 @@ import numpy as np
 
 from app.cli.options import (
     UsageError,
+    add_operating_point,
     bounded,
     load_model,
     output_names,
@@ -61,7 +62,7 @@ def register(subparsers) -> None:
 
     p = subparsers.add_parser("frf", help="frequency response from a motor torque (or a creep "
                               "disturbance) to every output: magnitude, phase, peaks")
-    _add_point(p)
+    add_operating_point(p)
     p.add_argument("--input", default=DEFAULT_INPUT, metavar="NAME",
                    help="ID1.motor.torque (the short-circuit torque's generalized force), "
                         "ID2.motor.torque or IDk.rimN.creep_disturbance [N] (default %(default)s)")
@@ -92,28 +93,11 @@ def register(subparsers) -> None:
     p.set_defaults(func=cmd_ripple)
 
 
-def _add_point(p: argparse.ArgumentParser, speed: bool = True) -> None:
-    """``--s0 --n0 --bm --params --json`` and (``speed``) ``--v`` [km/h]."""
-    p.add_argument("--s0", type=bounded("--s0 (creepage)", "(0, 1)"), default=0.005,
-                   help="longitudinal creepage s0 [-] (default %(default)s)")
-    if speed:
-        p.add_argument("--v", type=bounded("--v (speed, km/h)", "[1, 500]", "km/h"),
-                       default=120.0, help="speed [km/h] (default %(default)s)")
-    p.add_argument("--n0", type=bounded("--n0 (wheel force, N)", "[1e3, 1e6]", "N"),
-                   default=None, help="static wheel force N0 [N] (default: parameter set)")
-    p.add_argument("--bm", type=bounded("--bm (motor slope, N m s/rad)", "[0, 1e9]",
-                                        "N m s/rad"),
-                   default=None, help="motor slope b_M [N m s/rad] (default: parameter set)")
-    p.add_argument("--params", default=None, metavar="FILE",
-                   help="parameter file (TOML; default: the calibrated set)")
-    p.add_argument("--json", action="store_true", help="machine-readable JSON output")
-
-
 def _add_sweep_point(p: argparse.ArgumentParser) -> None:
     """The operating point without a speed, and the speed range ``--v A:B:N`` [km/h]."""
     p.add_argument("--v", default=SPEEDS, metavar="A:B:N",
                    help="N speeds from A to B km/h, 1 <= A < B <= 500 (default %(default)s)")
-    _add_point(p, speed=False)
+    add_operating_point(p, speed=False)
 
 
 def _add_excitation(p: argparse.ArgumentParser) -> None:
