@@ -266,6 +266,8 @@ def _frf_table(result) -> str:
              f"log-spaced over {result.f_hz[1]:g}…{result.f_hz[-1]:g} Hz and "
              f"{len(result.f_hz) - 1 - result.base_points} across the resonances "
              f"(modal form; {result.direct_points} solved directly)",
+             *([] if result.stable else [
+                 "UNSTABLE operating point: a mode grows, H(f) is no steady state"]),
              f"{'output':<34} {'unit':>5} {'static':>10}  peaks: f [Hz] |H| (× static)"]
     for i, (name, unit) in enumerate(zip(result.names, result.units, strict=True)):
         peaks = "; ".join(

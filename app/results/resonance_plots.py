@@ -139,7 +139,9 @@ class FrfPlot:
                                     for p in peaks]}
         op = frf.operating_point
         self.magnitude.title.text = (f"{output} at s0 = {op.s0:g}, v = {op.v_kmh:g} km/h "
-                                     f"(static gain {abs(frf.static_gain[row]):.4g})")
+                                     f"(static gain {abs(frf.static_gain[row]):.4g})"
+                                     + ("" if frf.stable else
+                                        " — unstable point: no steady state"))
         self.magnitude.yaxis.axis_label = f"|H| [{unit}] from {frf.input}"
 
 

@@ -248,6 +248,7 @@ class FrequencyResponse:
     peaks: tuple[tuple[Peak, ...], ...]  # per output, by frequency
     base_points: int  # the log-spaced points of the grid (the rest refine resonances)
     direct_points: int  # grid values solved directly (modal rounding estimate too large)
+    stable: bool = True  # False: a mode grows, H(f) is no steady state (only its definition)
 
     @property
     def magnitude(self) -> np.ndarray:
@@ -320,9 +321,11 @@ def frequency_response(model: BogieModel, op: OperatingPoint, input: str = DEFAU
     H = np.concatenate([gain[:, None], H_grid], axis=1)
     peaks = _peaks(model_transfer, grid, H_grid, gain, min_peak)
     _, unit = input_force(model, input)
+    lam = model_transfer.eigenvalues
+    stable = bool(np.all(lam[non_neutral(lam)].real <= 0))
     return FrequencyResponse(input, unit, op, f_all, tuple(matrices.names[i] for i in rows),
                              tuple(matrices.units[i] for i in rows), H, gain, peaks, points,
-                             len(suspect))
+                             len(suspect), stable)
 
 
 def _peaks(model_transfer: ModalTransfer, grid: np.ndarray, H_grid: np.ndarray,

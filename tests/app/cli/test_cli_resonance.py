@@ -108,6 +108,16 @@ def test_frf_text_states_peaks_and_amplification(capsys):
     assert "×" in row
 
 
+def test_frf_at_an_unstable_point_says_it_is_no_steady_state(capsys):
+    code, out, err = run(["frf", "--s0", "0.014", "--outputs", "ID1.driving_shaft.torque",
+                          "--f", "1:100:50"], capsys)
+    assert code == 0, err
+    assert "UNSTABLE operating point" in out
+    code, out, err = run(["frf", "--s0", "0.005", "--outputs", "ID1.driving_shaft.torque",
+                          "--f", "1:100:50"], capsys)
+    assert "UNSTABLE" not in out
+
+
 def test_ripple_json(capsys):
     code, out, err = run(["ripple", "--v", "60:120:13", "--ripple", "el:6=250,el:12=120",
                           "--outputs", "ID1.driving_shaft.torque", "--json"], capsys)
