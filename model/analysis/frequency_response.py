@@ -17,8 +17,8 @@ with ``[C₁ C₂] = C Q``, ``[b₁; b₂] = Qᵀ b`` and the rigid-body drift `
 The named outputs are forces and torques of elements, which a rigid-body motion does not strain
 (``C₁ = 0`` to rounding), so ``g = 0`` and the static gain ``H(0) = −Σ R_j / λ_j`` is finite.  One
 evaluation at F frequencies is a product of the residues (outputs × modes) with the kernel
-``1/(i 2π f − λ_j)`` (modes × F): an FRF of every output at 2000 frequencies costs a fraction of
-the eigen-analysis it reuses.  Rounding: ``ε · cond(Y) · Σ_j |R_j|/|s − λ_j|`` estimates the error of
+``1/(i 2π f − λ_j)`` (modes × F): an FRF of every output at 2000 frequencies costs about as much
+as the eigen-analysis it reuses (BENCHMARKS.md).  Rounding: ``ε · cond(Y) · Σ_j |R_j|/|s − λ_j|`` estimates the error of
 every value; a frequency whose estimate exceeds :data:`MODAL_TOLERANCE` of the largest |H| is
 solved directly instead.
 
@@ -28,7 +28,7 @@ Direct form (the reference, and for a few frequencies).  ``(−ω² M + iω B_to
 The grid.  ``N`` frequencies spaced logarithmically over [f_lo, f_hi], plus nine points on each
 mode's resonance ``Im λ/2π + {0, ±½, ±1, ±2, ±3} · |Re λ|/2π`` (the half-power half-width of
 the mode is |Re λ|/2π): a peak cannot fall between two grid points unseen.  Every local maximum
-of |H| on the grid is then refined by golden-section search to 1e-9 of its frequency, so peak
+of |H| on the grid is then refined by golden-section search to 1e-12 of its frequency, so peak
 heights are those of H itself, not of the grid.
 """
 
