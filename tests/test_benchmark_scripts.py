@@ -29,6 +29,8 @@ ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     pytest.param("bench_sensitivity.py", ["--repeats", "1", "--timed-runs", "1",
                                           "--creep-n", "16"],
                  "ds0*/dp at known s0*", id="sensitivity"),
+    pytest.param("bench_resonance.py", ["--speeds", "12", "--points", "200", "--repeat", "1"],
+                 "Campbell diagram, 12 speeds", id="resonance"),
 ])
 def test_benchmark_script_runs(script, arguments, expected):
     run = subprocess.run([sys.executable, str(ROOT / "scripts" / script), *arguments], cwd=ROOT,

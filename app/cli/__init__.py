@@ -3,7 +3,8 @@
 :mod:`.main` builds the parser from the groups' ``register`` functions and runs a command.
 Groups: :mod:`.analysis` (eigen, limit, modes, locus, export), :mod:`.calibrate`, :mod:`.serve`,
 :mod:`.response`, :mod:`.antislip`, :mod:`.sensitivity` (sensitivity, uncertainty),
-:mod:`.study`, :mod:`.compare`, :mod:`.report`.  What several groups need lives below them:
+:mod:`.study`, :mod:`.compare`, :mod:`.report`, :mod:`.resonance` (campbell, frf, ripple).
+What several groups need lives below them:
 :mod:`.options` (the parser, numbers with bounds, the operating point, ranges, the time grid, the
 short circuit, the creep, anti-slip and uncertainty options) and :mod:`.output` (JSON or a table,
 time histories to files, limit lines).  No group imports another (an import-linter contract in

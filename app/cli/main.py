@@ -19,6 +19,7 @@ from app.cli import (
     loads,
     parameters,
     report,
+    resonance,
     response,
     sensitivity,
     serve,
@@ -29,12 +30,13 @@ from model.mechanics.parameters import ParameterError
 
 COMMAND_GROUPS = (analysis.register, calibrate.register, analysis.register_export, serve.register,
                   response.register, sensitivity.register, antislip.register, study.register,
-                  compare.register, report.register, loads.register, parameters.register)
+                  compare.register, report.register, loads.register, resonance.register,
+                  parameters.register)
 
 
 def build_parser() -> BogieParser:
     parser = BogieParser(prog="bogie", description="Locomotive bogie drive dynamics: eigenvalues, "
-                         "stability and traction-motor short-circuit response.")
+                         "stability, traction-motor short-circuit response and resonances.")
     subparsers = parser.add_subparsers(dest="command", required=True, parser_class=BogieParser)
     for register in COMMAND_GROUPS:
         register(subparsers)

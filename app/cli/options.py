@@ -107,12 +107,15 @@ def positive_int(label: str) -> Callable[[str], int]:
 
 # --- the operating point -------------------------------------------------------------------------
 
-def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.005) -> None:
-    """``--s0 --v --n0 --bm --params --json`` (``s0``: the default creepage; None: not given)."""
+def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.005,
+                        speed: bool = True) -> None:
+    """``--s0 --v --n0 --bm --params --json`` (``s0``: the default creepage; None: not given;
+    ``speed`` False: no ``--v``, for a command that sweeps the speed)."""
     parser.add_argument("--s0", type=bounded("--s0 (creepage)", "(0, 1)"),
                         default=s0, help="longitudinal creepage s0 [-] (default %(default)s)")
-    parser.add_argument("--v", type=bounded("--v (speed, km/h)", "[1, 500]", "km/h"),
-                        default=120.0, help="speed [km/h] (default %(default)s)")
+    if speed:
+        parser.add_argument("--v", type=bounded("--v (speed, km/h)", "[1, 500]", "km/h"),
+                            default=120.0, help="speed [km/h] (default %(default)s)")
     parser.add_argument("--n0", type=bounded("--n0 (wheel force, N)", "[1e3, 1e6]", "N"),
                         default=None, help="static wheel force N0 [N] (default: parameter set)")
     parser.add_argument("--bm", type=bounded("--bm (motor slope, N m s/rad)", "[0, 1e9]",

@@ -5,10 +5,10 @@ locus, time histories); its pieces: :mod:`.controls` (the controls column), :mod
 state a computation depends on and the computations of a change), :mod:`.scheduler` (when and
 where they run), :mod:`.layout` (the page and the tabs), :mod:`.downloads`, :mod:`.session`
 (the served session's document).  Each view (modes, nonlinear creep, sensitivity, studies,
-variant, uncertainty band, design loads with its grid envelope) gets the dashboard object and
+variant, uncertainty band, design loads with its grid envelope, resonances) gets the dashboard object and
 talks to it through its small public interface (``state()``, ``alive()``, ``post()``,
 ``run_locked()``, ``warn()``, ``clear_warning()``, ``when_shown()``, ``flush_view()``,
-``params_path``, ``set_key``, ``study_owner``, ``show_history()``); no view imports
+``params_path``, ``set_key``, ``study_owner``, ``show_history()``, ``show_mode()``); no view imports
 :mod:`.dashboard`.  May use :mod:`app.report`, :mod:`app.results`, :mod:`app.services`
 and ``model``; never the server or the command line.
 """

@@ -11,12 +11,13 @@ locus, time histories, tables); its pieces have modules of their own:
 * :mod:`.downloads` — the files (CSV, JSON, TOML, HTML report);
 * :mod:`.session` — the served session's document, its URL query, showing results with its lock.
 
-The views (modes, nonlinear creep, sensitivity, studies, variant, design loads) get the
+The views (modes, nonlinear creep, sensitivity, studies, variant, design loads, resonances) get the
 dashboard object and use its public interface only: ``state()``, ``alive()``, ``post(doc,
 function, *args)``, ``run_locked(function, *args)``, ``warn(text)``, ``clear_warning()``,
 ``when_shown(tab, function, *args)``, ``flush_view(tab)``, ``params_path``, ``set_key``,
 ``study_owner`` (the session's claim in the server's study queue), ``show_history(key,
-history)`` (the nonlinear view: which history the peak table describes), the parameters, the
+history)`` (the nonlinear view: which history the peak table describes), ``show_mode(mode,
+where)`` (a mode picked elsewhere, shown in the Modes view), the parameters, the
 last valid results (``point``, ``response``, ``history``, ``locus_result``), the nonlinear view's
 creep switch and anti-slip key (``nonlinear``) and the plots they draw on.  A rejected parameter
 combination shows a notice and keeps the last valid results on screen.
@@ -37,6 +38,7 @@ from app.dashboard.downloads import Downloads
 from app.dashboard.modes_view import ModeClickThrough
 from app.dashboard.nonlinear_view import NonlinearView
 from app.dashboard.panel_fixes import skip_detached_markup_models
+from app.dashboard.resonance_view import ResonanceView
 from app.dashboard.scheduler import Scheduler
 from app.dashboard.sensitivity_view import SensitivityView
 from app.dashboard.session import post, run_locked, served_document, session_query
@@ -189,6 +191,9 @@ class BogieDashboard(pn.viewable.Viewer):
         # the worst case over the fault instant, grid envelopes, load spectra
         self.design_loads = DesignLoadsView(self)
         self.view_tabs.add("Design loads", self.design_loads.layout)
+        # the Campbell diagram, the frequency response, the forced response to a torque ripple
+        self.resonances = ResonanceView(self)
+        self.view_tabs.add("Resonances", self.resonances.layout)
         self.downloads = Downloads(self)
         self.controls = Controls(self, self.nonlinear.controls, self.downloads.widgets)
         self.sliders = self.controls.sliders
@@ -253,6 +258,12 @@ class BogieDashboard(pn.viewable.Viewer):
         """Apply the updates the view ``tab`` missed while hidden, in the order they came."""
         self.view_tabs.flush(tab)
 
+    def show_mode(self, mode: compute.Mode, where: str) -> None:
+        """Open the Modes view on ``mode`` (its shape, description and energy shares); ``where``
+        says where it was picked (the Resonances view's tapped Campbell point)."""
+        self.tabs.active = self.view_tabs.names.index("modes")
+        self.click.show_mode(mode, where)
+
     def show_published_case(self, s0: float) -> None:
         """The operating point of one of the study's published cases: ``s0`` at 120 km/h."""
         self.param.update(s0=s0, v=PUBLISHED_SPEED_KMH)
@@ -280,10 +291,11 @@ class BogieDashboard(pn.viewable.Viewer):
                       + "; ".join(notices))
 
     def _tab_shown(self, *_events) -> None:
-        """Views that compute only while shown (the variant comparison) learn it here; the
-        updates a hidden view missed are applied."""
+        """Views that compute only while shown (the variant comparison, the resonances) learn it
+        here; the updates a hidden view missed are applied."""
         shown = self.view_tabs.shown
         self.variant_view.on_shown(shown == "variant")
+        self.resonances.on_shown(shown == "resonances")
         self.flush_view(shown)
 
     def _share(self, *_events) -> None:
@@ -315,6 +327,7 @@ class BogieDashboard(pn.viewable.Viewer):
         # the sensitivity tornado is computed when its tab is open, shown when ready
         self.when_shown("sensitivity", self.sensitivity.request, self, state)
         self.when_shown("design-loads", self.design_loads.request_worst_case, state)
+        self.resonances.request(state)  # computed while its tab is open
         # the nonlinear result follows; the peak table shows the history of the creep model in
         # use (show_history, called by the nonlinear view)
         self.nonlinear.on_fast(state)

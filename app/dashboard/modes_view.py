@@ -152,8 +152,13 @@ class ModeClickThrough:
         except Exception as error:  # a model rejection: say so, keep the views
             dashboard.warn(f"Mode at the tapped point not shown: {error}")
             return
+        self.show_mode(mode, f"tapped on the root locus: s0 = {s0:.5g}, v = {v:.4g} km/h "
+                             f"(nearest mode to λ = {re:+.3f} + i {im / (2 * math.pi):.3f} Hz)")
+
+    def show_mode(self, mode: compute.Mode, where: str) -> None:
+        """Show ``mode`` (picked anywhere: a locus point, a Campbell point) in the mode views;
+        ``where`` says where it was picked."""
+        self.dashboard.flush_view("modes")  # the tables and views of the current point first
         self.shown = mode
-        dashboard.mode_plot.update(mode.displacement)
-        self.detail.object = mode_detail_html(
-            mode, f"tapped on the root locus: s0 = {s0:.5g}, v = {v:.4g} km/h (nearest mode "
-                  f"to λ = {re:+.3f} + i {im / (2 * math.pi):.3f} Hz)")
+        self.dashboard.mode_plot.update(mode.displacement)
+        self.detail.object = mode_detail_html(mode, where)

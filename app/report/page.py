@@ -6,7 +6,9 @@ from the bundled baseline), status numbers and s0*(v), Table 1/2 layouts, the ro
 sweep), Fig. 6, the creep characteristic, the time histories and the peak table with the limit
 crossings (of the linear closed form, or of the nonlinear creep model when the dashboard has it
 on), the design loads (the worst case over every fault instant, the load collective and the
-damage-equivalent ranges of the history), the code version and the date.  The figures are the dashboard's own
+damage-equivalent ranges of the history), the resonances (the Campbell diagram with its
+crossings, the frequency response and the forced response to the default torque ripple of ID1's
+driving shaft), the code version and the date.  The figures are the dashboard's own
 (:mod:`app.results.plots`, :mod:`app.results.eigenvalue_sweep`), fed with the same cached
 results (:mod:`app.results.compute`).
 
@@ -28,11 +30,13 @@ from pathlib import Path
 from bokeh.layouts import column, row
 
 from app.report.embedding import EmbeddedFigures, embed_inline
-from app.results import compute
+from app.results import compute, resonance
 from app.results.eigenvalue_sweep import Fig6Plot
 from app.results.load_plots import LoadCollectivePlot
 from app.results.plots import CreepPlot, ResponsePlots, RootLocusPlot
+from app.results.resonance_plots import CampbellPlot, FrfPlot, RipplePlot
 from app.results.tables import (
+    crossings_html,
     eigen_table_html,
     mode_table_html,
     peaks_html,
@@ -40,6 +44,7 @@ from app.results.tables import (
     worst_case_html,
 )
 from app.results.variants import differences, parameters_of_key, set_hash, split_key
+from model.analysis.frequency_response import FrequencyResponse
 from model.mechanics.parameters import SCHEMA
 
 ROOT = Path(__file__).resolve().parents[2]  # the project (app/report/page.py)
@@ -105,6 +110,9 @@ class ReportResults:
     limit: compute.LimitResult
     worst: compute.WorstCaseView  # the worst case over every fault instant (linear)
     spectra: compute.SpectraView  # load spectra of the history shown
+    campbell: resonance.CampbellView  # over the dashboard's speeds, the default orders
+    frf: FrequencyResponse  # from ID1's motor torque at the case's point
+    ripple: resonance.RippleView  # the default ripple over the dashboard's speeds
 
 
 def report_results(case: ReportCase, say=lambda _text: None) -> ReportResults:
@@ -122,7 +130,12 @@ def report_results(case: ReportCase, say=lambda _text: None) -> ReportResults:
     say("design loads: worst case over the fault instant, load spectra")
     worst = compute.worst_case_result(*case.point, *excitation)
     spectra = compute.spectra_result(*case.point, *excitation, case.anti_slip)
-    return ReportResults(point, response, locus, limit, worst, spectra)
+    say("resonances: Campbell diagram, frequency response, torque ripple")
+    common = (case.set_key, case.rail, case.s0, case.N0_kN, case.b_M)
+    campbell = resonance.campbell_result(*common)
+    frf = resonance.frf_result(*case.point)
+    ripple = resonance.ripple_result(*common)
+    return ReportResults(point, response, locus, limit, worst, spectra, campbell, frf, ripple)
 
 
 def report_figures(results: ReportResults) -> dict:
@@ -145,6 +158,14 @@ def report_figures(results: ReportResults) -> dict:
         plot = LoadCollectivePlot()
         plot.update(results.spectra, part)
         collectives.append(plot.figure)
+    campbell = CampbellPlot()
+    campbell.update(results.campbell)
+    campbell.mark_speed(results.point.key[3])
+    frf = FrfPlot()
+    frf.update(results.frf, resonance.DEFAULT_OUTPUT)
+    ripple = RipplePlot()
+    ripple.update(results.ripple, resonance.DEFAULT_OUTPUT)
+    ripple.mark_speed(results.point.key[3])
     return {
         "locus": locus_plot.figure,
         "fig6": column(row(*fig6.figures[:2], sizing_mode="stretch_width"), fig6.figures[2],
@@ -156,6 +177,9 @@ def report_figures(results: ReportResults) -> dict:
         "collective": column(row(*collectives[:2], sizing_mode="stretch_width"),
                              row(*collectives[2:], sizing_mode="stretch_width"),
                              sizing_mode="stretch_width"),
+        "campbell": campbell.figure,
+        "resonance": row(column(frf.magnitude, frf.phase, sizing_mode="stretch_width"),
+                         ripple.figure, sizing_mode="stretch_width"),
     }
 
 
@@ -229,6 +253,25 @@ def design_loads_section(results: ReportResults, collective_div: str) -> str:
 {collective_div}"""
 
 
+def resonance_section(results: ReportResults, campbell_div: str, resonance_div: str) -> str:
+    """Where the drive resonates (docs/resonance.md): the Campbell diagram with its crossings,
+    the frequency response and the forced response of ID1's driving shaft."""
+    view = results.campbell
+    ripple = ", ".join(f"{label} = {a:g} N m" for label, a in zip(
+        results.ripple.labels, results.ripple.amplitudes, strict=True))
+    return f"""<h2>Resonances</h2>
+<p>The modes a motor's torque drives over {view.v_kmh[0]:g}…{view.v_kmh[-1]:g} km/h at this
+creepage (coloured by their damping ratio), the excitation orders and their crossings (named at
+{view.reference_kmh:g} km/h; the dotted line: this report's speed).</p>
+{campbell_div}
+{crossings_html(view)}
+<p>The frequency response of {resonance.DEFAULT_OUTPUT} at this operating point, and its
+steady amplitude over speed under the torque ripple {html.escape(ripple)} of
+{html.escape(results.ripple.key[-1])} (the sum over the orders: the largest the steady state
+reaches).</p>
+{resonance_div}"""
+
+
 # --- the page --------------------------------------------------------------------------------------
 
 def report_page(case: ReportCase, results: ReportResults, figures: EmbeddedFigures,
@@ -263,6 +306,7 @@ parameter set {name}{' (variant)' if changes else ''}, hash <code>{set_hash(para
 <p class="sub">Time histories min/max-decimated for plotting (every extreme kept); the peaks are
 from the full 10 kHz history.</p>
 {design_loads_section(results, divs['collective'])}
+{resonance_section(results, divs['campbell'], divs['resonance'])}
 <p class="sub">Generated by the dashboard's report button or <code>bogie report</code>.</p>
 {figures.script}
 </body></html>

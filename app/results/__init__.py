@@ -1,7 +1,8 @@
 """What every interface shows: cached results as plain data, and the figures and tables of them.
 
 :mod:`.compute` (the dashboard's and the report's computations, cached across sessions),
-:mod:`.variants` (design variants of the bundled set), :mod:`.plots` and
-:mod:`.eigenvalue_sweep` (Bokeh figures fed with results), :mod:`.tables` (HTML tables of
-results).  May use ``model`` only.
+:mod:`.resonance` (those of the Campbell diagram, the frequency response and the forced
+response), :mod:`.variants` (design variants of the bundled set), :mod:`.plots`,
+:mod:`.eigenvalue_sweep` and :mod:`.resonance_plots` (Bokeh figures fed with results),
+:mod:`.tables` (HTML tables of results).  May use ``model`` only.
 """

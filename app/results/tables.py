@@ -1,6 +1,7 @@
 """HTML tables of results, shared by the dashboard and the report: Table 1's layout (eigenvalues),
-Table 2's (mode descriptions) and the peaks of the short-circuit response.  Units in every
-header: Re [1/s], Im [Hz], torques [N m], forces [N], times [s]."""
+Table 2's (mode descriptions), the peaks of the short-circuit response and the crossings of the
+Campbell diagram.  Units in every header: Re [1/s], Im [Hz], torques [N m], forces [N],
+times [s], speeds [km/h]."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import html
 import math
 
 from app.results import compute
+from app.results.resonance import CampbellView
 
 
 def _complex(lam: complex) -> str:
@@ -123,3 +125,22 @@ def spectra_html(spectra: compute.SpectraView) -> str:
             f"the history with {html.escape(spectra.history)}, Δt = "
             f"{spectra.fault_instant * 1e3:.4g} ms; ΔM_eq = (Σ nᵢ ΔMᵢ^m / N_ref)^(1/m), "
             f"N_ref = {first.n_ref:.0e} cycles, in the part's unit.</div>")
+
+
+CROSSINGS_LISTED = 8  # rows of the crossings table
+
+
+def crossings_html(view: CampbellView, listed: int = CROSSINGS_LISTED) -> str:
+    """The crossings with the largest severity as an HTML table."""
+    if not view.crossings:
+        return "<i>no order line meets a mode in the speed range</i>"
+    rows = "".join(
+        f"<tr><td>{c.v_kmh:.1f}</td><td>{c.f_hz:.2f}</td><td class='text'>{html.escape(c.label)}"
+        f"</td><td>{c.zeta:.4f}</td><td><b>{c.severity:.3g}</b></td>"
+        f"<td class='text'>{html.escape(c.worst_output)}</td>"
+        f"<td class='text'>{html.escape(c.mode)}</td></tr>" for c in view.crossings[:listed])
+    return (f"<b>Crossings</b> ({len(view.crossings)}, the {min(listed, len(view.crossings))} "
+            f"most severe; severity = torque amplitude per N m of {html.escape(view.input)} at "
+            "that order)<table class='bogie'><tr><th>v [km/h]</th><th>f [Hz]</th>"
+            "<th class='text'>order</th><th>ζ [-]</th><th>N m/N m</th>"
+            "<th class='text'>in</th><th class='text'>mode</th></tr>" + rows + "</table>")

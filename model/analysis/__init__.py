@@ -5,6 +5,8 @@ stability limit (:mod:`.stability`), mode descriptions (:mod:`.modes`), root loc
 continuation (:mod:`.locus`, :mod:`.continuation`), the short-circuit response (linear:
 :mod:`.response`; nonlinear creep with its block stepper: :mod:`.nonlinear`,
 :mod:`.block_stepper`), anti-slip reaction times (:mod:`.antislip`), eigenvalue and peak
-sensitivities (:mod:`.sensitivity`) and the system export (:mod:`.export`).  May use
-:mod:`model.mechanics` and :mod:`model.contact`; never the studies or ``app``.
+sensitivities (:mod:`.sensitivity`), the frequency response (:mod:`.frequency_response`), the
+Campbell diagram with its crossings and the forced response to a torque ripple (:mod:`.campbell`)
+and the system export (:mod:`.export`).  May use :mod:`model.mechanics` and :mod:`model.contact`;
+never the studies or ``app``.
 """

@@ -29,6 +29,10 @@ Method — a reduced model whose error is estimated at every point and bounded b
    a point).
 4. Branches are continued from point to point by an optimal assignment on ``1 − MAC`` plus the
    normalized eigenvalue distance, so branches do not swap at near-crossings.
+5. ``select`` (optional) narrows step 2 and the tracking to some of the modes inside the disc
+   (say, those a motor's torque excites: :mod:`model.analysis.campbell`): the basis holds only
+   their vectors, so a sweep of a few modes spread over a wide band costs what a sweep of a
+   narrow band does.  The error control is the same (the other modes are simply not tracked).
 
 The naive reference (:func:`dense_generalized_eigenvalues`) solves the generalized eigenproblem
 (21)–(22) densely at a point; ``scripts/bench_locus.py`` compares both.
@@ -200,6 +204,7 @@ class _SweepStart:
     last: tuple[np.ndarray, np.ndarray]
     reduced: Reduced
     solutions: dict[bytes, tuple[np.ndarray, np.ndarray]]
+    tracked: np.ndarray  # indices of the first point's eigenvalues that are tracked
 
 
 _SWEEP_STARTS: OrderedDict[tuple, _SweepStart] = OrderedDict()
@@ -209,8 +214,8 @@ _SWEEP_STARTS_LOCK = threading.Lock()
 
 
 def _sweep_start_key(model: BogieModel, first: OperatingPoint, last: OperatingPoint,
-                     radius: float) -> tuple:
-    return (id(model), first, last, radius)
+                     radius: float, select) -> tuple:
+    return (id(model), first, last, radius, select)
 
 
 def clear_sweep_starts() -> None:
@@ -255,7 +260,7 @@ def _solver_pool(workers: int) -> ThreadPoolExecutor:
 
 def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
                max_frequency_hz: float = 20.0, rtol: float = 1e-6, workers: int = 2,
-               lambda_floor: float = 0.0) -> RootLocus:
+               lambda_floor: float = 0.0, select=None) -> RootLocus:
     """Track the non-rigid eigenvalues with |λ| < 2π·max_frequency_hz (at the first value) while
     ``parameter`` ("s0" [-] or "v" [m/s]) runs through ``values``; the other quantities of the
     operating point ``op`` stay fixed.  ``workers`` threads solve the reduced eigenproblems
@@ -263,13 +268,17 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     real one outside it continues as one half of the new complex pair (the other half is not
     tracked); pairs that start complex stay conjugate pairs.  ``rtol``: the tolerance of every
     tracked eigenvalue inside the controlled disc, relative to max(|λ|, ``lambda_floor`` [1/s])
-    (default 0: relative to |λ|; the module docstring says when a floor is wanted)."""
+    (default 0: relative to |λ|; the module docstring says when a floor is wanted).
+    ``select``: None (every mode inside the disc) or a hashable callable ``select(model, point,
+    eigenvalues) -> bool mask`` over the eigenvalues of :func:`eigen_analysis` at ``point``: the
+    modes (inside the disc) whose vectors form the basis at each of the three exact points and,
+    at the first, the branches tracked (module docstring, step 5)."""
     if not (math.isfinite(lambda_floor) and lambda_floor >= 0):
         raise ValueError(f"lambda_floor must be a finite value >= 0 [1/s], got {lambda_floor!r}")
     values, points, coefficients = _sweep_points(model, op, parameter, values)
     radius = 2 * np.pi * max_frequency_hz
-    key = _sweep_start_key(model, points[0], points[-1], radius)
-    start = _sweep_start(model, op, parameter, points, radius, workers, key)
+    key = _sweep_start_key(model, points[0], points[-1], radius, select)
+    start = _sweep_start(model, op, parameter, points, radius, workers, key, select)
     inner = _InnerSolutions(start, coefficients[1:-1], workers)
     tracks = _track(model, points, coefficients, start, inner, radius, rtol,
                     max(lambda_floor, 1e-300))
@@ -299,18 +308,26 @@ def _exact(model: BogieModel, point: OperatingPoint) -> tuple[np.ndarray, np.nda
     return result.eigenvalues, q / np.linalg.norm(q, axis=0)
 
 
-def _modes(lam: np.ndarray, Q: np.ndarray, radius: float) -> list[np.ndarray]:
-    """Real and imaginary parts of the vectors Q of the eigenvalues with |λ| < ``radius`` [1/s]."""
-    chosen = Q[:, np.abs(lam) < radius]
-    return [chosen.real, chosen.imag]
+def _chosen(model: BogieModel, point: OperatingPoint, lam: np.ndarray, radius: float,
+            select) -> np.ndarray:
+    """Mask of the eigenvalues with |λ| < ``radius`` [1/s] that ``select`` keeps (all without)."""
+    inside = np.abs(lam) < radius
+    if select is None:
+        return inside
+    return inside & np.asarray(select(model, point, lam), dtype=bool)
+
+
+def _modes(Q: np.ndarray, chosen: np.ndarray) -> list[np.ndarray]:
+    """Real and imaginary parts of the vectors Q of the ``chosen`` eigenvalues."""
+    return [Q[:, chosen].real, Q[:, chosen].imag]
 
 
 def _sweep_start(model: BogieModel, op: OperatingPoint, parameter: str,
                  points: list[OperatingPoint], radius: float, workers: int,
-                 key: tuple) -> _SweepStart:
+                 key: tuple, select=None) -> _SweepStart:
     """The kept start of a sweep over this range, or a new one: the exact end points and the
     reduced model on their modes and those of the range's middle (``parameter`` halfway) with
-    |λ| < ``radius`` [1/s] (and the rigid-body modes)."""
+    |λ| < ``radius`` [1/s] that ``select`` keeps (and the rigid-body modes)."""
     with _SWEEP_STARTS_LOCK:
         start = _SWEEP_STARTS.get(key)
         if start is not None and start.model is model:
@@ -334,10 +351,13 @@ def _sweep_start(model: BogieModel, op: OperatingPoint, parameter: str,
     else:
         first, (last, middle) = _exact(model, points[0]), [_exact(model, p) for p in others]
     vectors = [model.rigid_body_modes]
-    for solution in (first, last, middle):
-        vectors += _modes(*solution, radius)
+    anchors = (points[0], others[0], others[1])
+    masks = [_chosen(model, point, solution[0], radius, select)
+             for point, solution in zip(anchors, (first, last, middle), strict=True)]
+    for (_, Q), chosen in zip((first, last, middle), masks, strict=True):
+        vectors += _modes(Q, chosen)
     reduced = Reduced(model, op, creep_patterns(model), vectors)
-    return _SweepStart(model, first, last, reduced, {})
+    return _SweepStart(model, first, last, reduced, {}, np.flatnonzero(masks[0]))
 
 
 class _InnerSolutions:
@@ -380,13 +400,13 @@ class _Tracks:
 def _track(model: BogieModel, points: list[OperatingPoint], coefficients: np.ndarray,
            start: _SweepStart, solution: _InnerSolutions, radius: float, rtol: float,
            floor: float) -> _Tracks:
-    """Continue the branches with |λ| < ``radius`` [1/s] at the first point from point to point:
-    the reduced solution where it is accurate to ``rtol`` (after Newton on a few branches), the
-    dense one otherwise and at the last point."""
+    """Continue the tracked branches (those with |λ| < ``radius`` [1/s] at the first point that
+    the sweep's selection keeps) from point to point: the reduced solution where it is accurate to
+    ``rtol`` (after Newton on a few branches), the dense one otherwise and at the last point."""
     first, last, reduced = start.first, start.last, start.reduced
     controlled = 1.5 * radius  # accuracy is enforced for branches inside this disc
     n_points = len(points)
-    tracked = np.flatnonzero(np.abs(first[0]) < radius)
+    tracked = start.tracked
     eigenvalues = np.zeros((n_points, len(tracked)), dtype=complex)
     errors = np.zeros((n_points, len(tracked)))
     dense = np.zeros(n_points, dtype=bool)
@@ -432,14 +452,26 @@ def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, redu
     failing = np.flatnonzero((estimate > rtol) & (np.abs(values_i) < controlled))
     if not ok or len(failing) > max(2, len(chosen) // 4):
         return None
-    # refine the few inaccurate branches by Newton's method in the full model
+    # refine the few inaccurate branches by Newton's method in the full model; the reduced
+    # matrices are real, so a complex pair's two branches are exact conjugates: the second is
+    # the conjugate of the first's refinement (one full-model solve per pair, not two)
     C = damping_matrix(model, point) if len(failing) else None
+    partner_of: dict[int, int] = {}  # conjugate branch -> the refined one it copies
     for b in failing:
+        if b in partner_of:
+            a = partner_of[b]
+            values_i[b], vectors_i[:, b] = values_i[a].conjugate(), vectors_i[:, a].conj()
+            estimate[b] = estimate[a]
+            continue
+        conjugates = [other for other in failing if other != b and values_i[b].imag != 0
+                      and values_i[other] == values_i[b].conjugate()]
+        if conjugates:
+            partner_of[conjugates[0]] = b
         values_i[b], vectors_i[:, b], estimate[b] = newton(
             model.M, C, model.K, values_i[b], vectors_i[:, b], rtol, floor=floor)
     if not np.all((estimate <= rtol) | (np.abs(values_i) >= controlled)):
         return None
-    return values_i, vectors_i, estimate, len(failing)
+    return values_i, vectors_i, estimate, len(failing) - len(partner_of)
 
 
 def _keep_sweep_start(key: tuple, model: BogieModel, start: _SweepStart,
@@ -449,7 +481,7 @@ def _keep_sweep_start(key: tuple, model: BogieModel, start: _SweepStart,
     with _SWEEP_STARTS_LOCK:
         if len(inner.keys) <= _SOLUTIONS_KEPT:
             start = _SweepStart(model, start.first, start.last, start.reduced,
-                                dict(zip(inner.keys, inner.solutions, strict=True)))
+                                dict(zip(inner.keys, inner.solutions, strict=True)), start.tracked)
         _SWEEP_STARTS[key] = start
         _SWEEP_STARTS.move_to_end(key)
         while len(_SWEEP_STARTS) > _SWEEP_STARTS_KEPT:

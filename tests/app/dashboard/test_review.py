@@ -338,9 +338,11 @@ def test_report_of_a_variant_is_self_contained_and_complete():
     assert "gear_ratio" in text  # the difference from the baseline
     # Table 1 layout ("Eigenvalues at"), Table 2 layout ("Mode shapes"), code version and date
     for heading in ("Operating point", "Root locus", "Fig. 6", "Eigenvalues at", "Mode shapes",
-                    "Peaks", "code 0.", " UTC", "Differences from the baseline"):
+                    "Peaks", "code 0.", " UTC", "Differences from the baseline", "Resonances",
+                    "Crossings"):
         assert heading in text, heading
-    for name in ("root-locus", "fig6-im", "fig6-re", "fig6-real"):
+    for name in ("root-locus", "fig6-im", "fig6-re", "fig6-real", "campbell", "frf-magnitude",
+                 "ripple-response"):
         assert f'"{name}"' in text, name  # the figures, by name, in the embedded document
     assert f"{point.max_real_part:+.4f}" in text
 

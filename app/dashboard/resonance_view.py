@@ -1,0 +1,220 @@
+"""The Resonances view: where the drive resonates (docs/resonance.md).
+
+* the Campbell diagram over the dashboard's speeds at its creepage, wheel force and motor slope:
+  the modes a motor's torque drives coloured by their damping ratio, the excitation orders, the
+  crossings marked (hover: the mode's description, the crossing's severity); a tapped point of a
+  mode shows that mode at that speed in the Modes view (``dashboard.show_mode``);
+* the frequency response of the chosen output at the dashboard's operating point;
+* the forced response of that output over speed to a motor torque ripple.
+
+Settings (CSS classes ``ctl-resonance-*``): the rippling motor, the output, the orders, fixed
+frequencies and the ripple as text (the command line's syntax).  A text the model does not take
+shows the dashboard's notice and keeps the previous one.  The computations run on the side-view
+worker threads when served (the diagram takes seconds) and are shown when ready; nothing here
+computes physics.
+"""
+
+from __future__ import annotations
+
+import html
+import logging
+
+import panel as pn
+
+from app.results import compute, resonance
+from app.results.resonance_plots import CampbellPlot, FrfPlot, RipplePlot
+from app.results.tables import crossings_html
+from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest
+from model.mechanics.excitation import DEFAULT_ORDERS, parse_amplitudes, parse_orders
+
+log = logging.getLogger(__name__)
+class ResonanceView:
+    """The view, its settings and plots; ``layout`` is what the dashboard's tab shows."""
+
+    def __init__(self, dashboard):
+        self.dashboard = dashboard
+        self.campbell_plot = CampbellPlot()
+        self.frf_plot = FrfPlot()
+        self.ripple_plot = RipplePlot()
+        outputs = [name for name, _ in resonance.output_names(dashboard.params_path, "calibrated")]
+        self.input = pn.widgets.Select(label="rippling motor (input)",
+                                       options=list(resonance.MOTOR_INPUTS), width=200,
+                                       css_classes=["ctl-resonance-input"])
+        self.output = pn.widgets.Select(label="output (FRF and forced response)", options=outputs,
+                                        value=resonance.DEFAULT_OUTPUT, width=280,
+                                        css_classes=["ctl-resonance-output"])
+        self.orders = pn.widgets.TextInput(label="excitation orders", value=DEFAULT_ORDERS,
+                                           width=330, css_classes=["ctl-resonance-orders"])
+        self.fixed = pn.widgets.TextInput(label="fixed frequencies [Hz]", value="",
+                                          placeholder="e.g. 450, 900", width=160,
+                                          css_classes=["ctl-resonance-fixed"])
+        self.ripple = pn.widgets.TextInput(label="torque ripple order=amplitude [N m]",
+                                           value=resonance.DEFAULT_RIPPLE, width=230,
+                                           css_classes=["ctl-resonance-ripple"])
+        # the texts in use (the last ones the model took)
+        self.settings = {"orders": DEFAULT_ORDERS, "fixed": (), "ripple": resonance.DEFAULT_RIPPLE}
+        self.note = pn.pane.HTML("", sizing_mode="stretch_width",
+                                 css_classes=["resonance-note"])
+        self.table = pn.pane.HTML("", sizing_mode="stretch_width",
+                                  css_classes=["resonance-crossings"])
+        self.campbell: resonance.CampbellView | None = None  # on screen
+        self.frf = None
+        self.ripple_view: resonance.RippleView | None = None
+        self._state = None  # the dashboard state of the last request
+        self.shown = False  # the view's tab is open (it computes only then)
+        self._wanted: dict[str, tuple] = {}  # kind -> key of the newest request
+        self._shown: dict[str, tuple] = {}  # kind -> key of the result on screen
+        self._requests = {kind: LatestRequest(SIDE_VIEW_POOL, dashboard.alive)
+                          for kind in ("frf", "campbell", "ripple")}
+        for widget in (self.orders, self.fixed, self.ripple):
+            widget.param.watch(self._on_text, "value")
+        self.input.param.watch(lambda _e: self._recompute(), "value")
+        self.output.param.watch(lambda _e: self._redraw(), "value")
+        self.campbell_plot.modes.selected.on_change("indices", self._on_tap)
+        self.layout = pn.Column(
+            pn.pane.Markdown("### Where the drive resonates (docs/resonance.md)  \n"
+                             "Campbell diagram over speed at this creepage (hover a point for "
+                             "its mode, tap it for its shape in the Modes view), the frequency "
+                             "response at this operating point, the forced response to a torque "
+                             "ripple over speed."),
+            pn.Row(self.input, self.output, self.orders, self.fixed, self.ripple),
+            self.note, pn.pane.Bokeh(self.campbell_plot.figure, sizing_mode="stretch_width"),
+            self.table,
+            pn.Row(pn.Column(pn.pane.Bokeh(self.frf_plot.magnitude, sizing_mode="stretch_width"),
+                             pn.pane.Bokeh(self.frf_plot.phase, sizing_mode="stretch_width"),
+                             sizing_mode="stretch_width"),
+                   pn.pane.Bokeh(self.ripple_plot.figure, sizing_mode="stretch_width"),
+                   sizing_mode="stretch_width"),
+            sizing_mode="stretch_width", css_classes=["resonance-view"])
+
+    # --- settings -----------------------------------------------------------------------------
+
+    def _on_text(self, _event) -> None:
+        """Take the texts the model accepts; for one it does not, the notice (previous kept)."""
+        try:
+            orders = self.orders.value
+            parse_orders(orders)
+            fixed = resonance.parse_fixed(self.fixed.value)
+            ripple = self.ripple.value
+            parse_amplitudes(ripple)
+        except ValueError as error:
+            message = error.args[0] if error.args else str(error)
+            self.dashboard.warn(f"Resonances: {message} (the previous settings are kept)")
+            return
+        self.dashboard.clear_warning()
+        new = {"orders": orders, "fixed": fixed, "ripple": ripple}
+        if new != self.settings:
+            self.settings = new
+            self._recompute()
+
+    def _recompute(self) -> None:
+        if self._state is not None:
+            self.request(self._state)
+
+    # --- computing and showing ------------------------------------------------------------------
+
+    def keys(self, state) -> dict[str, tuple]:
+        """The arguments of each result for the dashboard's ``state`` and the view's settings."""
+        s = self.settings
+        motor = self.input.value
+        common = (state.params_path, state.rail, state.s0, state.N0, state.b_M)
+        return {"frf": (*state.point, motor),
+                "campbell": (*common, s["orders"], s["fixed"], motor),
+                "ripple": (*common, s["ripple"], motor)}
+
+    def on_shown(self, shown: bool) -> None:
+        """The dashboard opened (or left) the view's tab: compute for its state if needed."""
+        self.shown = shown
+        if shown:
+            self._recompute()
+
+    def request(self, state) -> None:
+        """Compute for the dashboard's ``state`` if the view is open (served: on the side-view
+        threads, each result shown when ready if still wanted; otherwise at once); else only
+        remember it for when the view is opened."""
+        self._state = state
+        if not self.shown:
+            return
+        self.campbell_plot.mark_speed(state.v)
+        self.ripple_plot.mark_speed(state.v)
+        functions = {"frf": resonance.frf_result, "campbell": resonance.campbell_result,
+                     "ripple": resonance.ripple_result}
+        doc = pn.state.curdoc
+        served = doc is not None and doc.session_context is not None
+        for kind, key in self.keys(state).items():
+            self._wanted[kind] = key
+            if self._shown.get(kind) == key:
+                continue
+            if not served:
+                try:
+                    self._apply(kind, key, functions[kind](*key))
+                except Exception as error:
+                    self._failed(kind, key, error)
+                continue
+            self.note.object = "<i>computing the resonances… (the Campbell diagram takes a few " \
+                               "seconds)</i>"
+            future = self._requests[kind].submit(self._if_wanted, kind, key, functions[kind])
+            future.add_done_callback(lambda f, kind=kind, key=key: self._done(doc, kind, key, f))
+
+    def _if_wanted(self, kind: str, key: tuple, function):
+        return function(*key) if self._wanted.get(kind) == key else None
+
+    def _done(self, doc, kind: str, key: tuple, future) -> None:
+        if future.cancelled() or self._wanted.get(kind) != key:
+            return
+        if future.exception() is not None:
+            self.dashboard.post(doc, self._failed, kind, key, future.exception())
+        elif future.result() is not None:
+            self.dashboard.post(doc, self._apply, kind, key, future.result())
+
+    def _failed(self, kind: str, key: tuple, error: Exception) -> None:
+        if self._wanted.get(kind) == key:
+            log.warning("resonances (%s) failed: %s", kind, error)
+            message = error.args[0] if error.args else str(error)
+            self.note.object = f"<i>{kind} not shown: {html.escape(str(message))}</i>"
+
+    def _apply(self, kind: str, key: tuple, result) -> None:
+        if self._wanted.get(kind) != key:
+            return
+        self._shown[kind] = key
+        if kind == "frf":
+            self.frf = result
+        elif kind == "campbell":
+            self.campbell = result
+            self.campbell_plot.update(result)
+            self.table.object = crossings_html(result)
+        else:
+            self.ripple_view = result
+        self._redraw()
+        if all(self._shown.get(k) == self._wanted.get(k) for k in self._wanted):
+            self.note.object = ""
+
+    def _redraw(self) -> None:
+        """The FRF and the forced response of the chosen output."""
+        output = self.output.value
+        if self.frf is not None and output in self.frf.names:
+            self.frf_plot.update(self.frf, output)
+        if self.ripple_view is not None and output in self.ripple_view.names:
+            self.ripple_plot.update(self.ripple_view, output)
+
+    # --- a tapped mode ----------------------------------------------------------------------------
+
+    def _on_tap(self, _attr, _old, new) -> None:
+        if new:
+            self.dashboard.run_locked(self.show_mode, int(new[0]))
+
+    def show_mode(self, index: int) -> None:
+        """The mode of the tapped point ``index`` of the diagram at its speed, in the Modes view."""
+        data = self.campbell_plot.modes.data
+        state = self._state
+        if state is None or not 0 <= index < len(data["v"]):
+            return
+        v, name = float(data["v"][index]), str(data["name"][index])
+        try:
+            mode = compute.mode_near(state.params_path, state.rail, state.s0, v, state.N0,
+                                     state.b_M, float(data["re"][index]), float(data["im"][index]))
+        except Exception as error:  # a model rejection: say so, keep the views
+            self.dashboard.warn(f"Mode at the tapped point not shown: {error}")
+            return
+        self.dashboard.show_mode(mode, f"tapped on the Campbell diagram: “{name}” at "
+                                       f"v = {v:.1f} km/h, s0 = {state.s0:g}")
