@@ -39,10 +39,10 @@ case "${1:-}" in
         fi
         "$VENV/bin/ruff" check model app tests scripts
         "$VENV/bin/lint-imports"  # the import contract of pyproject.toml (docs/architecture.md)
-        # one pytest worker per core (pytest-xdist; tests/conftest.py says which tests share one),
+        # one pytest worker per core (pytest-xdist; tests/conftest.py says which tests go together),
         # the 25 slowest tests and the total at the end
         status=0
-        "$VENV/bin/python" -m pytest -n auto --dist loadgroup --durations=25 "$@" || status=$?
+        "$VENV/bin/python" -m pytest -n auto --durations=25 "$@" || status=$?
         echo "run.sh: test: ${SECONDS} s in all (install included), exit status ${status}" >&2
         exit "$status"
         ;;

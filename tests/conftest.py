@@ -41,19 +41,30 @@ def _one_blas_thread():
         yield
 
 
-# --- running in parallel (pytest-xdist, ``-n 2 --dist loadgroup``, as ``bash run.sh test`` does) --------
+# --- running in parallel (pytest-xdist: ``pytest -n auto``, as ``bash run.sh test`` runs it) -------------
 #
 # A work unit goes to one worker as a whole.  Tests that share something expensive built once per
-# worker run in one unit: every test that uses the dashboard server in this process or a browser
-# (one server, one Chromium), the attacks on a ``bogie serve`` process of their own and its
-# reliability runs (servers with their own cluster workers: two at once would overload two cores),
-# the image build, the Dask cluster of the engine tests.  The other test modules go as one unit
-# each (their module fixtures are built once), but for the few whose tests are long and share
-# nothing costly: those go test by test, so that both cores work on them.
+# worker run in one unit: every test of a module that serves the dashboard or drives a browser
+# (one server in this process, one Chromium; the attacks on a ``bogie serve`` process of their own
+# and its reliability runs, whose servers have cluster workers of their own: two such at once
+# would overload two cores), the image build, the Dask cluster of the engine tests.  The other
+# test modules go as one unit each (their module fixtures are built once), but for the few whose
+# tests are long and share nothing costly: those go test by test, so that both cores work on them.
+# The units are named from the test's id alone (``work_unit``): the scheduler sees nothing else.
 SERVED_FIXTURES = {"app_server", "chromium", "own_server"}
-GROUPS = {  # module -> group
-    "tests/app/server/test_boundary.py": "served",
-    "tests/app/server/test_reliability.py": "served",
+SERVED_MODULES = {
+    "tests/app/server/test_boundary.py",
+    "tests/app/server/test_reliability.py",
+    "tests/app/dashboard/test_dashboard.py",
+    "tests/app/dashboard/test_dashboard_browser.py",
+    "tests/app/dashboard/test_design_loads_browser.py",
+    "tests/app/dashboard/test_nonlinear_view_browser.py",
+    "tests/app/dashboard/test_resonance_browser.py",
+    "tests/app/dashboard/test_review_browser.py",
+    "tests/app/dashboard/test_uncertainty_band_browser.py",
+}
+GROUPS = {
+    **dict.fromkeys(SERVED_MODULES, "served"),
     "tests/image/test_docker_image.py": "image",
     "tests/model/studies/test_engine.py": "dask-cluster",
 }
@@ -68,36 +79,51 @@ TEST_BY_TEST = {
 FIRST = ("image", "served", "dask-cluster")  # the longest units start first
 
 
-def _group(item) -> str | None:
-    module = item.nodeid.split("::", 1)[0]
+def work_unit(nodeid: str) -> str:
+    """The work unit of a test, from its id: a group's name, the test's own id, or its module."""
+    module = nodeid.split("::", 1)[0]
     if module in GROUPS:
         return GROUPS[module]
-    if SERVED_FIXTURES & set(item.fixturenames):
-        return "served"
-    return None if module in TEST_BY_TEST else module
+    return nodeid if module in TEST_BY_TEST else module
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """Whole work units to a worker (xdist's scope scheduling, with our units as scopes)."""
+    from xdist.scheduler import LoadScopeScheduling
+
+    class WorkUnitScheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return work_unit(nodeid)
+
+    return WorkUnitScheduling(config, log)
 
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
-    """Mark each test with its work unit (``xdist_group``) and order the collection so that the
-    longest units come first: the image build (mostly waiting for downloads) and the served
-    tests start at once beside the rest, and no core idles at the end waiting for one of them.
-    Within a unit and a module the order is the file's (module fixtures are built once)."""
+    """Order the collection so that the longest work units come first (the scheduler hands them
+    out in this order): the image build (mostly waiting for downloads) and the served tests
+    start at once beside the rest, and no core idles at the end waiting for one of them.  Within
+    a unit and a module the order is the file's (module fixtures are built once).  A test that
+    serves the app or drives a browser outside the served modules is refused: it would start a
+    second server or browser beside the first."""
+    strays = sorted({item.nodeid.split("::", 1)[0] for item in items
+                     if SERVED_FIXTURES & set(item.fixturenames)} - SERVED_MODULES)
+    if strays:
+        raise pytest.UsageError(f"tests/conftest.py: add {', '.join(strays)} to SERVED_MODULES "
+                                "(it serves the app or drives a browser)")
+
     def rank(item) -> int:
-        group = _group(item)
-        if group in FIRST:
-            return FIRST.index(group)
+        unit = work_unit(item.nodeid)
+        if unit in FIRST:
+            return FIRST.index(unit)
         return len(FIRST) + (0 if item.get_closest_marker("slow") else 1)
 
-    units: dict[str, tuple[int, int]] = {}  # unit -> (rank, first position)
+    units: dict[str, tuple[int, int]] = {}  # unit -> (best rank of its tests, first position)
     for position, item in enumerate(items):
-        group = _group(item)
-        if group is not None:
-            item.add_marker(pytest.mark.xdist_group(group))
-        unit = group or item.nodeid
+        unit = work_unit(item.nodeid)
         best, first = units.get(unit, (rank(item), position))
         units[unit] = (min(best, rank(item)), first)
-    order = {id(item): (*units[_group(item) or item.nodeid], position)
+    order = {id(item): (*units[work_unit(item.nodeid)], position)
              for position, item in enumerate(items)}
     items.sort(key=lambda item: order[id(item)])
 
