@@ -87,6 +87,7 @@ def work_unit(nodeid: str) -> str:
     return nodeid if module in TEST_BY_TEST else module
 
 
+@pytest.hookimpl(optionalhook=True)  # a hook of pytest-xdist: unknown without it (-p no:xdist)
 def pytest_xdist_make_scheduler(config, log):
     """Whole work units to a worker (xdist's scope scheduling, with our units as scopes)."""
     from xdist.scheduler import LoadScopeScheduling
