@@ -8,8 +8,25 @@ Names follow the DOF scheme: ``<drive>.<element>.<quantity>``, e.g.
 * ``ID1.rim12.creep_force`` — longitudinal creep force on the wheel [N]
 * ``ID1.wheelset.adhesion_moment`` — r0 × (sum of the two creep forces) [N m]
 
+Section torques of the two shafts, where the press fits sit (the torque a fit must hold) [N m]:
+
+* ``ID1.hollow_shaft.gear_seat.torque`` — through the seat at the hollow shaft's gear end (node 5),
+  where the gear's torque, passed on by the disc clutch, enters the hollow shaft: the torque in
+  the shaft next to that node;
+* ``ID1.hollow_shaft.torque`` — in the hollow shaft's middle section (node 7);
+* ``ID1.axle.wheel_seat_12.torque``, ``ID1.axle.wheel_seat_14.torque`` — through the seat of wheel
+  12 or 14: the torque the axle passes into that wheel (the axle's torque on the claw clutch's side
+  of the wheel less what goes on to the journal);
+* ``ID1.axle.centre.torque`` — in the axle between the wheels, at its centre (node 13).
+
+A section torque is the beam elements' own torsion, ``G J / L (θ_up − θ_down)`` with its
+stiffness-proportional damping part, θ the rotation about the axle (``ry``) of the element's end
+nearer to the torque's source (up: the gear end of the hollow shaft, the claw clutch's end of the
+axle) and of the other end (down); at a node between two elements, their mean.
+
 Torques are about the global +y axis, forces along global axes (see :mod:`model.mechanics.dofs`), for
-both drives, so that ID1 and ID2 compare directly.
+both drives, so that ID1 and ID2 compare directly; every torque of the drive train is positive in
+traction (the side nearer to the motor leads).
 """
 
 from __future__ import annotations
@@ -18,7 +35,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from model.mechanics.assembly import DRIVES, RIM_NODES, BogieModel
+from model.mechanics.assembly import (
+    AXLE_CENTRE_NODE,
+    AXLE_CLAW_NODE,
+    AXLE_GEAR_NODE,
+    DISC_CLUTCH_NODE,
+    DRIVES,
+    HOLLOW_SHAFT_NODES,
+    JOURNAL_NODES,
+    RIM_NODES,
+    BogieModel,
+)
 from model.mechanics.operating_point import (
     OperatingPoint,
     creep_coefficients,
@@ -53,6 +80,11 @@ def output_matrices(model: BogieModel, op: OperatingPoint) -> OutputMatrices:
             units.append(unit)
             rows_q.append(row_q)
             rows_v.append(row_v)
+    for name, row_q, row_v in section_torque_rows(model):
+        names.append(name)
+        units.append("N m")
+        rows_q.append(row_q)
+        rows_v.append(row_v)
     coefficients = creep_coefficients(model.parameters, op)
     G = longitudinal_creep_pattern(model)  # columns e_x − r0 e_ry per rim, in model.rims order
     r0 = model.parameters["wheel_radius"]
@@ -81,6 +113,56 @@ def output_matrices(model: BogieModel, op: OperatingPoint) -> OutputMatrices:
         elif name.endswith("adhesion_moment"):
             steady[i] = 2 * coefficients.mu * op.N0 * r0
     return OutputMatrices(tuple(names), tuple(units), C_q, C_v, steady)
+
+
+# section -> the beam elements whose mean torque it is, each (upstream node, downstream node), and
+# the elements whose torque it passes on (subtracted: a seat holds what stays in its wheel)
+_HS_MIDDLE = HOLLOW_SHAFT_NODES[len(HOLLOW_SHAFT_NODES) // 2]  # node 7
+SECTIONS: dict[str, tuple[tuple[tuple[str, str], ...], tuple[tuple[str, str], ...]]] = {
+    "hollow_shaft.gear_seat": (((f"hs{DISC_CLUTCH_NODE}", f"hs{DISC_CLUTCH_NODE + 1}"),), ()),
+    "hollow_shaft": (((f"hs{_HS_MIDDLE - 1}", f"hs{_HS_MIDDLE}"),
+                      (f"hs{_HS_MIDDLE}", f"hs{_HS_MIDDLE + 1}")), ()),
+    f"axle.wheel_seat_{RIM_NODES[0]}": (((f"ax{AXLE_CLAW_NODE}", f"ax{RIM_NODES[0]}"),),
+                                         ((f"ax{RIM_NODES[0]}", f"ax{JOURNAL_NODES[0]}"),)),
+    "axle.centre": (((f"ax{AXLE_CLAW_NODE}", f"ax{AXLE_CENTRE_NODE}"),
+                     (f"ax{AXLE_CENTRE_NODE}", f"ax{AXLE_GEAR_NODE}")), ()),
+    f"axle.wheel_seat_{RIM_NODES[1]}": (((f"ax{AXLE_GEAR_NODE}", f"ax{RIM_NODES[1]}"),),
+                                         ((f"ax{RIM_NODES[1]}", f"ax{JOURNAL_NODES[1]}"),)),
+}
+SECTION_TORQUES = tuple(f"{drive}.{section}.torque" for drive in DRIVES for section in SECTIONS)
+
+
+def torsional_stiffness(model: BogieModel, drive: str, up: str, down: str) -> float:
+    """G J / L of the beam element between the nodes ``up`` and ``down`` of ``drive`` (e.g.
+    "ax10", "ax12") [N m/rad]: the hollow shaft's tube or the solid axle, L the nodes' distance."""
+    p = model.parameters
+    if up.startswith("hs"):
+        outer, inner = p["hollow_shaft_outer_radius"], p["hollow_shaft_inner_radius"]
+    else:
+        outer, inner = p["axle_radius"], 0.0
+    shear_modulus = p["young_modulus"] / (2 * (1 + p["poisson_ratio"]))
+    polar = np.pi / 2 * (outer**4 - inner**4)
+    length = float(np.linalg.norm(np.real(model.positions[f"{drive}.{down}"]
+                                          - model.positions[f"{drive}.{up}"])))
+    return shear_modulus * polar / length
+
+
+def section_torque_rows(model: BogieModel) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """(name, row on Δq, row on Δq̇) of every section torque of :data:`SECTION_TORQUES` [N m]:
+    the torsion of the beam elements (module docstring), their damping the shafts' loss time
+    times their stiffness (as assembled)."""
+    loss = model.parameters["shaft_loss_time"]
+    rows = []
+    for drive in DRIVES:
+        for section, (means, passed) in SECTIONS.items():
+            row = np.zeros(model.n)
+            for elements, weight in ((means, 1.0 / len(means)), (passed, -1.0)):
+                for up, down in elements:
+                    k = weight * torsional_stiffness(model, drive, up, down)
+                    row[model.dofs.index(f"{drive}.{up}.ry")] += k
+                    row[model.dofs.index(f"{drive}.{down}.ry")] -= k
+            rows.append((f"{drive}.{section}.torque", row, loss * row))
+    return rows
 
 
 def static_load(model: BogieModel, op: OperatingPoint) -> np.ndarray:
