@@ -18,6 +18,7 @@ import tomllib
 from collections.abc import Mapping
 
 from model.mechanics.parameters import (
+    ALL_SCHEMA,
     SCHEMA,
     ParameterError,
     Parameters,
@@ -100,8 +101,8 @@ def review_range(base: Parameters, name: str) -> tuple[float, float]:
 
 
 def _table(parameters: Parameters) -> dict:
-    return {name: {"value": parameters.values[name], "unit": SCHEMA[name][0],
-                   "note": parameters.notes.get(name, "")} for name in SCHEMA}
+    return {name: {"value": parameters.values[name], "unit": ALL_SCHEMA[name][0],
+                   "note": parameters.notes.get(name, "")} for name in ALL_SCHEMA}
 
 
 def _number(value: float) -> str:

@@ -468,7 +468,9 @@ def _assemble(parameters: Parameters) -> tuple[_Assembler, DofMap, dict[str, np.
     # centre (its reference point lies on that axis)
     car_body = asm.free("CB", (0.0, 0.0, p["secondary_height"] + 1.0), axes=CAR_BODY_AXES)
     m_cb = p["car_body_mass"]
-    asm.add_mass("CB", car_body, np.diag([m_cb, 0, m_cb, 0, 0, p["car_body_yaw_inertia"]]))
+    # longitudinally the bogie also drives the train it hauls (train_mass; 0: the locomotive alone)
+    asm.add_mass("CB", car_body, np.diag([m_cb + p["train_mass"], 0, m_cb, 0, 0,
+                                          p["car_body_yaw_inertia"]]))
     positions["BF"], positions["CB"] = frame.origin, car_body.origin
 
     half_base = p["wheelbase"] / 2

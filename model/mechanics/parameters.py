@@ -2,8 +2,13 @@
 
 A parameter file is a TOML table of entries ``name = { value = …, unit = "…", note = "…" }``.
 Every value is in SI units (the unit string must equal the schema's); the note says where the
-value comes from (public fact, estimate and why, or calibration output).  The schema below is the
-single list of what the model needs; unknown or missing names are errors.
+value comes from (public fact, estimate and why, or calibration output).  Two schemas:
+:data:`SCHEMA`, what the dynamics need, and :data:`ASSESSMENT_SCHEMA`, the strength data of the
+checks (:mod:`model.analysis.assessment`: press fits, shaft sections, coupling ratings, required
+safety factors), which do not enter the dynamics.  Unknown names are errors, and so are missing
+names of :data:`SCHEMA`, with two exceptions for files written before they existed: a missing
+``train_mass`` is 0 (the locomotive alone, as in the study), and missing strength data take the
+default set's values (each note says so).
 """
 
 from __future__ import annotations
@@ -72,6 +77,8 @@ SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "axle_radius": ("m", "radius of the (solid) wheelset axle", _POS),
     # --- masses and inertias ----------------------------------------------------------------------
     "car_body_mass": ("kg", "half car body mass carried by this bogie", _POS),
+    "train_mass": ("kg", "mass of the train this bogie hauls, beyond its half car body: added to "
+                   "the car body's longitudinal inertia (0: the locomotive alone)", _NONNEG),
     "car_body_yaw_inertia": ("kg m^2", "half car body yaw inertia about the vertical through the bogie centre", _POS),
     "frame_mass": ("kg", "bogie frame mass", _POS),
     "frame_inertia_x": ("kg m^2", "bogie frame roll inertia", _POS),
@@ -134,6 +141,41 @@ SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "motor_slope": ("N m s/rad", "b_M: falling slope of the healthy motor's torque-speed characteristic", _NONNEG),
 }
 
+# Strength data of the checks (model.analysis.assessment); they do not enter the dynamics.  The
+# shafts' own elastic constants are young_modulus and poisson_ratio; the axle is solid and the
+# hollow shaft's bore is 2 hollow_shaft_inner_radius, as in the dynamics.
+ASSESSMENT_SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
+    "wheel_seat_diameter": ("m", "wheel seat: diameter d of the axle's seat", _POS),
+    "wheel_seat_length": ("m", "wheel seat: length L of the fit", _POS),
+    "wheel_hub_outer_diameter": ("m", "wheel seat: outer diameter D of the wheel's hub", _POS),
+    "wheel_seat_interference_min": ("m", "wheel seat: smallest diametral interference of the tolerances", _POS),
+    "wheel_seat_interference_max": ("m", "wheel seat: largest diametral interference of the tolerances", _POS),
+    "wheel_seat_friction_min": ("1", "wheel seat: lowest friction coefficient of the fit", _POS),
+    "wheel_seat_friction_max": ("1", "wheel seat: highest friction coefficient of the fit", _POS),
+    "gear_seat_diameter": ("m", "gear seat: diameter d of the hollow shaft's seat", _POS),
+    "gear_seat_length": ("m", "gear seat: length L of the fit", _POS),
+    "gear_hub_outer_diameter": ("m", "gear seat: outer diameter D of the hub on the hollow shaft", _POS),
+    "gear_seat_interference_min": ("m", "gear seat: smallest diametral interference of the tolerances", _POS),
+    "gear_seat_interference_max": ("m", "gear seat: largest diametral interference of the tolerances", _POS),
+    "gear_seat_friction_min": ("1", "gear seat: lowest friction coefficient of the fit", _POS),
+    "gear_seat_friction_max": ("1", "gear seat: highest friction coefficient of the fit", _POS),
+    "hub_young_modulus": ("Pa", "Young's modulus of the hubs (wheel centre, gear hub)", _POS),
+    "hub_poisson_ratio": ("1", "Poisson's ratio of the hubs", (0.0, 0.5, False)),
+    "driving_shaft_diameter": ("m", "diameter of the (solid) driving shaft between rotor and pinion", _POS),
+    "axle_shear_stress_allowable": ("Pa", "permissible torsional shear stress of the axle", _POS),
+    "hollow_shaft_shear_stress_allowable": ("Pa", "permissible torsional shear stress of the hollow shaft", _POS),
+    "driving_shaft_shear_stress_allowable": ("Pa", "permissible torsional shear stress of the driving shaft", _POS),
+    "disc_clutch_rated_torque": ("N m", "largest torque the disc clutch is rated for", _POS),
+    "claw_clutch_rated_torque": ("N m", "largest torque the claw clutch is rated for", _POS),
+    "required_factor_slip": ("1", "required safety factor of a press fit against slip", _POS),
+    "required_factor_shear": ("1", "required safety factor of a shaft section against its permissible shear stress", _POS),
+    "required_factor_coupling": ("1", "required safety factor of a coupling against its rating", _POS),
+}
+ALL_SCHEMA = {**SCHEMA, **ASSESSMENT_SCHEMA}  # every name a parameter file may hold
+# names a file may leave out (written before they existed): train_mass -> 0, strength data -> the
+# default set's values
+OPTIONAL_DEFAULTS = {"train_mass": 0.0}
+
 
 @dataclass(frozen=True)
 class Parameters:
@@ -147,30 +189,38 @@ class Parameters:
         return self.values[name]
 
     def replace(self, **changes: float) -> Parameters:
-        """A copy with some values changed (validated)."""
+        """A copy with some values changed (validated; strength data as in
+        :func:`check_strength_data`)."""
         values = dict(self.values)
         for name, value in changes.items():
             values[name] = _check_value(name, value)
+        if any(name in ASSESSMENT_SCHEMA or name == "hollow_shaft_inner_radius"
+               for name in changes):
+            check_strength_data(values)
         return Parameters(values, self.notes, self.source)
 
 
 def parameter_hash(parameters: Parameters) -> str:
-    """SHA-256 (hex) of the values of a parameter set: names in schema order, each value as the
-    shortest decimal that round-trips (``repr``).  Notes and the source file do not count: two
-    sets with equal values have equal hashes.  Results of studies carry it, and a stored study
-    is resumed only with the same hash."""
-    canonical = json.dumps([[name, repr(float(parameters.values[name]))] for name in SCHEMA],
+    """SHA-256 (hex) of the values the dynamics depend on (:data:`SCHEMA`): names in schema
+    order, each value as the shortest decimal that round-trips (``repr``).  Notes, the source
+    file and the strength data do not count: two sets with equal dynamics have equal hashes.  A
+    parameter of :data:`OPTIONAL_DEFAULTS` counts only when it differs from its default, so a set
+    hashes as it did before that parameter existed.  Results of studies carry it, and a stored
+    study is resumed only with the same hash."""
+    canonical = json.dumps([[name, repr(float(parameters.values[name]))] for name in SCHEMA
+                            if name not in OPTIONAL_DEFAULTS
+                            or parameters.values[name] != OPTIONAL_DEFAULTS[name]],
                            separators=(",", ":"))
     return hashlib.sha256(canonical.encode("utf-8")).hexdigest()
 
 
 def _check_value(name: str, value: object) -> float:
-    if name not in SCHEMA:
+    if name not in ALL_SCHEMA:
         raise ParameterError(f"unknown parameter '{name}'; allowed: see model/mechanics/parameters.py SCHEMA")
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ParameterError(f"parameter '{name}' must be a number, got {value!r}")
     value = float(value)
-    unit, _, (low, high, low_allowed) = SCHEMA[name]
+    unit, _, (low, high, low_allowed) = ALL_SCHEMA[name]
     if not math.isfinite(value):
         raise ParameterError(f"parameter '{name}' must be finite, got {value}")
     if not (low < value <= high or (low_allowed and value == low)):
@@ -185,12 +235,12 @@ def parse_parameters(table: Mapping[str, object], source: str = "<memory>") -> P
     values: dict[str, float] = {}
     notes: dict[str, str] = {}
     for name, entry in table.items():
-        if name not in SCHEMA:
+        if name not in ALL_SCHEMA:
             raise ParameterError(f"{source}: unknown parameter '{name}'")
         if not isinstance(entry, Mapping) or "value" not in entry or "unit" not in entry:
             raise ParameterError(
                 f"{source}: parameter '{name}' must be a table {{ value = …, unit = \"…\", note = \"…\" }}")
-        unit = SCHEMA[name][0]
+        unit = ALL_SCHEMA[name][0]
         if entry["unit"] != unit:
             raise ParameterError(
                 f"{source}: parameter '{name}' has unit '{entry['unit']}', expected '{unit}'")
@@ -199,6 +249,16 @@ def parse_parameters(table: Mapping[str, object], source: str = "<memory>") -> P
         except ParameterError as error:
             raise ParameterError(f"{source}: {error}") from None
         notes[name] = str(entry.get("note", ""))
+    for name, default in OPTIONAL_DEFAULTS.items():
+        if name not in values:
+            values[name] = default
+            notes[name] = f"not in {source}: {default:g}, the locomotive alone as in the study"
+    missing_strength = [name for name in ASSESSMENT_SCHEMA if name not in values]
+    if missing_strength:
+        defaults, default_notes = _default_strength_data()
+        for name in missing_strength:
+            values[name] = defaults[name]
+            notes[name] = f"not in {source}: the default set's value ({default_notes[name]})"
     missing = [name for name in SCHEMA if name not in values]
     if missing:
         hint = ""
@@ -211,7 +271,50 @@ def parse_parameters(table: Mapping[str, object], source: str = "<memory>") -> P
         raise ParameterError(f"{source}: polach_kS must not exceed polach_kA")
     if values["hollow_shaft_inner_radius"] >= values["hollow_shaft_outer_radius"]:
         raise ParameterError(f"{source}: hollow_shaft_inner_radius must be below the outer radius")
+    try:
+        check_strength_data(values)
+    except ParameterError as error:
+        raise ParameterError(f"{source}: {error}") from None
     return Parameters(values, notes, source)
+
+
+def check_strength_data(values: Mapping[str, float]) -> None:
+    """Refuse strength data whose geometry or tolerances are not physical, naming the parameter
+    (:class:`ParameterError`): a hub not wider than its seat (d ≥ D), a bore not narrower than
+    the seat (d_i ≥ d), a tolerance range upside down.  Non-positive interferences and friction
+    coefficients are refused by the schema's bounds."""
+    pairs = (("wheel_hub_outer_diameter", "wheel_seat_diameter",
+              "must exceed the seat's diameter wheel_seat_diameter"),
+             ("gear_hub_outer_diameter", "gear_seat_diameter",
+              "must exceed the seat's diameter gear_seat_diameter"))
+    for outer, inner, what in pairs:
+        if values[outer] <= values[inner]:
+            raise ParameterError(f"parameter '{outer}' = {values[outer]:g} m {what} = "
+                                 f"{values[inner]:g} m")
+    bore = 2 * values["hollow_shaft_inner_radius"]
+    if values["gear_seat_diameter"] <= bore:
+        raise ParameterError(f"parameter 'gear_seat_diameter' = {values['gear_seat_diameter']:g} "
+                             f"m must exceed the hollow shaft's bore 2 hollow_shaft_inner_radius "
+                             f"= {bore:g} m")
+    for seat in ("wheel_seat", "gear_seat"):
+        for quantity, unit in (("interference", " m"), ("friction", "")):
+            low, high = f"{seat}_{quantity}_min", f"{seat}_{quantity}_max"
+            if values[low] > values[high]:
+                raise ParameterError(f"parameter '{low}' = {values[low]:g}{unit} must not exceed "
+                                     f"'{high}' = {values[high]:g}{unit}")
+
+
+def _default_strength_data() -> tuple[dict[str, float], dict[str, str]]:
+    """(values, notes) of the strength data in the default set's file."""
+    table = tomllib.loads(CALIBRATED_FILE.read_text(encoding="utf-8"))
+    values, notes = {}, {}
+    for name in ASSESSMENT_SCHEMA:
+        entry = table.get(name)
+        if not isinstance(entry, Mapping) or "value" not in entry:
+            raise ParameterError(f"{CALIBRATED_FILE}: strength datum '{name}' is missing")
+        values[name] = _check_value(name, entry["value"])
+        notes[name] = str(entry.get("note", ""))
+    return values, notes
 
 
 def load_parameters(path: str | Path | None = None) -> Parameters:
@@ -235,7 +338,10 @@ def dumps_parameters(parameters: Parameters, header: str = "") -> str:
     lines = [f"# {line}" if line else "#" for line in header.splitlines()]
     if lines:
         lines.append("")
-    for name, (unit, _, _) in SCHEMA.items():
+    for name, (unit, _, _) in ALL_SCHEMA.items():
+        if name == next(iter(ASSESSMENT_SCHEMA)):
+            lines.append("# strength data of the checks (bogie assess); they do not enter the "
+                         "dynamics")
         value = parameters.values[name]
         note = parameters.notes.get(name, "")
         lines.append(f"{name} = {{ value = {value!r}, unit = {_toml_string(unit)}, "

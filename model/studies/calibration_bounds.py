@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from model.mechanics.parameters import SCHEMA, Parameters
+from model.mechanics.parameters import ALL_SCHEMA, Parameters
 from model.studies.parameter_ranges import ParameterRange
 
 # stage A: creep law and gear ratio against the operating data (exactly determined)
@@ -120,12 +120,13 @@ def with_constraints(parameters: Parameters) -> Parameters:
 
 
 def parameter_rows(parameters: Parameters) -> list[dict]:
-    """One dict per parameter (schema order): name, value [SI], unit, note, and for the parameters
-    the calibration fits its bounds ``lower``, ``upper`` [SI] and ``on_bound`` (None otherwise):
-    what ``bogie parameters`` and the dashboard's Variant tab show."""
+    """One dict per parameter (schema order, the strength data last): name, value [SI], unit,
+    note, and for the parameters the calibration fits its bounds ``lower``, ``upper`` [SI] and
+    ``on_bound`` (None otherwise): what ``bogie parameters`` and the dashboard's Variant tab
+    show."""
     free = {f.name: f for f in FREE_PARAMETERS}
     rows = []
-    for name, (unit, _, _) in SCHEMA.items():
+    for name, (unit, _, _) in ALL_SCHEMA.items():
         value = float(parameters[name])
         f = free.get(name)
         rows.append({"name": name, "value": value, "unit": unit,

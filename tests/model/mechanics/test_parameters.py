@@ -9,6 +9,8 @@ import tomllib
 import pytest
 
 from model.mechanics.parameters import (
+    ALL_SCHEMA,
+    ASSESSMENT_SCHEMA,
     CALIBRATED_FILE,
     ESTIMATE_FILE,
     SCHEMA,
@@ -16,6 +18,7 @@ from model.mechanics.parameters import (
     Parameters,
     dumps_parameters,
     load_parameters,
+    parameter_hash,
     parse_parameters,
     save_parameters,
 )
@@ -35,9 +38,12 @@ def table(estimate) -> dict:
 @pytest.mark.parametrize("path", [ESTIMATE_FILE, CALIBRATED_FILE, None])
 def test_shipped_files_load_with_every_schema_entry(path):
     p = load_parameters(path)
-    assert set(p.values) == set(SCHEMA)
+    assert set(p.values) == set(ALL_SCHEMA)
     assert all(isinstance(v, float) and math.isfinite(v) for v in p.values.values())
-    assert all(p.notes[name].strip() for name in SCHEMA), "every value needs a provenance note"
+    assert all(p.notes[name].strip() for name in ALL_SCHEMA), "every value needs a provenance note"
+    # what the study gives nothing for is marked an estimate (or a standard value)
+    assert all(p.notes[name].startswith(("estimate", "standard")) for name in ASSESSMENT_SCHEMA)
+    assert p["train_mass"] == 0.0  # the study's: the half car body alone
 
 
 def test_default_is_the_calibrated_file():
@@ -173,3 +179,49 @@ def test_every_schema_entry_has_unit_description_and_sane_bounds():
         assert unit, name
         assert description, name
         assert low < high, name
+
+
+def test_sets_written_before_the_strength_data_and_train_mass_still_load(table):
+    """A file without the strength data and the train mass: the strength data are the default
+    set's (the notes say so), the train mass 0; the dynamics' hash is that of the same file with
+    them (what a stored study was written with)."""
+    full = parse_parameters(table, source="full.toml")
+    for name in [*ASSESSMENT_SCHEMA, "train_mass"]:
+        del table[name]
+    old = parse_parameters(table, source="old.toml")
+    default = load_parameters()
+    assert old["train_mass"] == 0.0
+    assert "not in old.toml" in old.notes["train_mass"]
+    for name in ASSESSMENT_SCHEMA:
+        assert old[name] == default[name]
+        assert old.notes[name].startswith("not in old.toml: the default set's value (")
+    assert parameter_hash(old) == parameter_hash(full)
+
+
+def test_hash_ignores_strength_data_and_a_zero_train_mass(estimate):
+    """Strength data do not enter the dynamics; the train mass does once it is not 0."""
+    assert parameter_hash(estimate.replace(wheel_seat_friction_min=0.1)) == parameter_hash(estimate)
+    assert parameter_hash(estimate.replace(train_mass=1e5)) != parameter_hash(estimate)
+
+
+@pytest.mark.parametrize(("changes", "message"), [
+    ({"wheel_hub_outer_diameter": 0.2}, r"'wheel_hub_outer_diameter' = 0.2 m must exceed the "
+                                        r"seat's diameter wheel_seat_diameter = 0.21 m"),
+    ({"gear_hub_outer_diameter": 0.25}, r"'gear_hub_outer_diameter' = 0.25 m must exceed"),
+    ({"gear_seat_diameter": 0.2}, r"'gear_seat_diameter' = 0.2 m must exceed the hollow "
+                                  r"shaft's bore"),
+    ({"wheel_seat_interference_min": -1e-4}, r"'wheel_seat_interference_min' = -0.0001 m is "
+                                             r"outside \(0.0, inf\]"),
+    ({"gear_seat_friction_min": 0.0}, r"'gear_seat_friction_min' = 0.0 1 is outside"),
+    ({"wheel_seat_interference_min": 4e-4}, r"'wheel_seat_interference_min' = 0.0004 m must "
+                                            r"not exceed 'wheel_seat_interference_max'"),
+    ({"wheel_seat_friction_max": 0.1}, r"'wheel_seat_friction_min' = 0.12 must not exceed"),
+])
+def test_unphysical_strength_data_are_refused_naming_the_parameter(table, estimate, changes,
+                                                                   message):
+    for name, value in changes.items():
+        table[name]["value"] = value
+    with pytest.raises(ParameterError, match=r"test\.toml: parameter " + message):
+        parse_parameters(table, source="test.toml")
+    with pytest.raises(ParameterError, match=message):
+        estimate.replace(**changes)
