@@ -14,6 +14,7 @@ import sys
 from app.cli import (
     analysis,
     antislip,
+    assess,
     calibrate,
     compare,
     loads,
@@ -31,7 +32,7 @@ from model.mechanics.parameters import ParameterError
 COMMAND_GROUPS = (analysis.register, calibrate.register, analysis.register_export, serve.register,
                   response.register, sensitivity.register, antislip.register, study.register,
                   compare.register, report.register, loads.register, resonance.register,
-                  parameters.register)
+                  assess.register, parameters.register)
 
 
 def build_parser() -> BogieParser:

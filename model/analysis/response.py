@@ -164,10 +164,13 @@ def _grid_exponentials(lam: np.ndarray, n_points: int, dt: float, block: int):
 
 
 def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu: complex,
-                   n_points: int, dt: float) -> tuple[np.ndarray, float, int, float]:
+                   n_points: int, dt: float, modes: str = "all"
+                   ) -> tuple[np.ndarray, float, int, float]:
     """Perturbation outputs y (n_points x p) by the modal closed form; (y, error estimate relative
     to the largest |y|, number of valid points, highest frequency [Hz] of a mode contributing
-    more than 1 % of some output's peak)."""
+    more than 1 % of some output's peak).  ``modes``: "all"; "real", the particular solutions
+    and the terms of the real (non-oscillating) eigenvalues only; "complex", the terms of the
+    complex pairs only ("real" + "complex" = "all")."""
     deflation, r = system.deflation, system.R.shape[1]
     lam, Y, _, cond, scale = system.modal  # A22 = (T Y) Λ (T Y)⁻¹, T = diag(scale)
     alpha, beta = system.step_particular(u0)
@@ -190,6 +193,12 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
     coef = W * d  # p x m: y_h(t) = Re Σ_j coef_j e^(λ_j t) + const_h
     # conjugate pairs: keep Im λ ≥ 0, double the strictly complex ones
     keep = lam.imag >= 0
+    if modes == "real":
+        keep = lam.imag == 0
+    elif modes == "complex":
+        keep = lam.imag > 0
+        const_h = np.zeros(C.shape[0], dtype=complex)
+        alpha, beta, x_mu = np.zeros_like(alpha), np.zeros_like(beta), np.zeros_like(x_mu)
     weight = np.where(lam.imag > 0, 2.0, 1.0)
     lam_k, coef_k = lam[keep], coef[:, keep] * weight[keep]
     # growth guard: cut the grid before any term exceeds 1e250
@@ -313,6 +322,19 @@ def solve_linear(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu:
             return y, "modal", estimate
     y, _ = _expm_outputs(system, C, u0, a, mu, n_points, dt)
     return y, "expm", math.nan
+
+
+def quasi_static_step(system: LinearSystem, C: np.ndarray, step: float, n_points: int,
+                      dt: float) -> np.ndarray:
+    """The part of the response to the step ``−step H(t)`` [N m] that does not oscillate
+    (n_points x p, perturbations of the outputs ``C``): the step's particular solution and the
+    terms of the real eigenvalues — the quasi-static take-over, slow as the vehicle's speed
+    changes, and the creep-damped drifts.  The rest of any short-circuit response (the complex
+    pairs' terms and the forced oscillation at f) is its dynamic part.  Modal closed form on the
+    grid ``t_k = k dt`` [s]."""
+    mu = complex(-1.0, 1.0)  # any μ that is not an eigenvalue: the input has no such term
+    y, _, valid, _ = _modal_outputs(system, C, -step, 0j, mu, n_points, dt, modes="real")
+    return y[:valid]
 
 
 # --- the bogie -----------------------------------------------------------------------------------

@@ -1,0 +1,130 @@
+"""``bogie assess``: from loads to verdicts — every press fit, shaft section and coupling of both
+drives checked in the three load cases, with safety factors and the governing check.
+
+    bogie assess [--s0 LIST] [--v LIST] [--n0 N] [--bm B] [--m0 M --f F --decay D]
+                 [--t-end T] [--fs FS] [--unstable-s0 S --unstable-v V] [--anti-slip-delay T]
+                 [--starting-v V] [--params FILE] [--json]
+
+A LIST is ``A,B,C`` or ``A:B:N``, increasing; speeds in km/h.  ``--s0``/``--v`` are the short-circuit
+case's grid (stable creepages only), as ``bogie envelope --phase all`` takes them; without
+``--t-end`` its horizon covers ID2's quasi-static take-over.  Everything runs in this process.
+``--json`` prints ``{"load_cases": [...], "checks": [...], "governing": {...}}``
+(model.studies.assessment.Assessment.as_dict).  Bad input (an unstable grid point, unphysical
+strength data in ``--params``): one line on stderr, exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from app.cli.options import add_time_grid, bounded, check_samples, parse_values
+from app.cli.output import emit
+
+KIND_LABELS = {"press_fit_slip": "press-fit slip", "torsional_shear": "torsional shear",
+               "coupling": "coupling rating"}
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("assess", help="verdicts: safety factors of every press fit, "
+                              "shaft and coupling in the short-circuit, unstable-adhesion and "
+                              "starting load cases")
+    p.add_argument("--s0", default="0.002,0.005", metavar="LIST",
+                   help="short_circuit: stable creepages s0 [-] (default %(default)s)")
+    p.add_argument("--v", default="80,120,200", metavar="LIST",
+                   help="short_circuit: speeds [km/h] (default %(default)s)")
+    p.add_argument("--n0", type=bounded("--n0 (wheel force, N)", "[1e3, 1e6]", "N"),
+                   default=None, help="wheel force N0 [N] (default: the parameter set's)")
+    p.add_argument("--bm", type=bounded("--bm (motor slope, N m s/rad)", "[0, 1e9]",
+                                        "N m s/rad"),
+                   default=None, help="motor slope b_M [N m s/rad] (default: the parameter set's)")
+    p.add_argument("--m0", type=bounded("--m0 (amplitude, N m)", "[0, 1e8]", "N m"),
+                   default=50_000.0, help="short-circuit amplitude M0 [N m] (default %(default)s)")
+    p.add_argument("--f", type=bounded("--f (frequency, Hz)", "(0, 1e5)", "Hz"), default=90.0,
+                   help="short-circuit frequency f [Hz] (default %(default)s)")
+    p.add_argument("--decay", type=bounded("--decay (D)", "[0, 10]"), default=0.04,
+                   help="short-circuit decay D [-] (default %(default)s)")
+    add_time_grid(p, "short_circuit horizon (default: until ID2's quasi-static take-over is "
+                  "within 1 %% of its end, at least 2 s)", "sampling rate of every history")
+    p.set_defaults(t_end=None)
+    p.add_argument("--unstable-s0", type=bounded("--unstable-s0 (creepage)", "(0, 1)"),
+                   default=0.014, help="unstable_adhesion: creepage beyond the adhesion maximum "
+                                       "[-] (default %(default)s)")
+    p.add_argument("--unstable-v", type=bounded("--unstable-v (speed, km/h)", "[1, 500]",
+                                                "km/h"),
+                   default=120.0, help="unstable_adhesion: speed [km/h] (default %(default)s)")
+    p.add_argument("--anti-slip-delay", type=bounded("--anti-slip-delay (s)", "[0, 60]", "s"),
+                   default=None, help="unstable_adhesion: reaction time of ID2's anti-slip "
+                                      "protection [s] (default 0.1)")
+    p.add_argument("--starting-v", type=bounded("--starting-v (speed, km/h)", "[1, 500]", "km/h"),
+                   default=5.0, help="starting: speed [km/h] (default %(default)s)")
+    p.add_argument("--params", default=None, metavar="FILE",
+                   help="parameter file (TOML; default: the calibrated set; strength data it "
+                        "lacks are the default set's)")
+    p.add_argument("--json", action="store_true", help="machine-readable JSON output")
+    p.set_defaults(func=cmd_assess)
+
+
+def options_from_args(args: argparse.Namespace):
+    """(parameters, :class:`model.studies.assessment.AssessmentOptions`) from the options."""
+    from model.analysis.response import ShortCircuit
+    from model.mechanics.operating_point import KMH
+    from model.mechanics.parameters import load_parameters
+    from model.studies.assessment import AssessmentOptions
+
+    parameters = load_parameters(args.params)
+    s0 = parse_values(args.s0, "--s0", 1e-9, 1 - 1e-9, "-", increasing=True)
+    v = [x * KMH for x in parse_values(args.v, "--v", 1, 500, "km/h", increasing=True)]
+    if args.t_end is not None:
+        check_samples(args)
+    elif 60.0 * args.fs > 2_000_000:
+        raise ValueError(f"--fs = {args.fs:g} Hz: the automatic horizon may reach 60 s, at most "
+                         f"{2_000_000 / 60:.0f} Hz (or give --t-end)")
+    if args.fs < 2.5 * args.f:
+        raise ValueError(f"--fs = {args.fs:g} Hz is too low to resolve the excitation at f = "
+                         f"{args.f:g} Hz: must be at least {2.5 * args.f:g} Hz")
+    options = AssessmentOptions(
+        s0=tuple(s0), v=tuple(v), N0=args.n0, b_M=args.bm,
+        excitation=ShortCircuit(M0=args.m0, f=args.f, D=args.decay), t_end=args.t_end,
+        fs=args.fs, unstable_s0=args.unstable_s0, unstable_v=args.unstable_v * KMH,
+        anti_slip_delay=args.anti_slip_delay, starting_v=args.starting_v * KMH)
+    return parameters, options
+
+
+def assessment_table(result) -> str:
+    """The checks as text: per load case its description and horizon, then one row per check."""
+    lines = []
+    for case in result.cases:
+        horizon = "steady" if case.horizon is None else f"horizon {case.horizon:g} s"
+        lines.append(f"{case.name} ({horizon}): {case.description}")
+    lines += ["", f"{'component':<20} {'check':<16} {'load case':<18} {'load [N m]':>11} "
+                  f"{'capacity':>11} {'factor':>7} {'req.':>5}  verdict  at"]
+    for c in result.checks:
+        at = "steady" if math.isnan(c.time) else f"t {c.time:.4g} s"
+        if "v_kmh" in c.scenario:
+            at += f", s0 {c.scenario['s0']:.4g}, {c.scenario['v_kmh']:g} km/h"
+        verdict = "ok" if c.ok else ("SHORT" if c.safety_factor >= 1 else "FAIL")
+        lines.append(f"{c.component:<20} {KIND_LABELS[c.kind]:<16} {c.load_case:<18} "
+                     f"{c.load:>11.4g} {c.capacity:>11.4g} {c.safety_factor:>7.3g} "
+                     f"{c.required:>5.3g}  {verdict:<7}  {at}")
+    g = result.governing
+    failed = sum(not c.ok for c in result.checks)
+    lines += ["", f"governing: {g.component} ({KIND_LABELS[g.kind]}) in {g.load_case}: safety "
+                  f"factor {g.safety_factor:.3g} against {g.required:.3g} required — "
+                  f"{'ok' if g.ok else 'NOT MET'}; {failed} of {len(result.checks)} checks "
+                  "below their required factor",
+              "SHORT: the capacity holds, the margin is below the required factor; FAIL: the "
+              "load exceeds the capacity.  Strength data marked 'estimate' in the parameter "
+              "set are assumptions (bogie parameters); not a certification to EN 13103-1 / "
+              "EN 13260."]
+    return "\n".join(lines)
+
+
+def cmd_assess(args: argparse.Namespace) -> None:
+    from model.studies.assessment import assess
+
+    parameters, options = options_from_args(args)
+    print("assess: short_circuit, unstable_adhesion, starting …", file=sys.stderr)
+    result = assess(parameters, options)
+    emit(args, result.as_dict(), assessment_table(result))

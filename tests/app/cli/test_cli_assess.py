@@ -1,0 +1,115 @@
+"""``bogie assess``: the JSON contract, the short-circuit loads equal to ``bogie envelope --phase
+all`` on the same grid, and bad input refused in one line with exit status 2."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from app.cli.main import main
+from model.mechanics.parameters import dumps_parameters, load_parameters
+
+GRID = ["--s0", "0.003,0.005", "--v", "120,200", "--t-end", "3", "--fs", "2500"]
+
+
+def run(argv: list[str], capsys) -> tuple[int, str, str]:
+    try:
+        code = main(argv)
+    except SystemExit as exit_:
+        code = exit_.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture(scope="module")
+def assessed():
+    """``bogie assess --json`` on a small grid (module scope: one run for the contract tests)."""
+    import contextlib
+    import io
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        code = main(["assess", *GRID, "--json"])
+    assert code == 0
+    return json.loads(out.getvalue())
+
+
+@pytest.mark.slow
+def test_json_contract(assessed):
+    data = assessed
+    assert [c["name"] for c in data["load_cases"]] == ["short_circuit", "unstable_adhesion",
+                                                       "starting"]
+    assert all(isinstance(c["description"], str) and c["description"] for c in data["load_cases"])
+    horizons = {c["name"]: c["horizon_s"] for c in data["load_cases"]}
+    assert horizons == {"short_circuit": 3.0, "unstable_adhesion": 2.0, "starting": None}
+    checks = data["checks"]
+    assert len(checks) == 16 * 3  # every press fit, shaft and coupling of both drives, 3 cases
+    for c in checks:
+        assert {"component", "kind", "output", "load_case", "load", "capacity", "safety_factor",
+                "required", "ok", "inputs"} <= set(c)
+        assert c["kind"] in ("press_fit_slip", "torsional_shear", "coupling")
+        assert c["safety_factor"] == pytest.approx(c["capacity"] / c["load"], rel=1e-12)
+        assert c["ok"] is (c["safety_factor"] >= c["required"])
+        if c["kind"] == "press_fit_slip":
+            i = c["inputs"]
+            assert {"d", "L", "D", "d_i", "delta", "mu", "E_hub", "E_shaft", "nu_hub",
+                    "nu_shaft"} <= set(i)
+            p = i["delta"] / (i["d"] * (((i["D"] ** 2 + i["d"] ** 2) / (i["D"] ** 2 - i["d"] ** 2)
+                                         + i["nu_hub"]) / i["E_hub"]
+                                        + ((i["d"] ** 2 + i["d_i"] ** 2)
+                                           / (i["d"] ** 2 - i["d_i"] ** 2) - i["nu_shaft"])
+                                        / i["E_shaft"]))
+            assert c["capacity"] == pytest.approx(i["mu"] * p * math.pi * i["d"] ** 2 * i["L"] / 2,
+                                                  rel=1e-12)
+        elif c["kind"] == "torsional_shear":
+            i = c["inputs"]
+            assert c["capacity"] == pytest.approx(
+                i["tau_allow"] * math.pi * (i["D"] ** 4 - i["d_i"] ** 4) / (16 * i["D"]), rel=1e-12)
+    governing = min(checks, key=lambda c: c["safety_factor"] / c["required"])
+    assert data["governing"]["component"] == governing["component"]
+    assert data["governing"]["load_case"] == governing["load_case"]
+    assert data["governing"]["safety_factor"] == governing["safety_factor"]
+
+
+@pytest.mark.slow
+def test_short_circuit_loads_are_the_envelopes_phase_all_extremes(assessed, capsys):
+    outputs = sorted({c["output"] for c in assessed["checks"]})
+    code, out, err = run(["envelope", *GRID, "--phase", "all", "--serial", "--json",
+                          "--outputs", ",".join(outputs)], capsys)
+    assert code == 0, err
+    envelope = {o["name"]: max(abs(o["max"]), abs(o["min"])) for o in json.loads(out)["outputs"]}
+    loads = {c["output"]: c["load"] for c in assessed["checks"]
+             if c["load_case"] == "short_circuit"}
+    assert set(loads) == set(envelope)
+    for name, load in loads.items():
+        assert load == pytest.approx(envelope[name], rel=1e-12), name
+
+
+@pytest.fixture(scope="module")
+def bad_set(tmp_path_factory):
+    path = tmp_path_factory.mktemp("sets") / "bad.toml"
+    text = dumps_parameters(load_parameters())
+    path.write_text(text.replace("wheel_hub_outer_diameter = { value = 0.33",
+                                 "wheel_hub_outer_diameter = { value = 0.2"), encoding="utf-8")
+    return str(path)
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--s0", "0.014", "--v", "120"], "--s0 0.014 at --v 120 km/h is not stable"),
+    (["--s0", "0.005,0.003"], "--s0 must increase"),
+    (["--v", "abc"], "--v must be numbers"),
+    (["--fs", "100"], "too low to resolve the excitation"),
+    (["--unstable-s0", "2"], "--unstable-s0 (creepage) = 2 is not allowed"),
+    (["--params", "BAD"], "'wheel_hub_outer_diameter' = 0.2 m must exceed the seat's diameter"),
+])
+def test_bad_input_is_one_line_with_exit_status_2(argv, message, bad_set, capsys):
+    argv = [bad_set if a == "BAD" else a for a in argv]
+    code, out, err = run(["assess", *argv], capsys)
+    assert code == 2
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert lines[-1].startswith(("bogie assess: error:", "bogie assess: error: argument"))
+    assert message in lines[-1]
+    assert "Traceback" not in err
+    assert out == ""
