@@ -168,7 +168,7 @@ ASSESSMENT_SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "disc_clutch_rated_torque": ("N m", "largest torque the disc clutch is rated for", _POS),
     "claw_clutch_rated_torque": ("N m", "largest torque the claw clutch is rated for", _POS),
     "required_factor_slip": ("1", "required safety factor of a press fit against slip", _POS),
-    "required_factor_shear": ("1", "required safety factor of a shaft section against its permissible shear stress", _POS),
+    "required_factor_shear": ("1", "required safety factor of a shaft against its permissible shear stress", _POS),
     "required_factor_coupling": ("1", "required safety factor of a coupling against its rating", _POS),
 }
 ALL_SCHEMA = {**SCHEMA, **ASSESSMENT_SCHEMA}  # every name a parameter file may hold
