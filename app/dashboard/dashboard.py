@@ -46,6 +46,7 @@ from app.dashboard.stages import State
 from app.dashboard.studies_view import StudiesView
 from app.dashboard.url_state import make_query, parse_query
 from app.dashboard.variant_view import VariantView
+from app.dashboard.verdicts_view import VerdictsView
 from app.results import compute
 from app.results.eigenvalue_sweep import Fig6Plot
 from app.results.plots import CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
@@ -169,6 +170,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.sensitivity = SensitivityView(self.alive)  # sensitivity tornado
         self.variant_view = VariantView(self)
         self.click = ModeClickThrough(self)  # tapped locus points and table rows -> mode views
+        self.verdicts = VerdictsView(self)  # safety factors of every fit, shaft and coupling
         self.view_tabs = layout.ViewTabs(
             ("Response", layout.response_view(self.creep_plot, self.peaks, self.response_plots)),
             ("Fig. 6", layout.fig6_view(self.fig6)),
@@ -179,8 +181,8 @@ class BogieDashboard(pn.viewable.Viewer):
         self.tabs = self.view_tabs.tabs
         self.main = pn.Column(
             self.notice, self.input_notice, self.nonlinear.notice,
-            pn.Row(pn.Column(self.status, self.scheduler.busy_notice, self.details,
-                             self.nonlinear.status, width=330),
+            pn.Row(pn.Column(self.status, self.verdicts.indicator, self.scheduler.busy_notice,
+                             self.details, self.nonlinear.status, width=330),
                    pn.Column(pn.Row(locus_choice, zoom), layout.bokeh_pane(self.locus_plot.figure),
                              sizing_mode="stretch_width"),
                    sizing_mode="stretch_width"),
@@ -194,6 +196,7 @@ class BogieDashboard(pn.viewable.Viewer):
         # the Campbell diagram, the frequency response, the forced response to a torque ripple
         self.resonances = ResonanceView(self)
         self.view_tabs.add("Resonances", self.resonances.layout)
+        self.view_tabs.add("Verdicts", self.verdicts.layout)
         self.downloads = Downloads(self)
         self.controls = Controls(self, self.nonlinear.controls, self.downloads.widgets)
         self.sliders = self.controls.sliders
@@ -296,6 +299,7 @@ class BogieDashboard(pn.viewable.Viewer):
         shown = self.view_tabs.shown
         self.variant_view.on_shown(shown == "variant")
         self.resonances.on_shown(shown == "resonances")
+        self.verdicts.on_shown(shown == "verdicts")
         self.flush_view(shown)
 
     def _share(self, *_events) -> None:
@@ -328,6 +332,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.when_shown("sensitivity", self.sensitivity.request, self, state)
         self.when_shown("design-loads", self.design_loads.request_worst_case, state)
         self.resonances.request(state)  # computed while its tab is open
+        self.verdicts.request(state)  # the indicator is on the first screen
         # the nonlinear result follows; the peak table shows the history of the creep model in
         # use (show_history, called by the nonlinear view)
         self.nonlinear.on_fast(state)

@@ -25,6 +25,9 @@ CSS = """
 .status-box {font-size: 30px; font-weight: 700; padding: 6px 14px; border-radius: 6px;
              color: white; text-align: center; letter-spacing: 0.05em}
 .status-box.ok {background: STABLE_COLOR} .status-box.bad {background: UNSTABLE_COLOR}
+.verdict-box {font-size: 20px; margin-top: 6px; color: #222} .verdict-box.green {background: #c8e6c9}
+.verdict-box.amber {background: #ffe0b2} .verdict-box.red {background: #ffcdd2}
+.verdict-box.pending {background: #eeeeee; font-size: 14px}
 table.bogie {border-collapse: collapse; font-size: 12px; width: 100%}
 table.bogie th, table.bogie td {border-bottom: 1px solid #ddd; padding: 2px 6px; text-align: right}
 table.bogie td.text, table.bogie th.text {text-align: left}

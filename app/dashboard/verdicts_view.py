@@ -1,0 +1,195 @@
+"""The verdicts in the dashboard: the indicator beside the stability status (the governing safety
+factor of the operating point, green / amber / red against its required factor) and the Verdicts
+tab — every check as a table (a row opens the history that produced its load) and a bar chart of
+the safety factors per load case — and a strength-data file that replaces the set's (a bad one is
+refused with a notice; the previous data are kept).
+
+The assessment (:func:`app.results.verdicts.assessment_result`) runs on a worker thread for each
+operating point shown; it takes seconds (the short-circuit case's horizon covers ID2's slow
+take-over), so the indicator says "computing" meanwhile.
+"""
+
+from __future__ import annotations
+
+import html
+import tomllib
+from functools import partial
+
+import panel as pn
+
+from app.dashboard import layout
+from app.results.verdicts import (
+    assessment_result,
+    check_rows,
+    indicator_html,
+    safety_factor_figure,
+)
+from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest, ignore_outcome
+from model.mechanics.parameters import ASSESSMENT_SCHEMA, ParameterError
+
+MAX_STRENGTH_BYTES = 50_000
+COLUMNS = ("component", "check", "load case", "load [kN m]", "capacity [kN m]", "safety factor",
+           "required", "verdict", "where")
+
+
+def strength_from_toml(data: bytes, base) -> tuple:
+    """The strength data of an uploaded TOML file (entries ``name = { value = …, unit = "…" }``
+    of :data:`model.mechanics.parameters.ASSESSMENT_SCHEMA`), checked against ``base`` (a
+    :class:`model.mechanics.parameters.Parameters`): ((name, value), …); raises ParameterError
+    naming what is wrong."""
+    if len(data) > MAX_STRENGTH_BYTES:
+        raise ParameterError(f"strength file too large ({len(data)} bytes, at most "
+                             f"{MAX_STRENGTH_BYTES})")
+    try:
+        table = tomllib.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
+        raise ParameterError(f"strength file is not valid TOML: {error}") from None
+    changes = {}
+    for name, entry in table.items():
+        if name not in ASSESSMENT_SCHEMA:
+            raise ParameterError(f"'{name[:60]}' is not a strength datum (allowed: "
+                                 f"{', '.join(list(ASSESSMENT_SCHEMA)[:4])}, …)")
+        if not isinstance(entry, dict) or "value" not in entry:
+            raise ParameterError(f"parameter '{name}' must be a table {{ value = …, unit = … }}")
+        unit = ASSESSMENT_SCHEMA[name][0]
+        if entry.get("unit", unit) != unit:
+            raise ParameterError(f"parameter '{name}' has unit '{entry['unit']}', expected "
+                                 f"'{unit}'")
+        changes[name] = entry["value"]
+    base.replace(**changes)  # validates each value and the geometry (names the parameter)
+    return tuple(sorted((name, float(value)) for name, value in changes.items()))
+
+
+class VerdictsView:
+    """Indicator, table, bar chart and strength file of one dashboard."""
+
+    def __init__(self, dashboard):
+        self.dashboard = dashboard
+        self._requests = LatestRequest(SIDE_VIEW_POOL, dashboard.alive)
+        self.strength: tuple = ()  # uploaded strength data ((name, value), …)
+        self.result = None  # the assessment on screen
+        self.rows: list[dict] = []
+        self._waiting: tuple | None = None  # not served: the key to assess when the tab opens
+        self._tab_open = False
+        self.indicator = layout.html_pane(indicator_html(None, "computing…"),
+                                          css_classes=["verdict-status"])
+        self.cases = layout.html_pane("")
+        self.table = pn.widgets.Tabulator(
+            self._frame([]), show_index=False, disabled=True, selectable=1,
+            layout="fit_data_stretch", sizing_mode="stretch_width", height=330,
+            css_classes=["verdict-table"])
+        self.table.on_click(self._clicked)
+        self.chart = pn.pane.Bokeh(sizing_mode="stretch_width", css_classes=["verdict-chart"])
+        self.upload = pn.widgets.FileInput(accept=".toml", css_classes=["verdict-strength"])
+        self.upload.param.watch(self._uploaded, "value")
+        self.notice = pn.pane.Alert("", alert_type="warning", visible=False,
+                                    css_classes=["verdict-notice"], sizing_mode="stretch_width")
+        self.layout = pn.Column(
+            pn.pane.Markdown(
+                "Every press fit (slip, DIN 7190), shaft (torsional shear) and coupling (rating) "
+                "of both drives in three load cases; safety factor = capacity / load. Click a "
+                "row for the history that produced its load. Strength data (TOML, entries as in "
+                "the parameter file, e.g. `wheel_seat_friction_min = { value = 0.1, unit = "
+                "\"1\" }`) replace the set's; docs/assessment.md."),
+            pn.Row(pn.pane.Markdown("**strength data (TOML):**"), self.upload),
+            self.notice, self.cases, self.table, self.chart, sizing_mode="stretch_width")
+
+    @staticmethod
+    def _frame(rows):
+        import pandas as pd
+
+        return pd.DataFrame({name: [r[name] for r in rows] for name in COLUMNS},
+                            columns=list(COLUMNS))
+
+    # --- computing ----------------------------------------------------------------------------
+
+    def _key(self, state) -> tuple:
+        return (state.params_path, state.rail, state.s0, state.v, state.N0, state.b_M, state.M0,
+                state.f, state.D, self.strength)
+
+    def request(self, state) -> None:
+        """Assess ``state``'s operating point (served: on a worker thread; not served, as in
+        tests without a server: when the Verdicts tab is opened)."""
+        key = self._key(state)
+        doc = pn.state.curdoc
+        if doc is None or doc.session_context is None:
+            self._waiting = key
+            if self._tab_open:
+                self.on_shown(True)
+            else:
+                self.indicator.object = indicator_html(None, "open the Verdicts tab")
+            return
+        self.indicator.object = indicator_html(None, "computing…")
+        future = self._requests.submit(self._compute_if_current, state, key)
+        ignore_outcome(future)
+        future.add_done_callback(partial(self._done, doc, key))
+
+    def on_shown(self, shown: bool) -> None:
+        """The Verdicts tab opened (``shown``) or closed; not served, the assessment waiting
+        for it is computed now."""
+        self._tab_open = shown
+        if shown and self._waiting is not None:
+            key, self._waiting = self._waiting, None
+            self._show(key, assessment_result(*key))
+
+    def _compute_if_current(self, state, key):
+        return assessment_result(*key) if self.dashboard.state() == state else None
+
+    def _done(self, doc, key, future) -> None:
+        if future.cancelled():
+            return
+        error = future.exception()
+
+        def show():
+            if error is not None:
+                self.indicator.object = indicator_html(None, f"not assessed: {error}")
+            elif future.result() is not None and self._key(self.dashboard.state()) == key:
+                self._show(key, future.result())
+        self.dashboard.post(doc, show)
+
+    def _show(self, key, result) -> None:
+        self.result = result
+        self.rows = check_rows(result)
+        self.indicator.object = indicator_html(result)
+        self.table.value = self._frame(self.rows)
+        self.cases.object = "<ul>" + "".join(
+            f"<li><b>{c.name}</b> ({'steady' if c.horizon is None else f'horizon {c.horizon:g} s'}"
+            f"): {html.escape(c.description)}</li>" for c in result.cases) + "</ul>"
+        self.chart.object = safety_factor_figure(result)
+
+    # --- input --------------------------------------------------------------------------------
+
+    def _uploaded(self, event) -> None:
+        from app.results import compute
+
+        if not event.new:
+            return
+        state = self.dashboard.state()
+        try:
+            strength = strength_from_toml(event.new, compute.parameters(state.params_path,
+                                                                        state.rail))
+        except ParameterError as error:
+            self.notice.object = (f"**Strength data not used:** {html.escape(str(error))} — the "
+                                  "previous data are kept.")
+            self.notice.visible = True
+            return
+        self.notice.visible = False
+        self.strength = strength
+        self.request(state)
+
+    def _clicked(self, event) -> None:
+        """A row: its load's history on the Response tab (its s0 and v; the nonlinear creep
+        model with anti-slip for the unstable_adhesion case)."""
+        if not 0 <= event.row < len(self.rows):
+            return
+        row = self.rows[event.row]
+        dash = self.dashboard
+        if row["s0"] is None or row["v_kmh"] is None:
+            return
+        dash.param.update(s0=min(max(row["s0"], 0.0005), 0.03),
+                          v=min(max(row["v_kmh"], 10.0), 250.0))
+        nonlinear = row["load case"] == "unstable_adhesion"
+        dash.nonlinear.creep.value = "nonlinear" if nonlinear else "linear"
+        if nonlinear:
+            dash.nonlinear.anti_slip.value = True
+        dash.tabs.active = dash.view_tabs.names.index("response")

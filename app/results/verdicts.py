@@ -1,0 +1,134 @@
+"""The assessment as the dashboard and the report show it: computed once per operating point and
+set (cached), the verdict indicator, the checks' table and the bar chart of safety factors.
+
+At the dashboard's operating point: a stable point is the short-circuit case's grid (that one
+point), an unstable one the unstable_adhesion case's point (the short-circuit case then takes the
+default grid of :mod:`model.studies.assessment`).
+"""
+
+from __future__ import annotations
+
+import html
+import math
+
+import numpy as np
+import panel as pn
+from bokeh.models import ColumnDataSource, HoverTool, Span
+from bokeh.plotting import figure
+
+from model.analysis.assessment import verdict_colour
+from model.mechanics.operating_point import KMH, OperatingPoint
+from model.studies.assessment import Assessment, AssessmentOptions, assess
+
+CASE_COLOURS = {"short_circuit": "#1f77b4", "unstable_adhesion": "#d62728", "starting": "#2ca02c"}
+KIND_LABELS = {"press_fit_slip": "press-fit slip", "torsional_shear": "torsional shear",
+               "coupling": "coupling rating"}
+VERDICT_WORDS = {"green": "MARGIN MET", "amber": "MARGIN SHORT", "red": "OVERLOADED"}
+
+
+@pn.cache(max_items=16)
+def assessment_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                      b_M: float, M0_kN: float, f: float, D: float,
+                      strength: tuple = ()) -> Assessment:
+    """The assessment at an operating point (primitives: the cache key), with the strength data
+    ``strength`` ((name, value) pairs) replacing the set's."""
+    from app.results import compute
+    from model.analysis.eigen import bogie_system
+    from model.analysis.response import ShortCircuit
+    from model.studies.maps import cached_model
+
+    parameters = compute.parameters(params_path, rail)
+    if strength:
+        parameters = parameters.replace(**dict(strength))
+    op = OperatingPoint(s0, v_kmh * KMH, N0_kN * 1e3, b_M)
+    stable = float(np.max(bogie_system(cached_model(parameters), op).eigenvalues().real)) <= 1e-6
+    excitation = ShortCircuit(M0=M0_kN * 1e3, f=f, D=D)
+    if stable:
+        options = AssessmentOptions(s0=(s0,), v=(op.v,), N0=op.N0, b_M=b_M, excitation=excitation)
+    else:
+        options = AssessmentOptions(N0=op.N0, b_M=b_M, excitation=excitation, unstable_s0=s0,
+                                    unstable_v=op.v)
+    return assess(parameters, options)
+
+
+def indicator_html(result: Assessment | None, note: str = "") -> str:
+    """The verdict box: the governing safety factor against its required factor, green / amber /
+    red (:func:`model.analysis.assessment.verdict_colour`)."""
+    if result is None:
+        return f'<div class="status-box verdict-box pending">VERDICT: {html.escape(note)}</div>'
+    g = result.governing
+    colour = verdict_colour(g)
+    return (f'<div class="status-box verdict-box {colour}" data-verdict="{colour}">'
+            f"{VERDICT_WORDS[colour]}</div>"
+            f"<div class='verdict-detail' style='font-size:13px'>governing safety factor "
+            f"<b>{g.safety_factor:.3g}</b> (required {g.required:.3g}): "
+            f"{html.escape(g.component)}, {KIND_LABELS[g.kind]}, {g.load_case}</div>")
+
+
+def check_rows(result: Assessment) -> list[dict]:
+    """One row per check, the worst margin first (what the Verdicts table and the report list)."""
+    rows = []
+    for c in sorted(result.checks, key=lambda c: -c.utilisation):
+        where = "steady" if math.isnan(c.time) else f"t = {c.time:.4g} s"
+        if "v_kmh" in c.scenario:
+            where += f", s0 = {c.scenario['s0']:.4g}, {c.scenario['v_kmh']:g} km/h"
+        rows.append({"component": c.component, "check": KIND_LABELS[c.kind],
+                     "load case": c.load_case, "load [kN m]": round(c.load / 1e3, 2),
+                     "capacity [kN m]": round(c.capacity / 1e3, 2),
+                     "safety factor": round(c.safety_factor, 3), "required": c.required,
+                     "verdict": verdict_colour(c), "where": where, "output": c.output,
+                     "s0": c.scenario.get("s0"), "v_kmh": c.scenario.get("v_kmh")})
+    return rows
+
+
+def checks_html(result: Assessment) -> str:
+    """The checks as an HTML table (the report)."""
+    head = ("<table class='bogie'><tr><th class='text'>component</th><th class='text'>check</th>"
+            "<th class='text'>load case</th><th>load [kN m]</th><th>capacity [kN m]</th>"
+            "<th>safety factor</th><th>required</th><th class='text'>verdict</th>"
+            "<th class='text'>where</th></tr>")
+    body = "".join(
+        f"<tr><td class='text'>{html.escape(r['component'])}</td><td class='text'>{r['check']}</td>"
+        f"<td class='text'>{r['load case']}</td><td>{r['load [kN m]']:.4g}</td>"
+        f"<td>{r['capacity [kN m]']:.4g}</td><td class='{'' if r['verdict'] == 'green' else 'bad'}'>"
+        f"{r['safety factor']:.3g}</td><td>{r['required']:.3g}</td>"
+        f"<td class='text'>{VERDICT_WORDS[r['verdict']].lower()}</td>"
+        f"<td class='text'>{html.escape(r['where'])}</td></tr>" for r in check_rows(result))
+    cases = "".join(
+        f"<li><b>{c.name}</b> ({'steady' if c.horizon is None else f'horizon {c.horizon:g} s'})"
+        f": {html.escape(c.description)}</li>" for c in result.cases)
+    return f"<ul class='load-cases'>{cases}</ul>{head}{body}</table>"
+
+
+def safety_factor_figure(result: Assessment):
+    """Bar chart of the safety factors of every component, one bar per load case (log scale),
+    with the required factors as lines."""
+    components = list(dict.fromkeys(c.component for c in result.checks))
+    x, top, colours, cases, names = [], [], [], [], []
+    for c in result.checks:
+        x.append((c.component, c.load_case))
+        top.append(min(c.safety_factor, 1e3))
+        colours.append(CASE_COLOURS[c.load_case])
+        cases.append(c.load_case)
+        names.append(c.component)
+    source = ColumnDataSource({"x": x, "top": top, "colour": colours, "case": cases,
+                               "component": names})
+    from bokeh.models import FactorRange
+
+    fig = figure(x_range=FactorRange(*[(n, case) for n in components
+                                       for case in CASE_COLOURS]),
+                 y_axis_type="log", height=330, sizing_mode="stretch_width",
+                 y_axis_label="safety factor = capacity / load [-]", name="verdict-bars",
+                 title="Safety factor of every check, per load case (blue short circuit, red "
+                       "unstable adhesion, green starting)", toolbar_location="above")
+    fig.vbar(x="x", top="top", bottom=0.05, width=0.8, color="colour", source=source)
+    for required in sorted({c.required for c in result.checks}):
+        fig.add_layout(Span(location=required, dimension="width", line_dash="dashed",
+                            line_color="black", line_width=1))
+    fig.add_layout(Span(location=1.0, dimension="width", line_color="red", line_width=2))
+    fig.add_tools(HoverTool(tooltips=[("component", "@component"), ("load case", "@case"),
+                                      ("safety factor", "@top{0.000}")]))
+    fig.xaxis.major_label_orientation = 1.0
+    fig.xaxis.group_label_orientation = 1.2
+    fig.x_range.range_padding = 0.02
+    return fig

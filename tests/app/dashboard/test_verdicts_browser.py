@@ -1,0 +1,41 @@
+"""The verdict indicator beside the stability status and the Verdicts tab, served and in
+headless Chromium (one page load): the indicator shows the governing safety factor with its
+colour, the tab lists all 48 checks and draws the bar chart, a row opens the Response tab at the
+operating point of its load."""
+
+from __future__ import annotations
+
+import html
+import re
+
+import pytest
+from conftest import open_app
+
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
+TEXT = """(cls) => { const m = [...Bokeh.documents[0].all_models]
+  .find(m => (m.css_classes || []).includes(cls)); return m ? m.text || '' : ''; }"""
+
+
+def test_verdict_indicator_and_view(app_server, chromium):
+    page = open_app(chromium, app_server)
+    box = page.locator(".verdict-status [data-verdict]")
+    box.wait_for(timeout=180_000)
+    colour = box.get_attribute("data-verdict")
+    assert colour in ("green", "amber", "red")
+    detail = re.sub(r"<[^>]+>", "", html.unescape(page.evaluate(TEXT, "verdict-status")))
+    factor = float(re.search(r"governing safety factor\s*([0-9.e+-]+)", detail).group(1))
+    required = float(re.search(r"required\s*([0-9.e+-]+)", detail).group(1))
+    # the colour follows the factor against the required one
+    assert colour == ("green" if factor >= required else "amber" if factor >= 1 else "red")
+    page.get_by_text("Verdicts", exact=True).click()
+    rows = page.locator(".verdict-table .tabulator-row")
+    rows.first.wait_for(timeout=60_000)
+    assert rows.count() >= 10  # the table is virtual: the first rows are rendered
+    first = rows.first.inner_text()
+    assert "short_circuit" in first or "starting" in first or "unstable_adhesion" in first
+    page.wait_for_function(
+        "() => [...Bokeh.documents[0].all_models].some(m => m.name === 'verdict-bars')",
+        timeout=60_000)
+    rows.first.click()
+    page.locator(".bk-tab.bk-active", has_text="Response").wait_for(timeout=30_000)
+    assert page.errors == []
