@@ -1,0 +1,58 @@
+"""``bogie assess`` at the default set against one ``bogie envelope --phase all`` call at a single
+(s0, v) point, in the same run (the target: at most 10x).
+
+    .venv/bin/python scripts/bench_assess.py [--runs 3] [--json FILE]
+
+Each command runs as its own process (as a user runs it, imports included), alternated; the
+medians and their ratio are printed.  The envelope is timed twice: as run by default (a local Dask
+cluster) and with ``--serial`` (in this process, the faster reference the ratio is stated against
+too).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+BOGIE = str(Path(sys.executable).with_name("bogie"))
+COMMANDS = {
+    "assess": [BOGIE, "assess", "--json"],
+    "envelope": [BOGIE, "envelope", "--s0", "0.005", "--v", "120", "--phase", "all", "--json"],
+    "envelope --serial": [BOGIE, "envelope", "--s0", "0.005", "--v", "120", "--phase", "all",
+                          "--serial", "--json"],
+}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--json", default=None)
+    args = parser.parse_args()
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    times: dict[str, list[float]] = {name: [] for name in COMMANDS}
+    for _ in range(args.runs):
+        for name, command in COMMANDS.items():
+            start = time.perf_counter()
+            subprocess.run(command, check=True, env=env, stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL)
+            times[name].append(time.perf_counter() - start)
+    medians = {name: statistics.median(values) for name, values in times.items()}
+    result = {"runs": args.runs, "times_s": times, "median_s": medians,
+              "ratio_to_envelope": medians["assess"] / medians["envelope"],
+              "ratio_to_envelope_serial": medians["assess"] / medians["envelope --serial"]}
+    for name, value in medians.items():
+        print(f"{name:<20} median {value:6.2f} s  ({', '.join(f'{x:.2f}' for x in times[name])})")
+    print(f"assess / envelope = {result['ratio_to_envelope']:.2f}x, assess / envelope --serial = "
+          f"{result['ratio_to_envelope_serial']:.2f}x (target <= 10x)")
+    if args.json:
+        Path(args.json).write_text(json.dumps(result, indent=1))
+
+
+if __name__ == "__main__":
+    main()
