@@ -55,7 +55,13 @@ def golden_model(golden):
 
 
 def test_golden_file_is_of_the_current_calibrated_set(golden):
-    current = load_parameters().values
+    """The dynamics' values (the strength data do not enter them; a zero train mass is the
+    golden file's, written before the parameter existed)."""
+    from model.mechanics.parameters import ASSESSMENT_SCHEMA, OPTIONAL_DEFAULTS
+
+    current = {name: value for name, value in load_parameters().values.items()
+               if name not in ASSESSMENT_SCHEMA
+               and not (name in OPTIONAL_DEFAULTS and value == OPTIONAL_DEFAULTS[name])}
     stored = golden["parameters"]
     changed = sorted(name for name in set(current) | set(stored)
                      if current.get(name) != stored.get(name))
