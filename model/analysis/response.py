@@ -80,6 +80,16 @@ AUTO_TOLERANCE = 1e-8
 WINDOW_TOLERANCE = 1e-13  # a decayed mode's terms below this x the largest term are not evaluated
 MAX_POINTS = 2_000_001  # time points per response
 MAX_T_END = 60.0  # [s]
+# The quasi-static part of a response: the static response and the modes that do not oscillate
+# or oscillate slower than this (|Im λ| / 2π), not completing a cycle in the study's 2 s window.
+# The bogie's slow modes (the vehicle's speed, a drive taking over a lost torque, creep-damped
+# drifts; a pair below 0.3 Hz where the motor slope b_M makes one) lie well below its lowest
+# structural mode (the car body's bounce, 1.26 Hz).
+QUASI_STATIC_HZ = 0.5
+# the split is given when the modal form's rounding-error estimate of the quasi-static part stays
+# below this (relative; the estimate is not a bound, measured errors were up to 150x it): 3 digits
+QUASI_STATIC_TOLERANCE = 1e-6
+GROWING = 1e-6  # [1/s]: a mode with a larger real part grows (no final value)
 
 
 class ResponseError(ValueError):
@@ -163,16 +173,12 @@ def _grid_exponentials(lam: np.ndarray, n_points: int, dt: float, block: int):
     return np.exp(np.outer(b, lam)), np.exp(np.outer(a, lam))
 
 
-def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu: complex,
-                   n_points: int, dt: float, modes: str = "all"
-                   ) -> tuple[np.ndarray, float, int, float]:
-    """Perturbation outputs y (n_points x p) by the modal closed form; (y, error estimate relative
-    to the largest |y|, number of valid points, highest frequency [Hz] of a mode contributing
-    more than 1 % of some output's peak).  ``modes``: "all"; "real", the particular solutions
-    and the terms of the real (non-oscillating) eigenvalues only; "complex", the terms of the
-    complex pairs only ("real" + "complex" = "all")."""
+def _modal_terms(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu: complex):
+    """The modal closed form's pieces for the outputs ``C``: (λ, coef, const_h, α, β, x_μ) with
+    the perturbation outputs ``y(t) = Re Σ_j coef_j e^(λ_j t) + const_h + C (α + β t)
+    + Re(C x_μ e^(μt))`` (coef p x m over every eigenvalue of the deflated system)."""
     deflation, r = system.deflation, system.R.shape[1]
-    lam, Y, _, cond, scale = system.modal  # A22 = (T Y) Λ (T Y)⁻¹, T = diag(scale)
+    lam, Y, _, _, scale = system.modal  # A22 = (T Y) Λ (T Y)⁻¹, T = diag(scale)
     alpha, beta = system.step_particular(u0)
     x_mu = system.exponential_particular(a, mu)
     xh0 = -(alpha + x_mu.real)
@@ -190,15 +196,34 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
         const_h = CQ1 @ a0 - (G / lam) @ d
     else:
         const_h = np.zeros(C.shape[0], dtype=complex)
-    coef = W * d  # p x m: y_h(t) = Re Σ_j coef_j e^(λ_j t) + const_h
-    # conjugate pairs: keep Im λ ≥ 0, double the strictly complex ones
-    keep = lam.imag >= 0
-    if modes == "real":
-        keep = lam.imag == 0
-    elif modes == "complex":
-        keep = lam.imag > 0
+    return lam, W * d, const_h, alpha, beta, x_mu
+
+
+def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu: complex,
+                   n_points: int, dt: float, part: str = "all"
+                   ) -> tuple[np.ndarray, float, int, float]:
+    """Perturbation outputs y (n_points x p) by the modal closed form; (y, error estimate relative
+    to the largest |y|, number of valid points, highest frequency [Hz] of a mode contributing
+    more than 1 % of some output's peak).  ``part``: "all"; "slow", the quasi-static part (the
+    step's particular solution, the rigid coordinates' offset, the terms of the modes slower
+    than :data:`QUASI_STATIC_HZ` and the forced oscillation if μ is that slow); "fast", the rest
+    ("slow" + "fast" = "all")."""
+    cond = system.modal[3]
+    lam, coef, const_h, alpha, beta, x_mu = _modal_terms(system, C, u0, a, mu)
+    slow_cut = 2 * math.pi * QUASI_STATIC_HZ  # [rad/s]
+    keep = lam.imag >= 0  # conjugate pairs: keep Im λ ≥ 0, double the strictly complex ones
+    if part == "slow":
+        keep &= lam.imag < slow_cut
+        if abs(mu.imag) >= slow_cut:
+            x_mu = np.zeros_like(x_mu)
+    elif part == "fast":
+        keep &= lam.imag >= slow_cut
         const_h = np.zeros(C.shape[0], dtype=complex)
-        alpha, beta, x_mu = np.zeros_like(alpha), np.zeros_like(beta), np.zeros_like(x_mu)
+        alpha, beta = np.zeros_like(alpha), np.zeros_like(beta)
+        if abs(mu.imag) < slow_cut:
+            x_mu = np.zeros_like(x_mu)
+    elif part != "all":
+        raise ValueError(f"part '{part}': all, slow or fast")
     weight = np.where(lam.imag > 0, 2.0, 1.0)
     lam_k, coef_k = lam[keep], coef[:, keep] * weight[keep]
     # growth guard: cut the grid before any term exceeds 1e250
@@ -324,17 +349,55 @@ def solve_linear(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu:
     return y, "expm", math.nan
 
 
+class QuasiStaticUnavailable(ResponseError):
+    """The quasi-static part cannot be separated reliably at this operating point (the modal
+    form is ill-conditioned there, e.g. at b_M = 0, where the vehicle's speed is neutral)."""
+
+
+@dataclass(frozen=True)
+class QuasiStatic:
+    """The quasi-static part of a response (perturbations of the outputs; see
+    :func:`quasi_static_response`)."""
+
+    y: np.ndarray  # valid x p on the grid t_k = k dt [output units]
+    final: np.ndarray  # p: its value long after, t → ∞ (NaN where it grows or drifts) [units]
+
+
+def quasi_static_response(system: LinearSystem, C: np.ndarray, u0: float, a: complex,
+                          mu: complex, n_points: int, dt: float) -> QuasiStatic:
+    """The quasi-static part of the response to ``u(t) = u0 + Re(a e^(μt))`` [N m] (the
+    excitation's terms, :meth:`ShortCircuit.terms`) of the outputs ``C``, on the grid
+    ``t_k = k dt`` [s]: the static response to the step and the terms of the modes that do not
+    oscillate or oscillate slower than :data:`QUASI_STATIC_HZ` — the take-over of a lost motor
+    torque as the vehicle's speed changes, the creep-damped drifts.  The rest (the faster modes'
+    terms, the forced oscillation at f) is the dynamic part: the oscillation about the
+    quasi-static value.  Raises :class:`QuasiStaticUnavailable` where the modal form is not
+    reliable (rounding-error estimate above :data:`QUASI_STATIC_TOLERANCE`)."""
+    try:
+        y, estimate, valid, _ = _modal_outputs(system, C, u0, a, mu, n_points, dt, part="slow")
+    except np.linalg.LinAlgError:
+        estimate = math.inf
+    if not estimate <= QUASI_STATIC_TOLERANCE:
+        raise QuasiStaticUnavailable(
+            f"the quasi-static part cannot be separated here (modal form ill-conditioned: "
+            f"error estimate {estimate:.2g})")
+    lam, _, const_h, alpha, beta, _ = _modal_terms(system, C, u0, a, mu)
+    final = const_h.real + C @ alpha
+    slow = lam[lam.imag < 2 * math.pi * QUASI_STATIC_HZ]
+    # an output that drifts (a rigid coordinate's ramp) more than 1e-9 of its size per second
+    size = np.maximum(np.abs(final), np.abs(y[:valid]).max(axis=0, initial=0.0))
+    drift = np.abs(C @ beta) > 1e-9 * np.maximum(size, 1e-300)
+    if len(slow) and slow.real.max() > GROWING:
+        drift[:] = True  # a slow mode grows: no final value
+    return QuasiStatic(y[:valid], np.where(drift, np.nan, final))
+
+
 def quasi_static_step(system: LinearSystem, C: np.ndarray, step: float, n_points: int,
-                      dt: float) -> np.ndarray:
-    """The part of the response to the step ``−step H(t)`` [N m] that does not oscillate
-    (n_points x p, perturbations of the outputs ``C``): the step's particular solution and the
-    terms of the real eigenvalues — the quasi-static take-over, slow as the vehicle's speed
-    changes, and the creep-damped drifts.  The rest of any short-circuit response (the complex
-    pairs' terms and the forced oscillation at f) is its dynamic part.  Modal closed form on the
-    grid ``t_k = k dt`` [s]."""
+                      dt: float) -> QuasiStatic:
+    """:func:`quasi_static_response` to the step ``−step H(t)`` [N m] alone (the loss of a
+    motor's torque ``step``)."""
     mu = complex(-1.0, 1.0)  # any μ that is not an eigenvalue: the input has no such term
-    y, _, valid, _ = _modal_outputs(system, C, -step, 0j, mu, n_points, dt, modes="real")
-    return y[:valid]
+    return quasi_static_response(system, C, -step, 0j, mu, n_points, dt)
 
 
 # --- the bogie -----------------------------------------------------------------------------------
@@ -520,3 +583,4 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
         truncated_at=None if valid == n_points else float(t[-1]),
         highest_excited_hz=(max(excitation.f if excitation.M0 > 0 else 0.0, info["mode_hz"])
                             if "mode_hz" in info else None))
+

@@ -128,9 +128,15 @@ def take_over_horizon(model, ops: list[OperatingPoint], outputs: list[str]) -> f
     """The time [s] after which the quasi-static part (:func:`model.analysis.response.
     quasi_static_step`) of every output at every operating point stays within 1 % of its final
     change, rounded up to a whole second, at least 2 s and at most 60 s (the response's
-    longest horizon; a take-over slower than that is cut there)."""
+    longest horizon; a take-over slower than that, or one that cannot be separated from the
+    oscillation at a point, is cut there)."""
     from model.analysis.eigen import bogie_system
-    from model.analysis.response import MAX_T_END, output_rows, quasi_static_step
+    from model.analysis.response import (
+        MAX_T_END,
+        QuasiStaticUnavailable,
+        output_rows,
+        quasi_static_step,
+    )
     from model.mechanics.operating_point import motor_torque
 
     dt = 0.01
@@ -139,10 +145,14 @@ def take_over_horizon(model, ops: list[OperatingPoint], outputs: list[str]) -> f
     latest = 0.0
     for op in ops:
         _, C, _, _ = output_rows(model, op, outputs)
-        trend = quasi_static_step(bogie_system(model, op), C, motor_torque(model.parameters, op),
-                                  n, dt)
-        final = trend[-1]
-        change = np.abs(trend).max(axis=0)
+        try:
+            part = quasi_static_step(bogie_system(model, op), C,
+                                     motor_torque(model.parameters, op), n, dt)
+        except QuasiStaticUnavailable:
+            return MAX_T_END
+        trend = part.y
+        final = np.where(np.isfinite(part.final), part.final, trend[-1])
+        change = np.maximum(np.abs(trend).max(axis=0), np.abs(final))
         away = np.abs(trend - final) > SETTLED * np.maximum(change, 1e-300)
         rows = np.flatnonzero(away.any(axis=1))
         if len(rows):
