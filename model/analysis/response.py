@@ -58,7 +58,14 @@ import scipy.linalg as sla
 
 from model.analysis.eigen import bogie_system
 from model.analysis.linear_system import LinearSystem
-from model.analysis.load_peaks import LIMITED, LimitCrossing, history_peaks_and_crossings  # noqa: F401 (re-export)
+from model.analysis.load_peaks import (  # noqa: F401 (re-export)
+    GROWTH_RATE,
+    LIMITED,
+    LimitCrossing,
+    LoadPeaks,
+    history_peaks_and_crossings,
+    load_peaks,
+)
 from model.mechanics.assembly import BogieModel
 from model.mechanics.operating_point import (
     OperatingPoint,
@@ -584,3 +591,30 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
         highest_excited_hz=(max(excitation.f if excitation.M0 > 0 else 0.0, info["mode_hz"])
                             if "mode_hz" in info else None))
 
+
+def linear_load_peaks(model: BogieModel, result: ResponseResult) -> LoadPeaks:
+    """The peaks a reviewer reads of a linear history (:class:`model.analysis.load_peaks.
+    LoadPeaks`): per output the maximum, the minimum and the swing from the pre-fault value with
+    their times, the swing split into its quasi-static part (:func:`quasi_static_response` of the
+    same excitation) and its dynamic part; at an unstable point the growth rate (largest Re λ
+    [1/s]) instead of a split."""
+    op = result.operating_point
+    growth = float(np.max(bogie_system(model, op).eigenvalues().real))
+    names = list(result.outputs)
+    quasi_static = final = None
+    note = ""
+    if growth > GROWTH_RATE:
+        note = "unbounded with linear creep"
+    else:
+        _, C, _, _ = output_rows(model, op, names)
+        u0, a, mu = result.excitation.terms(result.motor_torque)
+        dt = float(result.t[1] - result.t[0])
+        try:
+            part = quasi_static_response(bogie_system(model, op), C, u0, a, mu, len(result.t), dt)
+        except QuasiStaticUnavailable as error:
+            note = str(error)
+        else:
+            quasi_static = {name: part.y[:, j] for j, name in enumerate(names)}
+            final = {name: float(part.final[j]) for j, name in enumerate(names)}
+    return load_peaks(result.t, result.outputs, result.steady, result.units,
+                      result.limit_crossings, "linear", growth, quasi_static, final, note)
