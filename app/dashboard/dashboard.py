@@ -16,7 +16,8 @@ dashboard object and use its public interface only: ``state()``, ``alive()``, ``
 function, *args)``, ``run_locked(function, *args)``, ``warn(text)``, ``clear_warning()``,
 ``when_shown(tab, function, *args)``, ``flush_view(tab)``, ``params_path``, ``set_key``,
 ``study_owner`` (the session's claim in the server's study queue), ``show_history(key,
-history)`` (the nonlinear view: which history the peak table describes), ``show_mode(mode,
+history)`` and ``show_companion(key, history)`` (the nonlinear view: which history the peak
+table describes, and the nonlinear one beside an unbounded linear one), ``show_mode(mode,
 where)`` (a mode picked elsewhere, shown in the Modes view), the parameters, the
 last valid results (``point``, ``response``, ``history``, ``locus_result``), the nonlinear view's
 creep switch and anti-slip key (``nonlinear``) and the plots they draw on.  A rejected parameter
@@ -111,6 +112,11 @@ class BogieDashboard(pn.viewable.Viewer):
         # nonlinear one with nonlinear creep on (None while it is computed); and its key
         self.history: compute.ResponseView | None = None
         self.history_key: tuple | None = None
+        self._peaks_note = ""  # why there is no history yet
+        # beside an unbounded linear history: the nonlinear creep's (show_companion) and its key
+        self.companion: compute.ResponseView | None = None
+        self.companion_key: tuple | None = None
+        self._companion_note = ""
         self.error = ""  # last rejection message ("" if the current parameters are valid)
         self.closed = False  # the served session has ended: nothing more is computed for it
         # the session's claim on its study in the server's queue (Studies and Design loads tabs:
@@ -344,11 +350,26 @@ class BogieDashboard(pn.viewable.Viewer):
         (``history`` None: not ready, ``note`` says why).  ``key``: its arguments of
         :func:`app.results.compute.history_result`."""
         self.history, self.history_key = history, key
-        self.peaks.object = (peaks_html(history) if history is not None else
-                             f"<b>Peaks</b> — {html.escape(note)}")
+        self._peaks_note = note
+        self._show_peaks()
         self.downloads.describe(history)
         if history is not None:
             self.when_shown("design-loads", self.design_loads.show_history, key, history)
+
+    def show_companion(self, key: tuple | None, companion: compute.ResponseView | None,
+                       note: str = "") -> None:
+        """The nonlinear creep's history beside a linear one that grows without bound (the peak
+        table's physical answer at an unstable point; ``companion`` None: not ready or not
+        wanted, ``note`` says why).  ``key``: its arguments of
+        :func:`app.results.compute.history_result` (None: none)."""
+        self.companion, self.companion_key, self._companion_note = companion, key, note
+        self._show_peaks()
+
+    def _show_peaks(self) -> None:
+        history = self.history
+        self.peaks.object = (
+            peaks_html(history, self.companion, self._companion_note) if history is not None
+            else f"<b>Peaks</b> — {html.escape(self._peaks_note)}")
 
     def described_history(self) -> compute.ResponseView:
         """The history the peak table describes; computed now (cached) if it is not ready yet

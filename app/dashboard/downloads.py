@@ -93,4 +93,5 @@ class Downloads:
         anti_slip = key[-1] if key is not None else None  # None: linear creep
         return io.StringIO(build_report(state.params_path, state.rail, state.s0, state.v,
                                         state.N0, state.b_M, state.M0, state.f, state.D,
-                                        state.dt, state.t_end, anti_slip=anti_slip))
+                                        state.dt, state.t_end, anti_slip=anti_slip,
+                                        companion_anti_slip=self.dashboard.nonlinear.valid))

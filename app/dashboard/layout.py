@@ -21,6 +21,9 @@ from app.results.plots import STABLE, UNSTABLE
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets"  # app/dashboard/ -> project
 
+# the peak table's column [px]: per output the pre-fault value, max, min and swing with their
+# times and the swing's quasi-static and dynamic parts
+PEAKS_WIDTH = 800
 CSS = """
 .status-box {font-size: 30px; font-weight: 700; padding: 6px 14px; border-radius: 6px;
              color: white; text-align: center; letter-spacing: 0.05em}
@@ -31,6 +34,8 @@ CSS = """
 table.bogie {border-collapse: collapse; font-size: 12px; width: 100%}
 table.bogie th, table.bogie td {border-bottom: 1px solid #ddd; padding: 2px 6px; text-align: right}
 table.bogie td.text, table.bogie th.text {text-align: left}
+table.bogie td.t {color: #666}
+table.bogie.peaks td {white-space: nowrap; padding: 2px 4px} table.bogie.peaks th {padding: 2px 4px}
 table.bogie td.bad {color: UNSTABLE_COLOR; font-weight: 700}
 .busy-text {font-size: 13px; color: #555; font-style: italic}
 """.replace("UNSTABLE_COLOR", UNSTABLE).replace("STABLE_COLOR", STABLE)
@@ -86,7 +91,7 @@ class ViewTabs:
 def response_view(creep_plot, peaks, response_plots):
     """The "Response" tab: creep characteristic, peak table and the time histories."""
     return pn.Column(
-        pn.Row(bokeh_pane(creep_plot.figure), pn.Column(peaks, width=520),
+        pn.Row(bokeh_pane(creep_plot.figure), pn.Column(peaks, width=PEAKS_WIDTH),
                sizing_mode="stretch_width"),
         pn.Row(*(bokeh_pane(f) for f in response_plots.figures[:2]), sizing_mode="stretch_width"),
         pn.Row(*(bokeh_pane(f) for f in response_plots.figures[2:]), sizing_mode="stretch_width"),

@@ -12,7 +12,9 @@ The dashboard builds ``NonlinearView(dashboard)`` and places its ``controls``, `
 ``status`` in its page; it calls ``prefetch(state)`` when the linear first answer is computed
 (served) and ``on_fast(state)`` when that answer is shown.  This view tells the dashboard which
 history its peak table, CSV download and report describe (``dashboard.show_history``): the
-linear one, or with nonlinear creep on the nonlinear one (none while it is computed).  The
+linear one, or with nonlinear creep on the nonlinear one (none while it is computed); and, with
+linear creep at an unstable point, the nonlinear history beside the unbounded linear one
+(``dashboard.show_companion``: the peak table's physical answer).  The
 nonlinear histories are computed by :func:`app.results.compute.nonlinear_histories` (the report
 uses them too); the reaction-time search here takes primitives only (``pn.cache`` keys) and
 returns plain read-only data, like :mod:`app.results.compute`.
@@ -142,7 +144,7 @@ class NonlinearView:
                                     css_classes=["nonlinear-notice"], sizing_mode="stretch_width")
         self.status = pn.pane.HTML("", css_classes=["reaction-status"],
                                    sizing_mode="stretch_width")
-        self.valid = anti_slip_key(False, defaults.delay, defaults.threshold, defaults.rate)
+        self.valid = compute.ANTI_SLIP_OFF
         self.histories: NonlinearHistories | None = None  # last shown
         self.reaction: Reaction | None = None
         self._state = None  # the dashboard state of the linear result on screen
@@ -250,14 +252,35 @@ class NonlinearView:
             self._clear()
             self._progress = ""
             self.dash.show_history((*key[:-1], None), self.dash.response)
+            self._request_companion(key)
         elif key != self._shown_key:
             self._progress = "nonlinear creep: computing…"
             self.dash.show_history(key, None, "computing the nonlinear history…")
             self._start(key, partial(nonlinear_histories, *key), self._apply_histories)
         else:
             self.dash.show_history(key, self.histories.response)
+        if self.creep.value == "nonlinear" and self.dash.companion_key is not None:
+            self.dash.show_companion(None, None)  # the table shows the nonlinear history itself
         self._request_reaction()
         self._render_status()
+
+    def _request_companion(self, key) -> None:
+        """Linear creep on: beside a linear history that grows without bound, the nonlinear
+        history of ``key`` (the anti-slip controls as set) for the peak table."""
+        response = self.dash.response
+        if response is None or response.load_peaks is None or response.load_peaks.bounded:
+            if self.dash.companion_key is not None:
+                self.dash.show_companion(None, None)
+            return
+        if key == self.dash.companion_key and self.dash.companion is not None:
+            return
+        self.dash.show_companion(key, None, "computing…")
+        self._start(key, partial(nonlinear_histories, *key), self._apply_companion)
+
+    def _apply_companion(self, key, histories: NonlinearHistories) -> None:
+        if self.creep.value != "linear" or key != self._key():
+            return  # superseded
+        self.dash.show_companion(key, histories.response)
 
     def _reaction_key_of(self, state) -> tuple:
         """The reaction search's cache key at the dashboard ``state``."""
@@ -316,7 +339,8 @@ class NonlinearView:
         """Whether a request is still the one to show (checked before it starts)."""
         if apply == self._apply_reaction:
             return key == self._reaction_key
-        return self.creep.value == "nonlinear" and self._state is not None and key == self._key()
+        creep = "linear" if apply == self._apply_companion else "nonlinear"
+        return self.creep.value == creep and self._state is not None and key == self._key()
 
     def _done(self, doc, key, apply, future) -> None:
         if future.cancelled():
@@ -349,6 +373,10 @@ class NonlinearView:
                 and self._key() != self._shown_key:
             self.dash.show_history(self._key(), None, "the nonlinear history was rejected "
                                    "(see the notice above)")
+        if self.creep.value == "linear" and self.dash.companion_key is not None \
+                and self.dash.companion is None:
+            self.dash.show_companion(self.dash.companion_key, None,
+                                     "rejected (see the notice above)")
         self.notice.object = (f"**Nonlinear computation rejected:** {html.escape(str(message))} — "
                               "showing the last valid result.")
         self.notice.visible = True

@@ -5,12 +5,14 @@ Contents: verdict, operating point and excitation, the parameter set (name, hash
 from the bundled baseline), status numbers and s0*(v), Table 1/2 layouts, the root locus (dense
 sweep), Fig. 6, the creep characteristic, the time histories and the peak table with the limit
 crossings (of the linear closed form, or of the nonlinear creep model when the dashboard has it
-on), the design loads (the worst case over every fault instant, the load collective and the
-damage-equivalent ranges of the history), the resonances (the Campbell diagram with its
-crossings, the frequency response and the forced response to the default torque ripple of ID1's
-driving shaft), the code version and the date.  The figures are the dashboard's own
-(:mod:`app.results.plots`, :mod:`app.results.eigenvalue_sweep`), fed with the same cached
-results (:mod:`app.results.compute`).
+on; at an unstable point with linear creep the growth rate, when each output passes its limit
+and the nonlinear creep's peaks beside them), the design loads (the worst case over every
+fault instant, the load collective and the damage-equivalent ranges of the history), the
+resonances (the Campbell diagram with its crossings, the frequency response and the forced
+response to the default torque ripple of ID1's driving shaft), the verdicts (safety factors of
+every press fit, shaft and coupling), the code version and the date.  The figures are the
+dashboard's own (:mod:`app.results.plots`, :mod:`app.results.eigenvalue_sweep`), fed with the
+same cached results (:mod:`app.results.compute`).
 
 :func:`build_report` runs four stages: the results (:func:`report_results`), the figures
 (:func:`report_figures`), their embedding (:mod:`app.report.embedding`) and the page with its
@@ -64,6 +66,8 @@ table.bogie {border-collapse: collapse; font-size: 12px}
 table.bogie th, table.bogie td {border-bottom: 1px solid #ddd; padding: 2px 8px; text-align: right}
 table.bogie td.text, table.bogie th.text {text-align: left}
 table.bogie td.bad {color: #c0392b; font-weight: 700; background: none}
+table.bogie td.t {color: #666}
+table.bogie.peaks td {white-space: nowrap; padding: 2px 4px} table.bogie.peaks th {padding: 2px 4px}
 .cols {display: flex; gap: 32px; flex-wrap: wrap} .cols > div {flex: 1; min-width: 420px}
 """
 
@@ -99,6 +103,9 @@ class ReportCase:
     # nonlinear creep: ID2's anti-slip key (enabled, delay [s], threshold [m/s], rate [1/s]);
     # None: the linear closed form
     anti_slip: tuple | None = None
+    # the anti-slip key of the nonlinear history shown beside a linear one that grows without
+    # bound (default: the protection off, its parameters the defaults)
+    companion_anti_slip: tuple = compute.ANTI_SLIP_OFF
 
     @property
     def point(self) -> tuple:
@@ -120,6 +127,9 @@ class ReportResults:
     frf: FrequencyResponse  # from ID1's motor torque at the case's point
     ripple: resonance.RippleView  # the default ripple over the dashboard's speeds
     assessment: object = None  # the checks at the point (app.results.verdicts.assessment_result)
+    # beside a linear history that grows without bound: the nonlinear creep's (the physical
+    # answer of the peak table)
+    companion: compute.ResponseView | None = None
 
 
 def report_results(case: ReportCase, say=lambda _text: None) -> ReportResults:
@@ -129,6 +139,10 @@ def report_results(case: ReportCase, say=lambda _text: None) -> ReportResults:
     excitation = (case.M0_kNm, case.f, case.D, case.dt_ms, case.t_end)
     say("short-circuit response" + (" (nonlinear creep)" if case.anti_slip is not None else ""))
     response = compute.history_result(*case.point, *excitation, case.anti_slip)
+    companion = None
+    if not response.load_peaks.bounded:
+        say("short-circuit response with nonlinear creep (the linear one grows without bound)")
+        companion = compute.history_result(*case.point, *excitation, case.companion_anti_slip)
     say("root locus (dense sweep over s0)")
     locus = compute.dense_locus_result(case.set_key, case.rail, "s0", case.v_kmh, case.N0_kN,
                                        case.b_M)
@@ -145,7 +159,7 @@ def report_results(case: ReportCase, say=lambda _text: None) -> ReportResults:
     say("verdicts: safety factors of every fit, shaft and coupling")
     assessment = assessment_result(*case.point, case.M0_kNm, case.f, case.D)
     return ReportResults(point, response, locus, limit, worst, spectra, campbell, frf, ripple,
-                         assessment)
+                         assessment, companion)
 
 
 def report_figures(results: ReportResults) -> dict:
@@ -325,7 +339,8 @@ parameter set {name}{' (variant)' if changes else ''}, hash <code>{set_hash(para
 <h2>Fig. 6: eigenvalues against s0</h2>{divs['fig6']}
 <div class="cols"><div>{eigen_table_html(point)}</div><div>{mode_table_html(point)}</div></div>
 <h2>Short-circuit response ({html.escape(results.response.history)})</h2>
-<div class="cols"><div>{divs['creep']}</div><div>{peaks_html(results.response)}</div></div>
+<div class="cols"><div>{divs['creep']}</div>
+<div>{peaks_html(results.response, results.companion)}</div></div>
 {divs['response']}
 <p class="sub">Time histories min/max-decimated for plotting (every extreme kept); the peaks are
 from the full 10 kHz history.</p>
@@ -341,14 +356,18 @@ from the full 10 kHz history.</p>
 def build_report(set_key: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
                  M0_kNm: float, f: float, D: float, dt_ms: float | None, t_end: float,
                  progress=None, now: datetime.datetime | None = None,
-                 anti_slip: tuple | None = None) -> str:
+                 anti_slip: tuple | None = None,
+                 companion_anti_slip: tuple = compute.ANTI_SLIP_OFF) -> str:
     """The report as one HTML text.  Arguments as in :mod:`app.results.compute` (``set_key``: the
     parameter set, a bundled file or a variant of it, :mod:`app.results.variants`); ``progress``:
     called with the name of each step; ``now``: the date shown (default: now, UTC);
     ``anti_slip``: with nonlinear creep, ID2's anti-slip key (enabled, delay [s], threshold
-    [m/s], rate [1/s]) — the histories, peaks and spectra are then the nonlinear ones."""
+    [m/s], rate [1/s]) — the histories, peaks and spectra are then the nonlinear ones;
+    ``companion_anti_slip``: the key of the nonlinear history the peak table shows beside a
+    linear one that grows without bound."""
     case = ReportCase(set_key, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, t_end,
-                      None if anti_slip is None else tuple(anti_slip))
+                      None if anti_slip is None else tuple(anti_slip),
+                      tuple(companion_anti_slip))
     say = progress or (lambda _text: None)
     results = report_results(case, say)
     say("writing the report")

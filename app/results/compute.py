@@ -24,6 +24,8 @@ from model import (
     eigen_analysis,
     mode_character,
 )
+from model.analysis.load_peaks import LoadPeaks
+from model.analysis.nonlinear import AntiSlip
 from model.contact.creep import CREEP_PRESETS
 from model.mechanics.operating_point import OperatingPoint
 
@@ -66,6 +68,9 @@ DRIVE_PARTS = tuple(f"{d}.{q}" for d in ("ID1", "ID2") for q in PARTS)
 # drive parts
 HISTORY_OUTPUTS = RESPONSE_OUTPUTS + tuple(n for n in DRIVE_PARTS if n not in RESPONSE_OUTPUTS)
 LINEAR_HISTORY = "linear creep"  # the name of the linear closed form's history
+# the anti-slip key (enabled, delay [s], threshold [m/s], rate [1/s]) of the protection off, its
+# parameters the defaults (model.analysis.nonlinear.AntiSlip)
+ANTI_SLIP_OFF = (False, AntiSlip().delay, AntiSlip().threshold, AntiSlip().rate)
 PATH_POINTS = 1500  # points of each wheel's creepage path (nonlinear creep) sent to the browser
 RAINFLOW_BINS = 24  # bins of the rainflow matrix along the range and the mean
 
@@ -421,11 +426,16 @@ class ResponseView:
     M_ad: float  # [N m]
     truncated_at: float | None  # [s]
     crossings: list[tuple[str, str, float, float]]  # (output, limit name, time [s], value)
+    # the limits the totals are checked against: "M_ad" [N m], "M_ad/p" [N m], "mu_max N0" [N]
+    limits: dict[str, float] = field(default_factory=dict)
     plot_cut: float | None = None  # plots end here [s]: a torque exceeded GROWTH_CUT x M_ad
     # per series (outputs and "M_C"): (t [s], value), min/max-decimated, float32 for the browser
     plot: dict[str, tuple[np.ndarray, np.ndarray]] = field(repr=False, default=None)
     history: str = LINEAR_HISTORY  # which history: "linear creep", "nonlinear creep, …"
     fault_instant: float = math.nan  # the fault's time shift Δt of this history [s]
+    # what the peak table reads: max, min, swing and its split per output, or the growth
+    # (model.analysis.load_peaks.LoadPeaks)
+    load_peaks: LoadPeaks | None = field(repr=False, default=None)
 
     @property
     def nonlinear(self) -> bool:
@@ -460,12 +470,13 @@ def _growth_stop(t: np.ndarray, outputs: dict[str, np.ndarray], M_ad: float) -> 
     return int(beyond[0]) + 1 if len(beyond) else len(t)
 
 
-def history_view(r, history: str, cut_growth: bool,
+def history_view(r, history: str, cut_growth: bool, peaks,
                  plotted: tuple[str, ...] = HISTORY_OUTPUTS) -> ResponseView:
     """A linear (:class:`model.analysis.response.ResponseResult`) or nonlinear
     (:class:`model.analysis.nonlinear.NonlinearResult`) response of HISTORY_OUTPUTS as the
     dashboard and the report show it: the full histories, their peaks and limit crossings (one
-    rule for both: :mod:`model.analysis.load_peaks`), the decimated plot series of ``plotted``
+    rule for both: :mod:`model.analysis.load_peaks`), what the peak table reads (``peaks``,
+    :class:`model.analysis.load_peaks.LoadPeaks`), the decimated plot series of ``plotted``
     and M_C (``cut_growth``: they end where a torque grows beyond GROWTH_CUT x M_ad)."""
     outputs = {name: np.asarray(r.outputs[name]) for name in HISTORY_OUTPUTS}
     M_ad = float(r.limits["M_ad"])
@@ -483,7 +494,9 @@ def history_view(r, history: str, cut_growth: bool,
         truncated_at=getattr(r, "truncated_at", None),
         crossings=[(c.output, c.limit_name, c.time, c.value) for c in r.limit_crossings
                    if c.output in outputs],
-        plot=plot, history=history, fault_instant=float(r.excitation.shift(r.motor_torque)))
+        limits={name: float(value) for name, value in r.limits.items()},
+        plot=plot, history=history, fault_instant=float(r.excitation.shift(r.motor_torque)),
+        load_peaks=peaks)
 
 
 def excitation(M0_kNm: float, f: float, D: float, dt_ms: float | None):
@@ -505,14 +518,15 @@ def response_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN:
                     b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
                     t_end: float) -> ResponseView:
     """Short-circuit response of both drives (model.analysis.response), linear creep."""
-    from model.analysis.response import short_circuit_response
+    from model.analysis.response import linear_load_peaks, short_circuit_response
 
     m = model(params_path, rail)
     op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
     r = short_circuit_response(m, op, excitation(M0_kNm, f, D, dt_ms), t_end=float(t_end),
                                fs=sampling_rate(f), outputs=list(HISTORY_OUTPUTS))
     # the Response tab's plots (the Design loads tab draws the drive parts of its own result)
-    return history_view(r, LINEAR_HISTORY, cut_growth=True, plotted=RESPONSE_OUTPUTS)
+    return history_view(r, LINEAR_HISTORY, cut_growth=True, peaks=linear_load_peaks(m, r),
+                        plotted=RESPONSE_OUTPUTS)
 
 
 # --- the nonlinear creep model ----------------------------------------------------------------------
@@ -558,6 +572,7 @@ def nonlinear_histories(params_path: str, rail: str, s0: float, v_kmh: float, N0
                         t_end: float, anti_slip: tuple) -> NonlinearHistories:
     """The nonlinear response (model.analysis.nonlinear) of HISTORY_OUTPUTS; ``anti_slip``:
     (enabled, delay [s], threshold [m/s], rate [1/s]) of ID2's protection."""
+    from model.analysis.load_peaks import load_peaks
     from model.analysis.nonlinear import AntiSlip, nonlinear_response
 
     m = model(params_path, rail)
@@ -572,7 +587,10 @@ def nonlinear_histories(params_path: str, rail: str, s0: float, v_kmh: float, N0
              for rim, s in r.creepage.items()}
     return NonlinearHistories(
         # every drive part plotted: the Design loads tab overlays the nonlinear history
-        response=history_view(r, anti_slip_description(anti_slip), cut_growth=False),
+        response=history_view(r, anti_slip_description(anti_slip), cut_growth=False,
+                              peaks=load_peaks(r.t, r.outputs, r.steady, r.units,
+                                               r.limit_crossings, "nonlinear",
+                                               split_note="nonlinear creep: not split")),
         paths=paths, detection_time=r.detection_time, action_time=r.action_time,
         max_creepage=float(max(s.max() for s in r.creepage.values())),
         M_ad=float(r.limits["M_ad"]))

@@ -10,6 +10,8 @@ import math
 
 from app.results import compute
 from app.results.resonance import CampbellView
+from model.analysis.load_peaks import LIMITED
+from model.analysis.response import QUASI_STATIC_HZ
 
 
 def _complex(lam: complex) -> str:
@@ -49,31 +51,157 @@ def format_load(x: float) -> str:
     return f"{x:,.0f}" if abs(x) < 1e7 else f"{x:.3e}"
 
 
-def peaks_html(response: compute.ResponseView) -> str:
-    """Peaks (signed total of largest magnitude) and their times, per output, and the first
-    limit crossings, of the history ``response`` (the heading says which: linear or nonlinear
-    creep, and its fault instant Δt)."""
+KILO_UNITS = {"N m": "kN m", "N": "kN"}  # the peak table's units: kN m and kN
+
+
+def format_kilo(x: float, unit: str) -> str:
+    """A load in the peak table's unit (kN m, kN; other units as they are), 3 digits or more;
+    exponent form beyond 10⁷ of it (growth)."""
+    v = x / 1e3 if unit in KILO_UNITS else x
+    if not math.isfinite(v):
+        return "—"
+    if abs(v) >= 1e7:
+        return f"{v:.2e}"
+    if abs(v) >= 100:
+        return f"{v:,.0f}"
+    return f"{v:.1f}" if abs(v) >= 10 else f"{v:.2f}"
+
+
+def _at(value: float, time: float, unit: str, bad: bool = False) -> str:
+    return (f'<td class="{"bad" if bad else ""}">{format_kilo(value, unit)}</td>'
+            f'<td class="t">{time:.4f}</td>')
+
+
+def _limit_of(name: str, response: compute.ResponseView) -> tuple[str, float] | None:
+    """(limit name, magnitude) an output is checked against (model.analysis.load_peaks.LIMITED),
+    None if none."""
+    for suffix, limit in LIMITED:
+        if name.endswith(suffix) and limit in response.limits:
+            return limit, response.limits[limit]
+    return None
+
+
+def _row_label(name: str, unit: str) -> str:
+    return f'<td class="text">{html.escape(name)} [{KILO_UNITS.get(unit, unit)}]</td>'
+
+
+def _extremes_cells(name: str, response: compute.ResponseView) -> str:
+    """Pre-fault, max and min with their times, the swing from the pre-fault value with its time
+    (a value beyond the output's limit in red)."""
+    e, unit = response.load_peaks.extremes[name], response.units[name]
+    limit = _limit_of(name, response)
+    over = (lambda x: abs(x) > limit[1]) if limit else (lambda _x: False)
+    return (f"<td>{format_kilo(e.pre_fault, unit)}</td>"
+            + _at(e.maximum, e.time_of_maximum, unit, over(e.maximum))
+            + _at(e.minimum, e.time_of_minimum, unit, over(e.minimum))
+            + _at(e.swing, e.time_of_swing, unit))
+
+
+EXTREMES_HEAD = ("<th>pre-fault</th><th>max</th><th>at [s]</th><th>min</th><th>at [s]</th>"
+                 "<th>swing</th><th>at [s]</th>")
+
+
+def _history_line(response: compute.ResponseView) -> str:
+    return (f"<div class='peaks-history'>of the history with <b>{html.escape(response.history)}"
+            f"</b>, Δt = {response.fault_instant * 1e3:.4g} ms, 0 … {response.t[-1]:g} s</div>")
+
+
+def _crossings_line(response: compute.ResponseView) -> str:
+    crossings = "; ".join(f"{o} exceeds {n} at {t:.3f} s"
+                          for o, n, t, _ in response.crossings[:4])
+    return f"<div style='font-size:12px'>{html.escape(crossings)}</div>" if crossings else ""
+
+
+def peaks_html(response: compute.ResponseView, companion: compute.ResponseView | None = None,
+               companion_note: str = "") -> str:
+    """The peak table of the history ``response`` (the heading says which: linear or nonlinear
+    creep, and its fault instant Δt): per output the pre-fault value, the maximum, the minimum
+    and the swing from the pre-fault value, each with its time, and (linear creep) the swing
+    split into its quasi-static and dynamic parts; the first limit crossings below.  A linear
+    history that grows without bound (:attr:`model.analysis.load_peaks.LoadPeaks.bounded`)
+    gets the growth rate and when each output passes its limit instead, beside the bounded
+    peaks of ``companion``, the nonlinear creep's history (``companion_note`` while there is
+    none).  Torques in kN m, forces in kN, times in s after the fault."""
+    peaks = response.load_peaks
+    if not peaks.bounded:
+        return _unbounded_html(response, companion, companion_note)
+    split = not peaks.split_note
     rows = []
     for name in response.outputs:
-        peak, unit = response.peaks[name], response.units[name]
-        over = unit == "N m" and ("disc_clutch" in name or "claw_clutch" in name) \
-            and abs(peak) > response.M_ad
-        rows.append(f'<tr><td class="text">{name}</td><td class="{"bad" if over else ""}">'
-                    f"{format_load(peak)} {unit}</td><td>{response.peak_times[name]:.4f} s</td></tr>")
-    note = ""
+        e, unit = peaks.extremes[name], response.units[name]
+        cells = _row_label(name, unit) + _extremes_cells(name, response)
+        if split:
+            cells += (f"<td>{format_kilo(e.quasi_static, unit)}</td><td>{format_kilo(e.dynamic, unit)}</td>"
+                      f"<td>{format_kilo(e.quasi_static_at_end, unit)} → "
+                      f"{format_kilo(e.quasi_static_final, unit)}</td>")
+        rows.append(f"<tr>{cells}</tr>")
+    head = ('<table class="bogie peaks"><tr><th class="text">output</th>' + EXTREMES_HEAD
+            + ("<th>quasi-static</th><th>dynamic</th>"
+               f"<th>quasi-static at {peaks.t_end:g} s → final</th>" if split else "")
+            + "</tr>")
+    if split:
+        explain = ("swing = total − pre-fault value of largest magnitude = its quasi-static part "
+                   "(the static response to the lost motor torque and the modes slower than "
+                   f"{QUASI_STATIC_HZ:g} Hz: ID2 taking over ID1's torque as the vehicle slows) "
+                   "+ its dynamic part (the oscillation about it), both at the swing's time")
+    else:
+        explain = f"swings not split into quasi-static and dynamic parts: {peaks.split_note}"
+    M_ad = response.M_ad
+    return (f"<b>Peaks</b> (M_ad = {M_ad / 1e3:,.1f} kN m; torques in kN m, forces in kN, "
+            f"times in s after the fault; red: beyond M_ad, the driving shaft beyond M_ad/p)"
+            f"{_note(response)}{_history_line(response)}"
+            + head + "".join(rows) + "</table>"
+            + f"<div style='font-size:12px'>{html.escape(explain)}.</div>"
+            + _crossings_line(response))
+
+
+def _note(response: compute.ResponseView) -> str:
     if response.truncated_at is not None:
-        note = f" — growth: the time grid was cut at {response.truncated_at:.3f} s"
-    elif response.plot_cut is not None:
-        note = f" — unstable growth (plots end at {response.plot_cut:.3f} s; CSV has all)"
-    crossings = "; ".join(f"{o} exceeds {n} at {t:.3f} s" for o, n, t, _ in response.crossings[:4])
-    history = (f"<div class='peaks-history'>of the history with <b>{html.escape(response.history)}"
-               f"</b>, Δt = {response.fault_instant * 1e3:.4g} ms</div>")
-    return (f"<b>Peaks</b> (M_ad = {response.M_ad:,.0f} N m){note}{history}"
-            '<table class="bogie"><tr><th class="text">output</th><th>peak</th><th>at</th></tr>'
-            + "".join(rows) + "</table>"
-            + (f"<div style='font-size:12px'>{html.escape(crossings)}</div>" if crossings else ""))
+        return f" — growth: the time grid was cut at {response.truncated_at:.3f} s"
+    if response.plot_cut is not None:
+        return f" — unstable growth (plots end at {response.plot_cut:.3f} s; CSV has all)"
+    return ""
 
 
+def _unbounded_html(response: compute.ResponseView, companion: compute.ResponseView | None,
+                    companion_note: str) -> str:
+    """An unbounded linear history: the growth rate, when each output passes its limit, and
+    the nonlinear creep's bounded peaks beside it."""
+    peaks = response.load_peaks
+    largest = max(abs(peaks.extremes[n].swing) for n in response.outputs
+                  if response.units[n] == "N m")
+    ready = companion is not None and companion.load_peaks is not None
+    rows = []
+    for name in response.outputs:
+        unit = response.units[name]
+        limit = _limit_of(name, response)
+        crossing = peaks.crossings.get(name)
+        if limit is None:
+            passes = "<td class='text'>—</td><td>—</td>"
+        else:
+            when = (f"{crossing.time:.4f}" if crossing is not None
+                    else f"not within {peaks.t_end:g} s")
+            passes = f"<td class='text'>{html.escape(limit[0])}</td><td>{when}</td>"
+        nonlinear = (_extremes_cells(name, companion) if ready else "")
+        rows.append(f"<tr>{_row_label(name, unit)}{passes}{nonlinear}</tr>")
+    if ready:
+        physical = (f"<th colspan='7'>{html.escape(companion.history)}: "
+                    "the physical answer</th>")
+        second = "<tr><th></th><th></th><th></th>" + EXTREMES_HEAD + "</tr>"
+    else:
+        physical = (f"<th class='text'>nonlinear creep: "
+                    f"{html.escape(companion_note or 'not computed')}</th>")
+        second = ""
+    head = ('<table class="bogie peaks unbounded"><tr><th class="text">output</th>'
+            "<th class='text'>limit</th><th>linear: passes it at [s]</th>" + physical
+            + "</tr>" + second)
+    M_ad = response.M_ad
+    return (f"<b>Peaks: unbounded with linear creep</b> — the linear history grows as "
+            f"e^(σt), σ = <b>{peaks.growth_rate:+.4g} 1/s</b> (the largest Re λ){_note(response)}"
+            f"; its torques at {peaks.t_end:g} s (up to {largest:.3g} N m) are no load any shaft "
+            f"sees. Limits: M_ad = {M_ad / 1e3:,.1f} kN m, M_ad/p for the driving shafts; "
+            "torques in kN m, forces in kN, times in s after the fault."
+            f"{_history_line(response)}" + head + "".join(rows) + "</table>")
 # --- design loads ------------------------------------------------------------------------------
 
 def _part(name: str) -> str:

@@ -78,6 +78,40 @@ def test_status_follows_the_model_and_the_published_cases_flip(dash):
 
 
 @pytest.mark.slow
+def test_peak_table_of_the_published_cases(dash):
+    """The first screen's peak table: at s0 = 0.005 ID1's disc clutch swing with its time (the
+    model's largest |Δy|, not the pre-fault value at 0 s); at s0 = 0.014 "unbounded with linear
+    creep", the model's growth rate and the nonlinear creep's peaks beside it."""
+    from model.analysis.response import short_circuit_response
+
+    name = "ID1.disc_clutch.torque"
+    m = compute.model("", "calibrated")
+    for s0 in (0.005, 0.014):
+        dash.show_published_case(s0)
+        op = compute.operating_point("", "calibrated", s0, dash.v, dash.N0, dash.b_M)
+        r = short_circuit_response(m, op, compute.excitation(dash.M0, dash.f, dash.D, None),
+                                   dash.t_end, compute.sampling_rate(dash.f), [name])
+        table = dash.peaks.object
+        if s0 == 0.005:
+            swing = r.perturbation(name)
+            k = int(np.argmax(np.abs(swing)))
+            assert r.t[k] > 0.0
+            row = f"{swing[k] / 1e3:.1f}</td><td class=\"t\">{r.t[k]:.4f}</td>"
+            assert row in table
+            assert "unbounded" not in table
+        else:
+            growth = eigen_analysis(m, op, vectors=False).max_real_part
+            assert growth > 0
+            assert "unbounded with linear creep" in table
+            assert f"σ = <b>{growth:+.4g} 1/s</b>" in table
+            first = min(c.time for c in r.limit_crossings)
+            assert f"<td>{first:.4f}</td>" in table  # when it passes M_ad
+            assert "the physical answer" in table  # the nonlinear creep's peaks beside it
+            assert dash.companion is not None
+            assert dash.companion.history.startswith("nonlinear")
+
+
+@pytest.mark.slow
 def test_views_show_the_current_point(dash):
     dash.param.update(s0=0.0065, v=100.0)
     m = compute.model("", "calibrated")

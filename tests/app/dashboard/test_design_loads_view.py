@@ -37,7 +37,7 @@ from bokeh.document import Document
 from conftest import InProcessEngine, install_study_queue
 
 from app.results import compute
-from app.results.tables import format_load
+from app.results.tables import format_kilo, format_load
 from model.analysis.load_spectrum import N_REF
 
 POINT = ("", "calibrated", 0.005, 120.0, 100.0, 3000.0)
@@ -435,7 +435,10 @@ def test_peaks_csv_and_report_describe_the_nonlinear_history(dash):
                            outputs=list(compute.HISTORY_OUTPUTS))
     for name in compute.HISTORY_OUTPUTS:
         assert shown.peaks[name] == pytest.approx(r.peaks[name], rel=1e-12)
-        assert f"{format_load(r.peaks[name])} {r.units[name]}" in dash.peaks.object
+        y, unit = r.outputs[name], r.units[name]
+        row = dash.peaks.object.split(f">{name} [")[1].split("</tr>")[0]
+        for value in (y.max(), y.min(), r.perturbation_peaks[name]):
+            assert f">{format_kilo(value, unit)}</td>" in row, name
     assert "e+" not in dash.peaks.object  # no blow-up in the table
     crossings = [(c.output, c.limit_name, c.time) for c in r.limit_crossings]
     assert [(o, n, t) for o, n, t, _ in shown.crossings] == crossings
@@ -455,7 +458,8 @@ def test_peaks_csv_and_report_describe_the_nonlinear_history(dash):
     # the report
     report = dash.downloads.report_html().read()
     assert "Short-circuit response (nonlinear creep, anti-slip off)" in report
-    assert f"{format_load(r.peaks['ID2.disc_clutch.torque'])} N m" in report
+    peak = r.outputs["ID2.disc_clutch.torque"].max()
+    assert f">{format_kilo(peak, 'N m')}</td>" in report.split(">ID2.disc_clutch.torque [")[1]
     assert "Load spectrum of the history above (nonlinear creep, anti-slip off)" in report
     # back to linear creep: the linear history again
     dash.nonlinear.creep.value = "linear"

@@ -1,0 +1,109 @@
+"""The peak table a reviewer reads (app.results.tables.peaks_html), without a server: at the
+published stable case the swing of ID1's disc clutch with its time (not the pre-fault value at
+0 s), at the unstable case "unbounded with linear creep" with the growth rate, the limit
+crossings and the nonlinear creep's bounded peaks beside them.  Expected values come from the
+model, never typed in."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from app.results import compute
+from app.results.tables import peaks_html
+from model import eigen_analysis, load_parameters
+from model.analysis.response import short_circuit_response
+
+M0_KNM, F_HZ, DECAY, T_END = 50.0, 90.0, 0.04, 2.0  # the dashboard's defaults
+
+
+def _point(s0: float) -> tuple:
+    p = load_parameters()
+    return ("", "calibrated", s0, 120.0, p["wheel_force"] / 1e3, p["motor_slope"])
+
+
+def _linear(s0: float) -> compute.ResponseView:
+    return compute.response_result(*_point(s0), M0_KNM, F_HZ, DECAY, None, T_END)
+
+
+def _cells(table: str, name: str) -> list[str]:
+    """The texts of the cells of the row of output ``name``."""
+    row = re.search(rf"<tr><td class=\"text\">{re.escape(name)} \[[^<]*\]</td>(.*?)</tr>", table)
+    assert row is not None, name
+    return [re.sub(r"<[^>]+>", "", cell) for cell in re.findall(r"<td[^>]*>(.*?)</td>",
+                                                                  row.group(1))]
+
+
+def _number(cell: str) -> float:
+    return float(cell.replace(",", ""))
+
+
+def test_stable_case_shows_the_swing_of_id1_disc_clutch_at_its_time():
+    response = _linear(0.005)
+    table = peaks_html(response)
+    # the model's history at the same point
+    m = compute.model("", "calibrated")
+    op = compute.operating_point(*_point(0.005))
+    r = short_circuit_response(m, op, compute.excitation(M0_KNM, F_HZ, DECAY, None), T_END,
+                               compute.sampling_rate(F_HZ), ["ID1.disc_clutch.torque"])
+    name = "ID1.disc_clutch.torque"
+    swing = r.perturbation(name)
+    # the fault's first large peak: the first local extremum of the swing within 10 % of its
+    # largest magnitude
+    extrema = np.flatnonzero(np.diff(np.sign(np.diff(swing))) != 0) + 1
+    first = extrema[np.abs(swing[extrema]) >= 0.9 * np.abs(swing).max()][0]
+    pre, vmax, tmax, vmin, tmin, vswing, tswing, quasi, dynamic, end_final = _cells(table, name)
+    assert _number(pre) == pytest.approx(r.steady[name] / 1e3, abs=0.05)
+    assert _number(vswing) == pytest.approx(swing[first] / 1e3, abs=0.05)
+    assert float(tswing) == pytest.approx(r.t[first], abs=0.6e-4)
+    assert float(tswing) > 0.0  # not the pre-fault value at 0 s
+    y = r.outputs[name]
+    assert _number(vmin) == pytest.approx(y.min() / 1e3, abs=0.05)
+    assert _number(vmax) == pytest.approx(y.max() / 1e3, abs=0.05)
+    assert float(tmin) == pytest.approx(r.t[np.argmin(y)], abs=0.6e-4)
+    assert float(tmax) == pytest.approx(r.t[np.argmax(y)], abs=0.6e-4)
+    # the swing's parts add up to it (to the table's rounding) and the quasi-static part is the
+    # lost motor torque (ID1's pre-fault torque, within 5 %: the first creep-damped drift)
+    assert _number(quasi) + _number(dynamic) == pytest.approx(_number(vswing), abs=0.1)
+    assert _number(quasi) == pytest.approx(-r.steady[name] / 1e3, rel=0.05)
+    assert "→" in end_final
+    assert "quasi-static" in table
+    assert "unbounded" not in table
+
+
+def test_unstable_case_says_unbounded_with_the_growth_rate_beside_the_nonlinear_peaks():
+    response = _linear(0.014)
+    m = compute.model("", "calibrated")
+    op = compute.operating_point(*_point(0.014))
+    growth = eigen_analysis(m, op, vectors=False).max_real_part
+    assert growth > 0
+    waiting = peaks_html(response, None, "computing…")
+    assert "unbounded with linear creep" in waiting
+    assert f"σ = <b>{growth:+.4g} 1/s</b>" in waiting
+    assert "nonlinear creep: computing…" in waiting
+    companion = compute.nonlinear_histories(*_point(0.014), M0_KNM, F_HZ, DECAY, None, T_END,
+                                            compute.ANTI_SLIP_OFF).response
+    table = peaks_html(response, companion)
+    assert "the physical answer" in table
+    name = "ID1.disc_clutch.torque"
+    limit, passes, pre, vmax, tmax, vmin, tmin, vswing, tswing = _cells(table, name)
+    assert _number(pre) == pytest.approx(response.load_peaks.extremes[name].pre_fault / 1e3,
+                                         abs=0.05)
+    first = min(c.time for c in short_circuit_response(
+        m, op, compute.excitation(M0_KNM, F_HZ, DECAY, None), T_END, compute.sampling_rate(F_HZ),
+        [name]).limit_crossings if c.output == name)
+    assert limit == "M_ad"
+    assert float(passes) == pytest.approx(first, abs=0.6e-4)
+    y, t = companion.outputs[name], companion.t
+    assert _number(vmax) == pytest.approx(y.max() / 1e3, abs=0.05)
+    assert _number(vmin) == pytest.approx(y.min() / 1e3, abs=0.05)
+    assert float(tmax) == pytest.approx(t[np.argmax(y)], abs=0.6e-4)
+    assert float(tmin) == pytest.approx(t[np.argmin(y)], abs=0.6e-4)
+    k = np.argmax(np.abs(y - y[0]))
+    assert _number(vswing) == pytest.approx((y[k] - y[0]) / 1e3, abs=0.05)
+    assert float(tswing) == pytest.approx(t[k], abs=0.6e-4)
+    assert abs(_number(vswing)) < 10 * response.M_ad / 1e3  # bounded: no 1e32
+    # an output without a limit
+    assert _cells(table, "ID1.disc_clutch.force_y")[:2] == ["—", "—"]
