@@ -116,14 +116,29 @@ def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.00
     if speed:
         parser.add_argument("--v", type=bounded("--v (speed, km/h)", "[1, 500]", "km/h"),
                             default=120.0, help="speed [km/h] (default %(default)s)")
+    add_wheel_force_and_motor_slope(parser)
+    parser.add_argument("--params", default=None, metavar="FILE",
+                        help="parameter file (TOML; default: the calibrated set)")
+    parser.add_argument("--json", action="store_true", help="machine-readable JSON output")
+
+
+def add_wheel_force_and_motor_slope(parser: argparse.ArgumentParser) -> None:
+    """``--n0`` [N] and ``--bm`` [N m s/rad], one value each (None: the parameter set's)."""
     parser.add_argument("--n0", type=bounded("--n0 (wheel force, N)", "[1e3, 1e6]", "N"),
                         default=None, help="static wheel force N0 [N] (default: parameter set)")
     parser.add_argument("--bm", type=bounded("--bm (motor slope, N m s/rad)", "[0, 1e9]",
                                              "N m s/rad"),
                         default=None, help="motor slope b_M [N m s/rad] (default: parameter set)")
-    parser.add_argument("--params", default=None, metavar="FILE",
-                        help="parameter file (TOML; default: the calibrated set)")
-    parser.add_argument("--json", action="store_true", help="machine-readable JSON output")
+
+
+RAILS = ("calibrated", "dry", "wet")  # the creep laws: the set's own, Polach's presets
+
+
+def add_rail(parser: argparse.ArgumentParser) -> None:
+    """``--rail``: one creep law, the set's own (calibrated) or Polach's dry/wet preset."""
+    parser.add_argument("--rail", choices=RAILS, default="calibrated",
+                        help="creep law: the set's own (calibrated) or Polach's dry/wet preset "
+                             "(default %(default)s)")
 
 
 def load_model(args: argparse.Namespace):
@@ -199,13 +214,15 @@ MAX_SAMPLES = 2_000_000  # t_end × fs: the longest history model.analysis.respo
 
 
 def add_time_grid(p: argparse.ArgumentParser, t_end_help: str, fs_help: str | None = None, *,
-                  t_end: str = T_END, fs: str = FS) -> None:
-    """``--t-end`` [s] (default 2) and, with ``fs_help``, ``--fs`` [Hz] (default 10 000).
+                  t_end: str = T_END, fs: str = FS, t_end_default: float | None = 2.0) -> None:
+    """``--t-end`` [s] (default ``t_end_default``; None: the command chooses, and
+    ``t_end_help`` says how) and, with ``fs_help``, ``--fs`` [Hz] (default 10 000).
     ``t_end_help``/``fs_help`` say what the values mean for the command ("horizon of each run");
     ``t_end``/``fs`` are the allowed intervals, narrower where a command needs it (give the
     reason at the call).  With ``--fs``, call :func:`check_samples` before computing."""
-    p.add_argument("--t-end", type=bounded("--t-end (horizon, s)", t_end, "s"), default=2.0,
-                   help=f"{t_end_help} [s] (default %(default)s)")
+    default = "" if t_end_default is None else " (default %(default)s)"
+    p.add_argument("--t-end", type=bounded("--t-end (horizon, s)", t_end, "s"),
+                   default=t_end_default, help=f"{t_end_help} [s]{default}")
     if fs_help is not None:
         p.add_argument("--fs", type=bounded("--fs (sampling rate, Hz)", fs, "Hz"),
                        default=10_000.0, help=f"{fs_help} [Hz] (default %(default)s)")

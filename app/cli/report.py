@@ -15,7 +15,13 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from app.cli.options import UsageError, add_operating_point, add_short_circuit, add_time_grid
+from app.cli.options import (
+    UsageError,
+    add_operating_point,
+    add_rail,
+    add_short_circuit,
+    add_time_grid,
+)
 
 
 def register(subparsers) -> None:
@@ -25,8 +31,7 @@ def register(subparsers) -> None:
     # in kN m and ms) bound the short circuit and the simulated time
     add_short_circuit(p, m0="[0, 2e5]", f="[10, 300]", decay="[0, 0.3]", phase="[-0.01, 0.01]")
     add_time_grid(p, "simulated time", t_end="[0.2, 5]")
-    p.add_argument("--rail", choices=("calibrated", "dry", "wet"), default="calibrated",
-                   help="creep law (default: the set's own)")
+    add_rail(p)
     p.add_argument("--variant", default="", metavar="TEXT",
                    help="design variant: name:value,… (SI units) applied to the set")
     p.add_argument("--out", required=True, help="output file (.html)")

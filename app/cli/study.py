@@ -28,6 +28,7 @@ from app.cli.options import (
     EXIT_INTERRUPTED,
     UsageError,
     add_engine_options,
+    add_rail,
     add_uncertainty_options,
     bounded,
     parse_values,
@@ -44,8 +45,7 @@ def _common(p: argparse.ArgumentParser) -> None:
                    help="motor slopes b_M [N m s/rad]: x1,x2,… or A:B:N (default: the set's)")
     p.add_argument("--params", default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
-    p.add_argument("--rail", choices=("calibrated", "dry", "wet"), default="calibrated",
-                   help="creep law: the set's own (calibrated) or Polach's dry/wet preset")
+    add_rail(p)
     p.add_argument("--out", required=True, metavar="X.zarr", help="Zarr store to write")
     p.add_argument("--resume", action="store_true",
                    help="continue the study in --out (same parameters and arguments only)")
