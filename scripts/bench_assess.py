@@ -4,9 +4,9 @@
     .venv/bin/python scripts/bench_assess.py [--runs 3] [--json FILE]
 
 Each command runs as its own process (as a user runs it, imports included), alternated; the
-medians and their ratio are printed.  The envelope is timed twice: as run by default (a local Dask
-cluster) and with ``--serial`` (in this process, the faster reference the ratio is stated against
-too).
+medians and their ratios are printed.  Both commands are timed twice: as run by default (their
+short-circuit grid on a local Dask cluster) and with ``--serial`` (in the command's process); the
+ratios compare like with like.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from pathlib import Path
 BOGIE = str(Path(sys.executable).with_name("bogie"))
 COMMANDS = {
     "assess": [BOGIE, "assess", "--json"],
+    "assess --serial": [BOGIE, "assess", "--serial", "--json"],
     "envelope": [BOGIE, "envelope", "--s0", "0.005", "--v", "120", "--phase", "all", "--json"],
     "envelope --serial": [BOGIE, "envelope", "--s0", "0.005", "--v", "120", "--phase", "all",
                           "--serial", "--json"],
@@ -45,11 +46,11 @@ def main() -> None:
     medians = {name: statistics.median(values) for name, values in times.items()}
     result = {"runs": args.runs, "times_s": times, "median_s": medians,
               "ratio_to_envelope": medians["assess"] / medians["envelope"],
-              "ratio_to_envelope_serial": medians["assess"] / medians["envelope --serial"]}
+              "ratio_serial": medians["assess --serial"] / medians["envelope --serial"]}
     for name, value in medians.items():
         print(f"{name:<20} median {value:6.2f} s  ({', '.join(f'{x:.2f}' for x in times[name])})")
-    print(f"assess / envelope = {result['ratio_to_envelope']:.2f}x, assess / envelope --serial = "
-          f"{result['ratio_to_envelope_serial']:.2f}x (target <= 10x)")
+    print(f"assess / envelope = {result['ratio_to_envelope']:.2f}x, with --serial both "
+          f"{result['ratio_serial']:.2f}x (target <= 10x)")
     if args.json:
         Path(args.json).write_text(json.dumps(result, indent=1))
 

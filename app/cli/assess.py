@@ -1,16 +1,21 @@
 """``bogie assess``: from loads to verdicts — every press fit, shaft section and coupling of both
 drives checked in the three load cases, with safety factors and the governing check.
 
-    bogie assess [--s0 LIST] [--v LIST] [--n0 N] [--bm B] [--m0 M --f F --decay D]
-                 [--t-end T] [--fs FS] [--unstable-s0 S --unstable-v V] [--anti-slip-delay T]
-                 [--starting-v V] [--params FILE] [--json]
+    bogie assess [--s0 LIST] [--v LIST] [--n0 N] [--bm B] [--rail calibrated|dry|wet]
+                 [--m0 M --f F --decay D] [--t-end T] [--fs FS]
+                 [--unstable-s0 S --unstable-v V] [--anti-slip-delay T --anti-slip-threshold W
+                 --anti-slip-rate R --anti-slip-floor F] [--starting-v V] [--params FILE]
+                 [--scheduler tcp://HOST:PORT | --workers N | --serial] [--json]
 
 A LIST is ``A,B,C`` or ``A:B:N``, increasing; speeds in km/h.  ``--s0``/``--v`` are the short-circuit
 case's grid (stable creepages only), as ``bogie envelope --phase all`` takes them; without
-``--t-end`` its horizon covers ID2's quasi-static take-over.  Everything runs in this process.
-``--json`` prints ``{"load_cases": [...], "checks": [...], "governing": {...}}``
-(model.studies.assessment.Assessment.as_dict).  Bad input (an unstable grid point, unphysical
-strength data in ``--params``): one line on stderr, exit status 2.
+``--t-end`` its horizon covers ID2's quasi-static take-over.  That grid runs on the study engine as
+the envelope does (a local Dask cluster by default, ``--scheduler`` a running one, ``--serial`` in
+this process); the other two cases are single runs in this process.  ``--json`` prints
+``{"load_cases": [...], "checks": [...], "governing": {...}}``
+(model.studies.assessment.Assessment.as_dict, with the creep law ``rail``).  Bad input (an
+unstable grid point, unphysical strength data in ``--params``): one line on stderr, exit status 2;
+Ctrl-C: exit status 130.
 """
 
 from __future__ import annotations
@@ -19,8 +24,22 @@ import argparse
 import math
 import sys
 
-from app.cli.options import add_time_grid, bounded, check_samples, parse_values
+from app.cli.options import (
+    EXIT_INTERRUPTED,
+    add_anti_slip_arguments,
+    add_engine_options,
+    add_rail,
+    add_short_circuit,
+    add_time_grid,
+    add_wheel_force_and_motor_slope,
+    anti_slip_from,
+    bounded,
+    check_samples,
+    parse_values,
+    short_circuit_from,
+)
 from app.cli.output import emit
+from app.cli.runs import ProgressBar, start_engine
 
 KIND_LABELS = {"press_fit_slip": "press-fit slip", "torsional_shear": "torsional shear",
                "coupling": "coupling rating"}
@@ -34,46 +53,40 @@ def register(subparsers) -> None:
                    help="short_circuit: stable creepages s0 [-] (default %(default)s)")
     p.add_argument("--v", default="80,120,200", metavar="LIST",
                    help="short_circuit: speeds [km/h] (default %(default)s)")
-    p.add_argument("--n0", type=bounded("--n0 (wheel force, N)", "[1e3, 1e6]", "N"),
-                   default=None, help="wheel force N0 [N] (default: the parameter set's)")
-    p.add_argument("--bm", type=bounded("--bm (motor slope, N m s/rad)", "[0, 1e9]",
-                                        "N m s/rad"),
-                   default=None, help="motor slope b_M [N m s/rad] (default: the parameter set's)")
-    p.add_argument("--m0", type=bounded("--m0 (amplitude, N m)", "[0, 1e8]", "N m"),
-                   default=50_000.0, help="short-circuit amplitude M0 [N m] (default %(default)s)")
-    p.add_argument("--f", type=bounded("--f (frequency, Hz)", "(0, 1e5)", "Hz"), default=90.0,
-                   help="short-circuit frequency f [Hz] (default %(default)s)")
-    p.add_argument("--decay", type=bounded("--decay (D)", "[0, 10]"), default=0.04,
-                   help="short-circuit decay D [-] (default %(default)s)")
+    add_wheel_force_and_motor_slope(p)
+    add_rail(p)
+    add_short_circuit(p, phase=None)  # every fault instant: no --phase
     add_time_grid(p, "short_circuit horizon (default: until ID2's quasi-static take-over is "
-                  "within 1 %% of its end, at least 2 s)", "sampling rate of every history")
-    p.set_defaults(t_end=None)
-    p.add_argument("--unstable-s0", type=bounded("--unstable-s0 (creepage)", "(0, 1)"),
-                   default=0.014, help="unstable_adhesion: creepage beyond the adhesion maximum "
-                                       "[-] (default %(default)s)")
-    p.add_argument("--unstable-v", type=bounded("--unstable-v (speed, km/h)", "[1, 500]",
-                                                "km/h"),
-                   default=120.0, help="unstable_adhesion: speed [km/h] (default %(default)s)")
-    p.add_argument("--anti-slip-delay", type=bounded("--anti-slip-delay (s)", "[0, 60]", "s"),
-                   default=None, help="unstable_adhesion: reaction time of ID2's anti-slip "
-                                      "protection [s] (default 0.1)")
+                  "within 1 %% of its end, at least 2 s, at most 60 s)",
+                  "sampling rate of every history", t_end_default=None)
+    unstable = p.add_argument_group("unstable_adhesion (nonlinear creep, ID2's anti-slip "
+                                    "protection)")
+    unstable.add_argument("--unstable-s0", type=bounded("--unstable-s0 (creepage)", "(0, 1)"),
+                          default=0.014, help="creepage beyond the adhesion maximum [-] "
+                                              "(default %(default)s)")
+    unstable.add_argument("--unstable-v", type=bounded("--unstable-v (speed, km/h)", "[1, 500]",
+                                                       "km/h"),
+                          default=120.0, help="speed [km/h] (default %(default)s)")
+    add_anti_slip_arguments(unstable)
     p.add_argument("--starting-v", type=bounded("--starting-v (speed, km/h)", "[1, 500]", "km/h"),
                    default=5.0, help="starting: speed [km/h] (default %(default)s)")
     p.add_argument("--params", default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set; strength data it "
                         "lacks are the default set's)")
+    add_engine_options(p.add_argument_group("where the short_circuit grid runs (as bogie "
+                                            "envelope)"))
     p.add_argument("--json", action="store_true", help="machine-readable JSON output")
     p.set_defaults(func=cmd_assess)
 
 
 def options_from_args(args: argparse.Namespace):
     """(parameters, :class:`model.studies.assessment.AssessmentOptions`) from the options."""
-    from model.analysis.response import ShortCircuit
     from model.mechanics.operating_point import KMH
     from model.mechanics.parameters import load_parameters
     from model.studies.assessment import AssessmentOptions
+    from model.studies.envelope import rail_parameters
 
-    parameters = load_parameters(args.params)
+    parameters = rail_parameters(load_parameters(args.params), args.rail)
     s0 = parse_values(args.s0, "--s0", 1e-9, 1 - 1e-9, "-", increasing=True)
     v = [x * KMH for x in parse_values(args.v, "--v", 1, 500, "km/h", increasing=True)]
     if args.t_end is not None:
@@ -85,10 +98,10 @@ def options_from_args(args: argparse.Namespace):
         raise ValueError(f"--fs = {args.fs:g} Hz is too low to resolve the excitation at f = "
                          f"{args.f:g} Hz: must be at least {2.5 * args.f:g} Hz")
     options = AssessmentOptions(
-        s0=tuple(s0), v=tuple(v), N0=args.n0, b_M=args.bm,
-        excitation=ShortCircuit(M0=args.m0, f=args.f, D=args.decay), t_end=args.t_end,
-        fs=args.fs, unstable_s0=args.unstable_s0, unstable_v=args.unstable_v * KMH,
-        anti_slip_delay=args.anti_slip_delay, starting_v=args.starting_v * KMH)
+        s0=tuple(s0), v=tuple(v), N0=args.n0, b_M=args.bm, excitation=short_circuit_from(args),
+        t_end=args.t_end, fs=args.fs, unstable_s0=args.unstable_s0,
+        unstable_v=args.unstable_v * KMH, anti_slip=anti_slip_from(args),
+        starting_v=args.starting_v * KMH)
     return parameters, options
 
 
@@ -122,9 +135,21 @@ def assessment_table(result) -> str:
 
 
 def cmd_assess(args: argparse.Namespace) -> None:
-    from model.studies.assessment import assess
+    from model.studies.assessment import assess, short_circuit_points
 
     parameters, options = options_from_args(args)
-    print("assess: short_circuit, unstable_adhesion, starting …", file=sys.stderr)
-    result = assess(parameters, options)
-    emit(args, result.as_dict(), assessment_table(result))
+    short_circuit_points(parameters, options)  # an unstable grid point: refused before any work
+    engine = None
+    try:
+        engine, mapper, where = start_engine(args)
+        print(f"assess: short_circuit ({len(options.s0) * len(options.v)} point(s) on {where}), "
+              "unstable_adhesion, starting …", file=sys.stderr)
+        result = assess(parameters, options, mapper, ProgressBar("assess: short_circuit",
+                                                                 unit="points"))
+    except KeyboardInterrupt:
+        print("\nassess: interrupted", file=sys.stderr)
+        raise SystemExit(EXIT_INTERRUPTED) from None
+    finally:
+        if engine is not None:
+            engine.close()
+    emit(args, {**result.as_dict(), "rail": args.rail}, assessment_table(result))

@@ -34,6 +34,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from model.analysis.assessment import Check, Component, drive_components, governing, verify
+from model.analysis.load_peaks import GROWTH_RATE
+from model.analysis.nonlinear import AntiSlip
 from model.analysis.response import ResponseError, ShortCircuit
 from model.mechanics.operating_point import KMH, OperatingPoint, creep_law
 from model.mechanics.parameters import Parameters
@@ -64,7 +66,7 @@ class AssessmentOptions:
     unstable_s0: float = 0.014  # unstable_adhesion: creepage [-]
     unstable_v: float = 120.0 * KMH  # unstable_adhesion: speed [m/s]
     unstable_t_end: float = 2.0  # unstable_adhesion: horizon [s]
-    anti_slip_delay: float | None = None  # [s] (None: AntiSlip's default)
+    anti_slip: AntiSlip | None = None  # unstable_adhesion: ID2's protection (None: defaults)
     starting_v: float = 5.0 * KMH  # starting: speed [m/s]
 
     def __post_init__(self) -> None:
@@ -170,23 +172,36 @@ def _largest(max_value: float, min_value: float, max_at: dict, min_at: dict) -> 
     return CaseLoad(float(value), float(time), at)
 
 
-def short_circuit_case(parameters: Parameters, outputs: list[str],
-                       options: AssessmentOptions) -> LoadCase:
-    """The short-circuit case: ``bogie envelope --phase all`` over the options' grid (in this
-    process), every grid point stable (else :class:`AssessmentError`)."""
+def short_circuit_points(parameters: Parameters, options: AssessmentOptions
+                         ) -> list[OperatingPoint]:
+    """The operating points of the short-circuit case's grid, each checked stable (else
+    :class:`AssessmentError` naming the first that is not)."""
     from model.analysis.eigen import bogie_system
-    from model.studies.envelope import EnvelopeStudy, resolve_outputs, run_envelope
     from model.studies.maps import cached_model
 
     model = cached_model(parameters)
     ops = [_operating_point(parameters, s0, v, options) for s0 in options.s0 for v in options.v]
     for op in ops:
         growth = float(np.max(bogie_system(model, op).eigenvalues().real))
-        if growth > 1e-6:
+        if growth > GROWTH_RATE:
             raise AssessmentError(
                 f"--s0 {op.s0:g} at --v {op.v_kmh:g} km/h is not stable (growth rate "
                 f"{growth:.3g} 1/s): the short-circuit case takes stable creepages; beyond the "
                 "adhesion maximum is the unstable_adhesion case")
+    return ops
+
+
+def short_circuit_case(parameters: Parameters, outputs: list[str], options: AssessmentOptions,
+                       map_unordered=None, progress=None) -> LoadCase:
+    """The short-circuit case: ``bogie envelope --phase all`` over the options' grid, every grid
+    point stable (else :class:`AssessmentError`); its points on the study engine's
+    ``map_unordered`` (default: in this process), ``progress(finished, total, elapsed [s])``
+    after each (:func:`model.studies.envelope.run_envelope`)."""
+    from model.studies.envelope import EnvelopeStudy, resolve_outputs, run_envelope
+    from model.studies.maps import cached_model
+
+    model = cached_model(parameters)
+    ops = short_circuit_points(parameters, options)
     horizon = options.t_end if options.t_end is not None else take_over_horizon(model, ops,
                                                                                 outputs)
     names, units = resolve_outputs(model, ops[0], outputs)
@@ -194,7 +209,7 @@ def short_circuit_case(parameters: Parameters, outputs: list[str],
     study = EnvelopeStudy(s0=options.s0, v=options.v, N0=(ops[0].N0,), b_M=(ops[0].b_M,),
                           outputs=names, units=units, M0=(e.M0,), f=(e.f,), D=(e.D,),
                           fault="all", t_end=horizon, fs=options.fs)
-    result = run_envelope(study, parameters)
+    result = run_envelope(study, parameters, map_unordered, progress)
     loads = {o.name: _largest(o.max, o.min, o.max_at, o.min_at) for o in result.outputs}
     return LoadCase(
         "short_circuit",
@@ -212,14 +227,13 @@ def unstable_adhesion_case(parameters: Parameters, outputs: list[str],
                            options: AssessmentOptions) -> LoadCase:
     """The unstable case: nonlinear creep and ID2's anti-slip protection at its reaction time."""
     from model.analysis.fault_instant import continuity_phases
-    from model.analysis.nonlinear import AntiSlip, nonlinear_response
+    from model.analysis.nonlinear import nonlinear_response
     from model.mechanics.operating_point import motor_torque
     from model.studies.maps import cached_model
 
     model = cached_model(parameters)
     op = _operating_point(parameters, options.unstable_s0, options.unstable_v, options)
-    protection = AntiSlip() if options.anti_slip_delay is None \
-        else AntiSlip(delay=options.anti_slip_delay)
+    protection = AntiSlip() if options.anti_slip is None else options.anti_slip
     e = options.excitation
     excitation = ShortCircuit(M0=e.M0, f=e.f, D=e.D)  # the continuity root (physics first)
     r = nonlinear_response(model, op, excitation, options.unstable_t_end, options.fs,
@@ -267,17 +281,16 @@ def starting_case(parameters: Parameters, outputs: list[str], options: Assessmen
 
 
 def assess(parameters: Parameters, options: AssessmentOptions | None = None,
-           progress=None) -> Assessment:
-    """The three load cases and every check under them (``progress(done, total)`` after each
-    case if given)."""
+           map_unordered=None, progress=None) -> Assessment:
+    """The three load cases and every check under them.  The short-circuit case's grid runs on
+    the study engine's ``map_unordered`` (default: in this process) with ``progress(finished,
+    total, elapsed [s])`` after each point; the other two cases are single runs here."""
     options = AssessmentOptions() if options is None else options
     components = drive_components(parameters)
     outputs = list(dict.fromkeys(c.output for c in components))
-    cases = []
-    for done, build in enumerate((short_circuit_case, unstable_adhesion_case, starting_case)):
-        cases.append(build(parameters, outputs, options))
-        if progress is not None:
-            progress(done + 1, len(LOAD_CASES))
+    cases = [short_circuit_case(parameters, outputs, options, map_unordered, progress),
+             unstable_adhesion_case(parameters, outputs, options),
+             starting_case(parameters, outputs, options)]
     checks = []
     for case in cases:
         for component in components:

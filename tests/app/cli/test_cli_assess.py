@@ -1,5 +1,6 @@
 """``bogie assess``: the JSON contract, the short-circuit loads equal to ``bogie envelope --phase
-all`` on the same grid, and bad input refused in one line with exit status 2."""
+all`` on the same grid (in this process and on a local cluster, the envelope's engine options),
+the envelope's rail and anti-slip options, and bad input refused in one line with exit status 2."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import json
 import math
 
 import pytest
+from test_cli import run_process
 
 from app.cli.main import main
 from model.mechanics.parameters import dumps_parameters, load_parameters
@@ -31,7 +33,7 @@ def assessed():
 
     out = io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
-        code = main(["assess", *GRID, "--json"])
+        code = main(["assess", *GRID, "--serial", "--json"])
     assert code == 0
     return json.loads(out.getvalue())
 
@@ -87,6 +89,34 @@ def test_short_circuit_loads_are_the_envelopes_phase_all_extremes(assessed, caps
         assert load == pytest.approx(envelope[name], rel=1e-12), name
 
 
+@pytest.mark.slow
+def test_the_short_circuit_grid_on_a_local_cluster_equals_serial(assessed):
+    """The envelope's engine options: ``--workers 2`` (a local cluster of worker processes, the
+    default engine) gives the serial run's checks; a wet rail and the protection's options reach
+    the load cases."""
+    cluster = run_process(["assess", *GRID, "--workers", "2", "--json"])
+    assert cluster.returncode == 0, cluster.stderr
+    assert "local cluster of 2 worker process(es)" in cluster.stderr
+    data = json.loads(cluster.stdout)
+    assert data["checks"] == assessed["checks"]
+    assert data["rail"] == "calibrated"
+
+
+@pytest.mark.slow
+def test_rail_and_anti_slip_options_reach_the_load_cases(assessed, capsys):
+    code, out, err = run(["assess", *GRID, "--serial", "--json", "--rail", "wet",
+                          "--anti-slip-delay", "0.25", "--anti-slip-rate", "5"], capsys)
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["rail"] == "wet"
+    unstable = next(c for c in data["load_cases"] if c["name"] == "unstable_adhesion")
+    assert unstable["scenario"]["anti_slip_delay_s"] == 0.25
+    assert "after 0.25 s" in unstable["description"]
+    starting = next(c for c in data["load_cases"] if c["name"] == "starting")
+    before = next(c for c in assessed["load_cases"] if c["name"] == "starting")
+    assert starting["scenario"]["mu_max"] < before["scenario"]["mu_max"]  # wet: less adhesion
+
+
 @pytest.fixture(scope="module")
 def bad_set(tmp_path_factory):
     path = tmp_path_factory.mktemp("sets") / "bad.toml"
@@ -103,6 +133,9 @@ def bad_set(tmp_path_factory):
     (["--fs", "100"], "too low to resolve the excitation"),
     (["--unstable-s0", "2"], "--unstable-s0 (creepage) = 2 is not allowed"),
     (["--params", "BAD"], "'wheel_hub_outer_diameter' = 0.2 m must exceed the seat's diameter"),
+    (["--rail", "icy"], "invalid choice: 'icy'"),
+    (["--workers", "0"], "--workers = 0 is not allowed"),
+    (["--anti-slip-rate", "-1"], "--anti-slip-rate (1/s)"),
 ])
 def test_bad_input_is_one_line_with_exit_status_2(argv, message, bad_set, capsys):
     argv = [bad_set if a == "BAD" else a for a in argv]
