@@ -8,21 +8,12 @@ import json
 import math
 
 import pytest
-from test_cli import run_process
+from test_cli import assert_one_line_error, run, run_process
 
 from app.cli.main import main
 from model.mechanics.parameters import dumps_parameters, load_parameters
 
 GRID = ["--s0", "0.003,0.005", "--v", "120,200", "--t-end", "3", "--fs", "2500"]
-
-
-def run(argv: list[str], capsys) -> tuple[int, str, str]:
-    try:
-        code = main(argv)
-    except SystemExit as exit_:
-        code = exit_.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")
@@ -140,9 +131,7 @@ def bad_set(tmp_path_factory):
 def test_bad_input_is_one_line_with_exit_status_2(argv, message, bad_set, capsys):
     argv = [bad_set if a == "BAD" else a for a in argv]
     code, out, err = run(["assess", *argv], capsys)
-    assert code == 2
-    lines = [line for line in err.splitlines() if line.strip()]
-    assert lines[-1].startswith(("bogie assess: error:", "bogie assess: error: argument"))
-    assert message in lines[-1]
-    assert "Traceback" not in err
+    assert_one_line_error(code, out, err)
+    assert err.startswith("bogie assess: error:")
+    assert message in err
     assert out == ""
