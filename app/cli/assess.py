@@ -41,9 +41,6 @@ from app.cli.options import (
 from app.cli.output import emit
 from app.cli.runs import ProgressBar, start_engine
 
-KIND_LABELS = {"press_fit_slip": "press-fit slip", "torsional_shear": "torsional shear",
-               "coupling": "coupling rating"}
-
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("assess", help="verdicts: safety factors of every press fit, "
@@ -107,30 +104,32 @@ def options_from_args(args: argparse.Namespace):
 
 def assessment_table(result) -> str:
     """The checks as text: per load case its description and horizon, then one row per check."""
+    from model.analysis.assessment import KIND_NAMES, VERDICT_WORDS, verdict_colour
+
     lines = []
     for case in result.cases:
         horizon = "steady" if case.horizon is None else f"horizon {case.horizon:g} s"
         lines.append(f"{case.name} ({horizon}): {case.description}")
     lines += ["", f"{'component':<20} {'check':<16} {'load case':<18} {'load [N m]':>11} "
-                  f"{'capacity':>11} {'factor':>7} {'req.':>5}  verdict  at"]
+                  f"{'capacity [N m]':>14} {'safety factor':>13} {'required':>8}  "
+                  f"{'verdict':<12}  at"]
     for c in result.checks:
-        at = "steady" if math.isnan(c.time) else f"t {c.time:.4g} s"
+        at = "steady" if math.isnan(c.time) else f"t = {c.time:.4g} s"
         if "v_kmh" in c.scenario:
-            at += f", s0 {c.scenario['s0']:.4g}, {c.scenario['v_kmh']:g} km/h"
-        verdict = "ok" if c.ok else ("SHORT" if c.safety_factor >= 1 else "FAIL")
-        lines.append(f"{c.component:<20} {KIND_LABELS[c.kind]:<16} {c.load_case:<18} "
-                     f"{c.load:>11.4g} {c.capacity:>11.4g} {c.safety_factor:>7.3g} "
-                     f"{c.required:>5.3g}  {verdict:<7}  {at}")
+            at += f", s0 = {c.scenario['s0']:.4g}, {c.scenario['v_kmh']:g} km/h"
+        lines.append(f"{c.component:<20} {KIND_NAMES[c.kind]:<16} {c.load_case:<18} "
+                     f"{c.load:>11.4g} {c.capacity:>14.4g} {c.safety_factor:>13.3g} "
+                     f"{c.required:>8.3g}  {VERDICT_WORDS[verdict_colour(c)]:<12}  {at}")
     g = result.governing
     failed = sum(not c.ok for c in result.checks)
-    lines += ["", f"governing: {g.component} ({KIND_LABELS[g.kind]}) in {g.load_case}: safety "
+    lines += ["", f"governing: {g.component} ({KIND_NAMES[g.kind]}) in {g.load_case}: safety "
                   f"factor {g.safety_factor:.3g} against {g.required:.3g} required — "
                   f"{'ok' if g.ok else 'NOT MET'}; {failed} of {len(result.checks)} checks "
                   "below their required factor",
-              "SHORT: the capacity holds, the margin is below the required factor; FAIL: the "
-              "load exceeds the capacity.  Strength data marked 'estimate' in the parameter "
-              "set are assumptions (bogie parameters); not a certification to EN 13103-1 / "
-              "EN 13260."]
+              "margin short: the capacity holds, the safety factor is below the required one; "
+              "overloaded: the load exceeds the capacity.  Strength data marked 'estimate' in "
+              "the parameter set are assumptions (bogie parameters); not a certification to "
+              "EN 13103-1 / EN 13260."]
     return "\n".join(lines)
 
 

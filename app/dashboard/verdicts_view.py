@@ -88,9 +88,10 @@ class VerdictsView:
             pn.pane.Markdown(
                 "Every press fit (slip, DIN 7190), shaft (torsional shear) and coupling (rating) "
                 "of both drives in three load cases; safety factor = capacity / load. Click a "
-                "row for the history that produced its load. Strength data (TOML, entries as in "
-                "the parameter file, e.g. `wheel_seat_friction_min = { value = 0.1, unit = "
-                "\"1\" }`) replace the set's; docs/assessment.md."),
+                "row for the history that produced its load (the starting case's are static). "
+                "Strength data (TOML, entries as in the parameter file, e.g. "
+                "`wheel_seat_friction_min = { value = 0.1, unit = \"1\" }`) replace the set's; "
+                "docs/assessment.md."),
             pn.Row(pn.pane.Markdown("**strength data (TOML):**"), self.upload),
             self.notice, self.cases, self.table, self.chart, sizing_mode="stretch_width")
 
@@ -179,12 +180,13 @@ class VerdictsView:
 
     def _clicked(self, event) -> None:
         """A row: its load's history on the Response tab (its s0 and v; the nonlinear creep
-        model with anti-slip for the unstable_adhesion case)."""
+        model with anti-slip for the unstable_adhesion case).  The starting case's loads are
+        static: no history produced them."""
         if not 0 <= event.row < len(self.rows):
             return
         row = self.rows[event.row]
         dash = self.dashboard
-        if row["s0"] is None or row["v_kmh"] is None:
+        if row["s0"] is None or row["v_kmh"] is None or row["load case"] == "starting":
             return
         dash.param.update(s0=min(max(row["s0"], 0.0005), 0.03),
                           v=min(max(row["v_kmh"], 10.0), 250.0))

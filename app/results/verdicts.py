@@ -13,17 +13,14 @@ import math
 
 import numpy as np
 import panel as pn
-from bokeh.models import ColumnDataSource, HoverTool, Span
+from bokeh.models import ColumnDataSource, FactorRange, HoverTool, Span
 from bokeh.plotting import figure
 
-from model.analysis.assessment import verdict_colour
+from model.analysis.assessment import KIND_NAMES, VERDICT_WORDS, verdict_colour
 from model.mechanics.operating_point import KMH, OperatingPoint
 from model.studies.assessment import Assessment, AssessmentOptions, assess
 
 CASE_COLOURS = {"short_circuit": "#1f77b4", "unstable_adhesion": "#d62728", "starting": "#2ca02c"}
-KIND_LABELS = {"press_fit_slip": "press-fit slip", "torsional_shear": "torsional shear",
-               "coupling": "coupling rating"}
-VERDICT_WORDS = {"green": "MARGIN MET", "amber": "MARGIN SHORT", "red": "OVERLOADED"}
 
 
 @pn.cache(max_items=16)
@@ -59,10 +56,10 @@ def indicator_html(result: Assessment | None, note: str = "") -> str:
     g = result.governing
     colour = verdict_colour(g)
     return (f'<div class="status-box verdict-box {colour}" data-verdict="{colour}">'
-            f"{VERDICT_WORDS[colour]}</div>"
+            f"{VERDICT_WORDS[colour].upper()}</div>"
             f"<div class='verdict-detail' style='font-size:13px'>governing safety factor "
             f"<b>{g.safety_factor:.3g}</b> (required {g.required:.3g}): "
-            f"{html.escape(g.component)}, {KIND_LABELS[g.kind]}, {g.load_case}</div>")
+            f"{html.escape(g.component)}, {KIND_NAMES[g.kind]}, {g.load_case}</div>")
 
 
 def check_rows(result: Assessment) -> list[dict]:
@@ -72,11 +69,12 @@ def check_rows(result: Assessment) -> list[dict]:
         where = "steady" if math.isnan(c.time) else f"t = {c.time:.4g} s"
         if "v_kmh" in c.scenario:
             where += f", s0 = {c.scenario['s0']:.4g}, {c.scenario['v_kmh']:g} km/h"
-        rows.append({"component": c.component, "check": KIND_LABELS[c.kind],
+        rows.append({"component": c.component, "check": KIND_NAMES[c.kind],
                      "load case": c.load_case, "load [kN m]": round(c.load / 1e3, 2),
                      "capacity [kN m]": round(c.capacity / 1e3, 2),
                      "safety factor": round(c.safety_factor, 3), "required": c.required,
-                     "verdict": verdict_colour(c), "where": where, "output": c.output,
+                     "verdict": VERDICT_WORDS[verdict_colour(c)], "colour": verdict_colour(c),
+                     "where": where, "output": c.output,
                      "s0": c.scenario.get("s0"), "v_kmh": c.scenario.get("v_kmh")})
     return rows
 
@@ -90,9 +88,9 @@ def checks_html(result: Assessment) -> str:
     body = "".join(
         f"<tr><td class='text'>{html.escape(r['component'])}</td><td class='text'>{r['check']}</td>"
         f"<td class='text'>{r['load case']}</td><td>{r['load [kN m]']:.4g}</td>"
-        f"<td>{r['capacity [kN m]']:.4g}</td><td class='{'' if r['verdict'] == 'green' else 'bad'}'>"
+        f"<td>{r['capacity [kN m]']:.4g}</td><td class='{'' if r['colour'] == 'green' else 'bad'}'>"
         f"{r['safety factor']:.3g}</td><td>{r['required']:.3g}</td>"
-        f"<td class='text'>{VERDICT_WORDS[r['verdict']].lower()}</td>"
+        f"<td class='text'>{r['verdict']}</td>"
         f"<td class='text'>{html.escape(r['where'])}</td></tr>" for r in check_rows(result))
     cases = "".join(
         f"<li><b>{c.name}</b> ({'steady' if c.horizon is None else f'horizon {c.horizon:g} s'})"
@@ -113,11 +111,9 @@ def safety_factor_figure(result: Assessment):
         names.append(c.component)
     source = ColumnDataSource({"x": x, "top": top, "colour": colours, "case": cases,
                                "component": names})
-    from bokeh.models import FactorRange
-
     fig = figure(x_range=FactorRange(*[(n, case) for n in components
                                        for case in CASE_COLOURS]),
-                 y_axis_type="log", height=330, sizing_mode="stretch_width",
+                 y_axis_type="log", height=400, sizing_mode="stretch_width",
                  y_axis_label="safety factor = capacity / load [-]", name="verdict-bars",
                  title="Safety factor of every check, per load case (blue short circuit, red "
                        "unstable adhesion, green starting)", toolbar_location="above")
@@ -128,7 +124,8 @@ def safety_factor_figure(result: Assessment):
     fig.add_layout(Span(location=1.0, dimension="width", line_color="red", line_width=2))
     fig.add_tools(HoverTool(tooltips=[("component", "@component"), ("load case", "@case"),
                                       ("safety factor", "@top{0.000}")]))
-    fig.xaxis.major_label_orientation = 1.0
-    fig.xaxis.group_label_orientation = 1.2
+    # the colour says the load case (title): only the components are written under the bars
+    fig.xaxis.major_label_text_font_size = "0pt"
+    fig.xaxis.group_label_orientation = 0.9
     fig.x_range.range_padding = 0.02
     return fig

@@ -36,6 +36,10 @@ from model.mechanics.assembly import DRIVES, RIM_NODES
 from model.mechanics.parameters import Parameters
 
 KINDS = ("press_fit_slip", "torsional_shear", "coupling")
+KIND_NAMES = {"press_fit_slip": "press-fit slip", "torsional_shear": "torsional shear",
+              "coupling": "coupling rating"}  # each kind in words (tables, reports)
+# each verdict colour (:func:`verdict_colour`) in words
+VERDICT_WORDS = {"green": "margin met", "amber": "margin short", "red": "overloaded"}
 
 
 def contact_pressure(delta: float, d: float, D: float, d_i: float, E_hub: float, nu_hub: float,
