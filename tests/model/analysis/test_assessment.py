@@ -39,7 +39,7 @@ def test_press_fit_solid_shaft_against_din_7190_closed_form_and_a_worked_example
         assert p == pytest.approx(E * delta / d * (1 - (d / D) ** 2) / 2, rel=1e-12)
     assert p == pytest.approx(51e6, abs=0.5e6)
     assert slip_torque(mu, p, d, L) == pytest.approx(965.0, abs=1.0)
-    # the formula T = μ p π d² L / 2
+    # the slip torque T = μ p π d² L / 2
     assert slip_torque(mu, p, d, L) == pytest.approx(mu * p * math.pi * d**2 * L / 2, rel=1e-15)
 
 
