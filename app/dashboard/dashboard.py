@@ -162,7 +162,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.input_notice = pn.pane.Alert("", alert_type="warning", visible=False,
                                           css_classes=["input-notice"],
                                           sizing_mode="stretch_width")
-        self.peaks = layout.html_pane("")
+        self.peaks = layout.html_pane("", css_classes=["peak-table"])
         self.eigen_table = layout.html_pane("")
         self.mode_select = pn.widgets.Select(label="mode ν", options={}, width=420,
                                              css_classes=["ctl-mode"])

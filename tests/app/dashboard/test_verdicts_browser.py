@@ -1,7 +1,8 @@
 """The verdict indicator beside the stability status and the Verdicts tab, served and in
 headless Chromium (one page load): the indicator shows the governing safety factor with its
 colour, the tab lists all 48 checks and draws the bar chart, a row opens the Response tab at the
-operating point of its load."""
+operating point of its load; on the same first screen the peak table gives ID1's disc clutch
+swing with its time after the fault and its quasi-static and dynamic parts."""
 
 from __future__ import annotations
 
@@ -27,6 +28,13 @@ def test_verdict_indicator_and_view(app_server, chromium):
     required = float(re.search(r"required\s*([0-9.e+-]+)", detail).group(1))
     # the colour follows the factor against the required one
     assert colour == ("green" if factor >= required else "amber" if factor >= 1 else "red")
+    # the peak table of the first screen (the stable default point): the swing, not the
+    # pre-fault value at 0 s, and its split
+    peaks = html.unescape(page.evaluate(TEXT, "peak-table"))
+    assert "quasi-static at" in peaks
+    row = peaks.split(">ID1.disc_clutch.torque [kN m]<")[1].split("</tr>")[0]
+    cells = re.findall(r"<td[^>]*>([^<]*)</td>", row)
+    assert float(cells[6]) > 0.0  # the swing's time [s]
     page.get_by_text("Verdicts", exact=True).click()
     rows = page.locator(".verdict-table .tabulator-row")
     rows.first.wait_for(timeout=60_000)
@@ -36,6 +44,6 @@ def test_verdict_indicator_and_view(app_server, chromium):
     page.wait_for_function(
         "() => [...Bokeh.documents[0].all_models].some(m => m.name === 'verdict-bars')",
         timeout=60_000)
-    rows.first.click()
+    rows.filter(has_text="short_circuit").first.click()  # a starting row has no history
     page.locator(".bk-tab.bk-active", has_text="Response").wait_for(timeout=30_000)
     assert page.errors == []
