@@ -96,7 +96,6 @@ QUASI_STATIC_HZ = 0.5
 # the split is given when the modal form's rounding-error estimate of the quasi-static part stays
 # below this (relative; the estimate is not a bound, measured errors were up to 150x it): 3 digits
 QUASI_STATIC_TOLERANCE = 1e-6
-GROWING = 1e-6  # [1/s]: a mode with a larger real part grows (no final value)
 
 
 class ResponseError(ValueError):
@@ -394,7 +393,7 @@ def quasi_static_response(system: LinearSystem, C: np.ndarray, u0: float, a: com
     # an output that drifts (a rigid coordinate's ramp) more than 1e-9 of its size per second
     size = np.maximum(np.abs(final), np.abs(y[:valid]).max(axis=0, initial=0.0))
     drift = np.abs(C @ beta) > 1e-9 * np.maximum(size, 1e-300)
-    if len(slow) and slow.real.max() > GROWING:
+    if len(slow) and slow.real.max() > GROWTH_RATE:
         drift[:] = True  # a slow mode grows: no final value
     return QuasiStatic(y[:valid], np.where(drift, np.nan, final))
 
