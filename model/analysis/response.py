@@ -90,8 +90,9 @@ MAX_T_END = 60.0  # [s]
 # The quasi-static part of a response: the static response and the modes that do not oscillate
 # or oscillate slower than this (|Im λ| / 2π), not completing a cycle in the study's 2 s window.
 # The bogie's slow modes (the vehicle's speed, a drive taking over a lost torque, creep-damped
-# drifts; a pair below 0.3 Hz where the motor slope b_M makes one) lie well below its lowest
-# structural mode (the car body's bounce, 1.26 Hz).
+# drifts; a slow pair where the motor slope b_M makes one) lie well below its lowest structural
+# mode (the car body's bounce): no mode between 0.6 and 2 times this at stable points
+# (tests/model/analysis/test_response_model.py::test_no_mode_near_the_quasi_static_cutoff).
 QUASI_STATIC_HZ = 0.5
 # the split is given when the modal form's rounding-error estimate of the quasi-static part stays
 # below this (relative; the estimate is not a bound, measured errors were up to 150x it): 3 digits

@@ -305,3 +305,27 @@ def test_quasi_static_and_dynamic_parts_add_up_to_the_response(b_M):
     # the short circuit's oscillating torque (net impulse ≈ M0/ω) hardly moves the slow modes:
     # the whole response's quasi-static part is the step's to within 1 % of the lost torque
     assert np.abs(slow - trend.y).max() < 0.01 * lost
+
+
+def test_no_mode_near_the_quasi_static_cutoff():
+    """The split into quasi-static and dynamic parts does not hinge on a mode near
+    QUASI_STATIC_HZ: over stable points of the calibrated set (s0, speed and motor slope across
+    their ranges) every mode lies below 0.6 × or above 2 × the cutoff (the slow pair b_M makes,
+    the car body's bounce)."""
+    from model.analysis.eigen import bogie_system
+    from model.analysis.response import QUASI_STATIC_HZ
+    from model.mechanics.assembly import build_model
+    from model.mechanics.operating_point import OperatingPoint
+    from model.mechanics.parameters import load_parameters
+
+    parameters = load_parameters()
+    model = build_model(parameters)
+    near = []
+    for s0 in (0.002, 0.005):
+        for v_kmh in (40.0, 120.0, 200.0):
+            for b_M in (0.0, parameters["motor_slope"], 20_000.0):
+                op = OperatingPoint.from_kmh(s0, v_kmh, parameters["wheel_force"], b_M)
+                hz = bogie_system(model, op).eigenvalues().imag / (2 * np.pi)
+                near += [(s0, v_kmh, b_M, f) for f in hz
+                         if 0.6 * QUASI_STATIC_HZ < f < 2 * QUASI_STATIC_HZ]
+    assert near == []
