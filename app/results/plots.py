@@ -199,7 +199,9 @@ class CreepPlot:
                           line_dash="dashed", line_width=2, visible=False)
         self.maximum = Span(location=0.0, dimension="height", line_color="#777777",
                             line_dash="dotted")
-        self.limit_label = Label(x=0.0, y=0.02, text="s0*", text_color=UNSTABLE, visible=False)
+        # left of the line: the legend sits bottom right, the curve high above
+        self.limit_label = Label(x=0.0, y=0.02, text="s0*", text_color=UNSTABLE, visible=False,
+                                 text_align="right")
         fig.add_layout(self.limit)
         fig.add_layout(self.maximum)
         fig.add_layout(self.limit_label)
@@ -222,7 +224,7 @@ class CreepPlot:
         if ok:
             self.limit.location = limit.s0_limit
             self.limit_label.x = limit.s0_limit
-            self.limit_label.text = f" s0* = {limit.s0_limit:.4f}"
+            self.limit_label.text = f"s0* = {limit.s0_limit:.4f} "
 
 
 class ResponsePlots:
