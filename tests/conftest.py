@@ -62,6 +62,7 @@ SERVED_MODULES = {
     "tests/app/dashboard/test_resonance_browser.py",
     "tests/app/dashboard/test_review_browser.py",
     "tests/app/dashboard/test_uncertainty_band_browser.py",
+    "tests/app/dashboard/test_verdicts_browser.py",
 }
 GROUPS = {
     **dict.fromkeys(SERVED_MODULES, "served"),
