@@ -25,6 +25,10 @@ CSS = """
 .status-box {font-size: 30px; font-weight: 700; padding: 6px 14px; border-radius: 6px;
              color: white; text-align: center; letter-spacing: 0.05em}
 .status-box.ok {background: STABLE_COLOR} .status-box.bad {background: UNSTABLE_COLOR}
+.status-box.unknown {background: #888888}
+.status-box.preview {opacity: 0.5; border: 2px dashed #333; font-size: 24px}
+.status-box .preview-tag {display: block; font-size: 11px; font-weight: 400; letter-spacing: 0}
+.preview-text {font-size: 12px; line-height: 1.4; color: #444; padding-top: 3px}
 table.bogie {border-collapse: collapse; font-size: 12px; width: 100%}
 table.bogie th, table.bogie td {border-bottom: 1px solid #ddd; padding: 2px 6px; text-align: right}
 table.bogie td.text, table.bogie th.text {text-align: left}

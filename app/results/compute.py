@@ -10,6 +10,8 @@ results for plotting.  Units: SI, except where a name says otherwise (``v_kmh`` 
 from __future__ import annotations
 
 import math
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -72,6 +74,34 @@ RAINFLOW_BINS = 24  # bins of the rainflow matrix along the range and the mean
 
 class ModelRejected(ValueError):
     """A parameter combination the model rejects (message shown to the user)."""
+
+
+class Known:
+    """The results a cached function has computed, by its arguments, looked up without
+    computing anything (a dragged slider's preview asks only what is known).  Bounded like the
+    function's own cache; thread-safe."""
+
+    def __init__(self, size: int):
+        self.size = size
+        self._results: OrderedDict = OrderedDict()
+        self._lock = threading.Lock()
+
+    def remember(self, key: tuple, result) -> None:
+        with self._lock:
+            self._results[key] = result
+            self._results.move_to_end(key)
+            while len(self._results) > self.size:
+                self._results.popitem(last=False)
+
+    def get(self, key: tuple):
+        """The result for ``key`` if it was computed (and is still kept), else None."""
+        with self._lock:
+            return self._results.get(key)
+
+
+_KNOWN_POINTS = Known(256)  # point_result by its arguments
+_KNOWN_LIMITS = Known(128)  # limit_result by its arguments
+_KNOWN_LOCI = Known(128)  # locus_result / dense_locus_result by (arguments, dense)
 
 
 # --- model -----------------------------------------------------------------------------------
@@ -212,13 +242,22 @@ def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: fl
     law = creep_law(m.parameters, op.N0)
     s_max, mu_max = law.maximum(op.v)
     s_grid = np.linspace(0.0, max(0.03, 1.5 * op.s0), 301)
-    return PointResult(
+    point = PointResult(
         key=(params_path, rail, s0, v_kmh, N0_kN, b_M), eigenvalues=result.eigenvalues,
         stable=result.stable, max_real_part=result.max_real_part, flutter=result.flutter,
         divergence=result.divergence, n_rigid=result.n_rigid, modes=modes,
         real=result.real[:N_REAL_TABLE], creep_s=s_grid, creep_mu=np.asarray(law.mu(s_grid, op.v)),
         mu0=float(law.mu(op.s0, op.v)), s_max=s_max, mu_max=mu_max,
         M_ad=adhesion_moment(m.parameters, op.v, op.N0))
+    _KNOWN_POINTS.remember(point.key, point)
+    return point
+
+
+def known_point(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                b_M: float) -> PointResult | None:
+    """:func:`point_result` of these arguments if it has been computed, else None (nothing is
+    computed)."""
+    return _KNOWN_POINTS.get((params_path, rail, s0, v_kmh, N0_kN, b_M))
 
 
 @pn.cache(max_items=64)
@@ -264,9 +303,18 @@ def limit_result(params_path: str, rail: str, v_kmh: float, N0_kN: float,
     try:
         limit = stability_limit(m, v_kmh * KMH, N0_kN * 1e3, b_M, s0_low=LOCUS_S0[0] / 2,
                                 xtol=LIMIT_XTOL, bracket=bracket)
+        result = LimitResult(limit.s0_limit, "")
     except NoStabilityLimit as error:
-        return LimitResult(None, str(error))
-    return LimitResult(limit.s0_limit, "")
+        result = LimitResult(None, str(error))
+    _KNOWN_LIMITS.remember((params_path, rail, v_kmh, N0_kN, b_M), result)
+    return result
+
+
+def known_limit(params_path: str, rail: str, v_kmh: float, N0_kN: float,
+                b_M: float) -> LimitResult | None:
+    """:func:`limit_result` of these arguments if it has been computed, else None (nothing is
+    computed)."""
+    return _KNOWN_LIMITS.get((params_path, rail, v_kmh, N0_kN, b_M))
 
 
 # --- root locus --------------------------------------------------------------------------------
@@ -316,7 +364,9 @@ def locus_result(params_path: str, rail: str, parameter: str, fixed: float, N0_k
     """The coarse sweep (LOCUS_POINTS evenly spaced): tracked branches over s0 (at speed
     ``fixed`` [km/h]) or over v (at creepage ``fixed``).  Shown first; brackets s0*(v)."""
     shown = np.linspace(*_sweep_range(parameter), LOCUS_POINTS)
-    return _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=False)
+    locus = _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=False)
+    _KNOWN_LOCI.remember((params_path, rail, parameter, fixed, N0_kN, b_M, False), locus)
+    return locus
 
 
 @pn.cache(max_items=64)
@@ -326,7 +376,35 @@ def dense_locus_result(params_path: str, rail: str, parameter: str, fixed: float
     (:func:`refine_grid`); replaces the coarse one on screen."""
     coarse = locus_result(params_path, rail, parameter, fixed, N0_kN, b_M)
     shown = refine_grid(coarse.values, coarse.eigenvalues, LOCUS_DENSE_POINTS)
-    return _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=True)
+    locus = _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=True)
+    _KNOWN_LOCI.remember((params_path, rail, parameter, fixed, N0_kN, b_M, True), locus)
+    return locus
+
+
+def known_locus(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
+                b_M: float) -> LocusResult | None:
+    """The dense root locus of these arguments if it has been computed, else the coarse one,
+    else None (nothing is computed)."""
+    key = (params_path, rail, parameter, fixed, N0_kN, b_M)
+    return _KNOWN_LOCI.get((*key, True)) or _KNOWN_LOCI.get((*key, False))
+
+
+def reduced_estimate(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
+                     b_M: float, point: tuple):
+    """The eigenvalues at ``point`` = (s0, v_kmh, N0_kN, b_M) from the reduced model of the
+    root locus of the other arguments (:func:`model.analysis.locus.kept_sweep_estimate`: one
+    small eigenproblem, no dense solve), or None if that sweep's start is not kept."""
+    from model.analysis.locus import kept_sweep_estimate
+
+    m = model(params_path, rail)
+    low, high = _sweep_range(parameter)
+    if parameter == "s0":
+        ends = [operating_point(params_path, rail, x, fixed, N0_kN, b_M) for x in (low, high)]
+    else:
+        ends = [operating_point(params_path, rail, fixed, x, N0_kN, b_M) for x in (low, high)]
+    op = operating_point(params_path, rail, *point)
+    return kept_sweep_estimate(m, op, *ends, max_frequency_hz=LOCUS_MAX_HZ,
+                               lambda_floor=LOCUS_LAMBDA_FLOOR)
 
 
 def _step_lengths(eigenvalues: np.ndarray, re_unit: float, im_unit: float) -> np.ndarray:
