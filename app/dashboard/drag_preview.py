@@ -33,7 +33,8 @@ class DragPreview:
     """The previews of one dashboard's dragged sliders.
 
     The dashboard provides ``state()``, ``alive()``, ``shown_locus``, its parameters, ``status``
-    (the status pane), ``locus_plot`` and ``creep_plot``; it calls :meth:`request` for a dragged
+    (the status pane), ``details`` (the committed point's numbers, faded during a preview),
+    ``locus_plot`` and ``creep_plot``; it calls :meth:`request` for a dragged
     value, :meth:`release` when a slider is let go, and :meth:`end` when a full answer or a
     rejection is shown."""
 
@@ -85,6 +86,7 @@ class DragPreview:
         if self.dashboard.status.object == self._preview_html:
             self.dashboard.status.object = self._saved_status
         self._saved_status = None
+        self.dashboard.details.styles = {}
         self.dashboard.locus_plot.update_preview(None)
         self.dashboard.creep_plot.update_preview(None)
 
@@ -115,8 +117,9 @@ class DragPreview:
         dashboard = self.dashboard
         if result is None or drag != self._drag or dashboard.state() == state:
             return
-        if self._saved_status is None:
-            self._saved_status = dashboard.status.object
+        if self._saved_status is None:  # the drag's first preview: the details are the
+            self._saved_status = dashboard.status.object  # committed point's, shown faded
+            dashboard.details.styles = {"opacity": "0.45"}
         self._preview_html = status_html(result, name)
         dashboard.status.object = self._preview_html
         dashboard.locus_plot.update_preview(result.eigenvalues)

@@ -162,7 +162,8 @@ def describe(result: Preview, dragged: str) -> list[str]:
     value = {"s0": f"s0 = {s0:.4f}", "v": f"v = {v_kmh:g} km/h", "N0": f"N0 = {N0_kN:g} kN",
              "b_M": f"b_M = {b_M:g} N m s/rad"}[dragged]
     if result.s0_limit is not None:
-        limit = f"limit s0* = {result.s0_limit:.4f} at {v_kmh:g} km/h"
+        limit = (f"limit s0* = {result.s0_limit:.4f} at {v_kmh:g} km/h "
+                 f"(margin s0* − s0 = {result.s0_limit - s0:+.4f})")
         if dragged != "s0":
             limit = f"s0 = {s0:.4f}, {limit}"
     else:
