@@ -27,6 +27,9 @@ from app.results.preview import PREVIEWED, Preview, describe, preview
 from app.services.thread_pools import PREVIEW_POOL, LatestRequest
 
 log = logging.getLogger(__name__)
+# a dragged value is previewed this long after it arrives [ms] (the newest one then): a keyboard
+# step's release, a few ms behind its value, arrives meanwhile and is not previewed
+PREVIEW_DELAY_MS = 25
 
 
 class DragPreview:
@@ -44,12 +47,31 @@ class DragPreview:
         self._drag = 0  # the drag a preview belongs to: a release or a full answer ends it
         self._saved_status: str | None = None  # the status the previews cover while shown
         self._preview_html = ""  # the status pane's text while a preview is shown
+        self._waiting: tuple[str, float] | None = None  # the newest dragged value, not yet asked
         self.shown = 0  # previews shown in this session (the browser test counts its own)
 
     def request(self, name: str, value) -> None:
         """A preview of the operating point with ``name`` (one of PREVIEWED) at the dragged
         ``value`` (display units); nothing if the value is the parameter's (a release or a
-        keyboard step: the full answer follows) or not a value the parameter takes."""
+        keyboard step: the full answer follows) or not a value the parameter takes.  Served, it
+        is decided :data:`PREVIEW_DELAY_MS` later, for the newest value then: a keyboard step
+        sends ``value`` and ``value_throttled`` a few milliseconds apart (on a loaded server
+        Panel handles them as two events), and its release comes first (no preview is
+        computed)."""
+        doc = served_document()
+        if doc is None:
+            self._request(None, name, value)
+            return
+        waiting, self._waiting = self._waiting, (name, value)
+        if waiting is None:
+            doc.add_timeout_callback(partial(self._fire, doc), PREVIEW_DELAY_MS)
+
+    def _fire(self, doc) -> None:
+        waiting, self._waiting = self._waiting, None
+        if waiting is not None:
+            self._request(doc, *waiting)
+
+    def _request(self, doc, name: str, value) -> None:
         dashboard = self.dashboard
         if name not in PREVIEWED:
             return
@@ -65,7 +87,6 @@ class DragPreview:
         if state == committed:
             return
         drag = self._drag
-        doc = served_document()
         if doc is None:  # without a server (tests): at once
             self._show(drag, name, state, self._compute(drag, name, state))
             return
@@ -75,6 +96,7 @@ class DragPreview:
     def release(self) -> None:
         """The slider is let go (or stepped by a key): previews not yet shown are dropped."""
         self._drag += 1
+        self._waiting = None
         self._requests.cancel()
 
     def end(self) -> None:

@@ -5,8 +5,9 @@ While the button is held, the status shows previews (lighter, marked "preview") 
 second, each with the verdict the stability limit gives (stable below s0*, unstable above, one
 slider step of slack on either side); the server runs no dense eigen-analysis meanwhile (its
 process-wide count, :func:`model.analysis.linear_system.dense_decompositions`: the app is served
-in this process); after the release, the full answer's verdict is the last preview's.  s0* comes
-from the model (``stability_limit``), not from the dashboard's cache.
+in this process); after the release, the full answer's verdict is the last preview's; a keyboard
+step then gets its full answer and no preview.  s0* comes from the model (``stability_limit``),
+not from the dashboard's cache.
 """
 
 from __future__ import annotations
@@ -42,6 +43,8 @@ SLIDER_RANGE = """() => {
   const m = [...Bokeh.documents[0].all_models].find(m => (m.css_classes || []).includes('ctl-s0'));
   return [m.start, m.end, m.value];
 }"""
+CURRENT_POINT = """() => { const d = Bokeh.documents[0].get_model_by_name('locus_current').data;
+  return Array.from(d instanceof Map ? d.get('x') : d.x).join(','); }"""
 PREVIEW = re.compile(r'class="status-box (\w+) preview" data-verdict="(\w+)" data-s0="([0-9.e-]+)"')
 FULL = re.compile(r'class="status-box (ok|bad)"')
 
@@ -126,6 +129,17 @@ def test_dragging_s0_across_the_limit_previews_the_verdict(app_server, chromium)
     assert {"ok": "stable", "bad": "unstable"}[full.group(1)] == previews[-1][1]
     assert page.evaluate(SLIDER_RANGE)[2] == pytest.approx(previews[-1][2], abs=S0_STEP / 2)
     assert page.evaluate("() => window.markerLog.at(-1)") == 0  # the preview marker is gone
+    # a keyboard step on the focused handle: its full answer, no preview
+    seen = page.evaluate("() => window.statusLog.length")
+    current = page.evaluate(CURRENT_POINT)
+    handle = page.locator(".ctl-s0 .noUi-handle")
+    handle.focus()
+    handle.press("ArrowLeft")
+    page.wait_for_function(f"(before) => ({CURRENT_POINT})() !== before", arg=current,
+                           timeout=60_000)
+    page.wait_for_timeout(300)
+    assert not any("preview" in html.unescape(text) for _, text in
+                   page.evaluate("() => window.statusLog")[seen:])
     print(f"\n{len(previews)} previews in {seconds:.2f} s "
           f"({len(previews) / seconds:.1f}/s), s0 {previews[0][2]}..{previews[-1][2]}, "
           f"s0* = {s0_limit:.5f}")
