@@ -4,7 +4,7 @@
 
 Starts ``bogie serve`` on a free port (a separate process, as users run it), then:
 
-1. single session: keyboard steps on the s0 slider handle (each a new value, so no cache
+1. single session: keyboard steps (PageUp: 0.0005) on the s0 slider handle (each a new value, so no cache
    hit); latency = key press → the browser holds new eigenvalues (root-locus current point)
    *and* new time histories (both must have changed; the status is sent with the eigenvalues).
    The steps follow each other at once (the next key press as soon as the previous result is
@@ -49,6 +49,9 @@ import served_app  # noqa: E402 - the scripts' own helpers
 from served_app import free_port  # noqa: E402 - also used by bench_nonlinear_app
 
 CHROMIUM = "/usr/bin/chromium"
+# an s0 step: PageUp moves the slider by five of its 0.0001 steps, 0.0005, the values the
+# benchmarks have always stepped through (0.005, 0.0055, … across s0* ≈ 0.0082 at 120 km/h)
+S0_KEY = "PageUp"
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 # the probe runs every 5 ms on the page's main thread while a step is measured, beside the work
@@ -275,7 +278,7 @@ async def session(page, seed: int, presses: int) -> list[float]:
     out = []
     for _ in range(presses):
         await asyncio.sleep(rng.uniform(0.3, 1.5))
-        out.append(await step(page, "ctl-s0", "ArrowRight", FAST))
+        out.append(await step(page, "ctl-s0", S0_KEY, FAST))
     return out
 
 
@@ -349,13 +352,13 @@ async def run(args) -> dict:
             await settle_n0(page, 1)
             await wait_settled(page)
             log("single session: s0 steps, then speed steps")  # own N0 = 99 kN: nothing cached from earlier runs
-            fast = [await step(page, "ctl-s0", "ArrowRight", FAST) for _ in range(args.presses)]
+            fast = [await step(page, "ctl-s0", S0_KEY, FAST) for _ in range(args.presses)]
             # the same steps one at a time: each after the previous one's work is done (its
             # s0*, locus, ranges and drawing), as a reviewer moves a slider and looks
             isolated = []
             for _ in range(args.isolated):
                 await wait_idle(page)
-                isolated.append(await step(page, "ctl-s0", "ArrowRight", FAST))
+                isolated.append(await step(page, "ctl-s0", S0_KEY, FAST))
             results["single_isolated_s"] = isolated
             speeds = [await speed_step(page) for _ in range(args.locus_presses)]
             results["single_fast_s"] = fast
