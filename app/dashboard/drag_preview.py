@@ -84,7 +84,8 @@ class DragPreview:
             return  # only a doctored client sends one; its release gets the notice
         committed = dashboard.state()
         state = replace(committed, **{name: key_value(name, value)})
-        if state == committed:
+        if state == committed:  # dragged back to the value on screen (or released there)
+            self.end()
             return
         drag = self._drag
         if doc is None:  # without a server (tests): at once

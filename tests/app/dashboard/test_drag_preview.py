@@ -43,7 +43,13 @@ def test_a_held_slider_previews_and_the_full_answer_replaces_it(dash):
     assert dense_decompositions() == before
     assert dash.drag_preview.shown == 3
 
-    # a release that changes nothing (back at the committed value): the preview goes at once
+    # dragged back to the committed value: the committed status again
+    dash.drag_preview.request("s0", dash.s0)
+    assert dash.status.object == committed
+    dash.drag_preview.request("s0", 0.0121)
+    assert "preview" in dash.status.object
+
+    # a release that changes nothing: the preview goes at once
     dash.drag_preview.release()
     dash.drag_preview.end()
     assert dash.status.object == committed
