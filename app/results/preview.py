@@ -148,7 +148,7 @@ def preview(point: tuple, locus_key: tuple | None, dragged: str = "s0") -> Previ
         i = estimate.leading
         lam = estimate.eigenvalues[estimate.eigenvalues.imag >= 0]
         leading, leading_source = complex(estimate.eigenvalues[i]), REDUCED
-        leading_error = float(estimate.error_bound[i])
+        leading_error = float(estimate.absolute_error[i])
         if stable is None and estimate.stable is not None:
             stable, source = estimate.stable, REDUCED
     return Preview(point, stable, source, s0_limit, lam, leading, leading_source, leading_error,

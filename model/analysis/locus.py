@@ -309,8 +309,9 @@ class RitzEstimate:
     basis_size: int  # columns of the sweep's basis Φ
 
     @property
-    def error_bound(self) -> np.ndarray:
-        """The estimated absolute error of each eigenvalue [1/s]."""
+    def absolute_error(self) -> np.ndarray:
+        """The estimated absolute error of each eigenvalue [1/s] (first order: the sweep's
+        measured errors are 10–30 times smaller; not a rigorous bound)."""
         return self.error_estimate * np.maximum(np.abs(self.eigenvalues), self.lambda_floor)
 
     @property
@@ -321,10 +322,10 @@ class RitzEstimate:
     @property
     def stable(self) -> bool | None:
         """The verdict where the error estimates decide it: False if a real part exceeds its
-        error bound, True if every real part stays ≤ 0 with its bound added, None otherwise
+        estimated error, True if every real part stays ≤ 0 with its error added, None otherwise
         (the estimate cannot tell; only the eigenvalues inside the disc are judged, as
         :attr:`RootLocus.stable` does)."""
-        re, bound = self.eigenvalues.real, self.error_bound
+        re, bound = self.eigenvalues.real, self.absolute_error
         if np.any(re - bound > 0):
             return False
         if np.all(re + bound <= 0):

@@ -61,7 +61,7 @@ def test_the_verdict_across_the_limit_is_the_eigen_analysis_one(known):
 def test_other_sliders_use_the_reduced_model_and_say_when_nothing_is_known(known):
     """A speed, wheel force or motor slope no computation has visited: the reduced model of the
     locus on screen gives the verdict (the eigen-analysis's) and the leading eigenvalue with its
-    error bound, without a dense solve.  A point with no cached result and no kept sweep (another
+    error estimate, without a dense solve.  A point with no cached result and no kept sweep (another
     rail condition, never computed) is not guessed: verdict None.  A computed point is exact."""
     N0, b_M, key, _ = known
     points = [(SET, RAIL, 0.005, 155.0, N0, b_M), (SET, RAIL, 0.005, V_KMH, 131.0, b_M),

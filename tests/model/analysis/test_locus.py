@@ -167,8 +167,8 @@ def test_a_negative_floor_is_refused():
 def test_a_kept_sweep_estimates_other_points_without_a_dense_solve(setup):
     """The reduced model of a kept sweep (over s0 at 120 km/h) gives the eigenvalues at points
     off the sweep — another creepage, speed, wheel force or motor slope — with no dense
-    eigendecomposition; each Ritz value inside the disc lies within its own error bound (plus
-    1e-9 1/s) of an eigenvalue of the deflated dense solution, and the verdict, where the bounds
+    eigendecomposition; each Ritz value inside the disc lies within its own error estimate (plus
+    1e-9 1/s) of an eigenvalue of the deflated dense solution, and the verdict, where the estimates
     decide it, is the dense one's.  A sweep that is not kept gives None."""
     from model.analysis.linear_system import dense_decompositions
     from model.analysis.locus import kept_sweep_estimate
@@ -187,11 +187,11 @@ def test_a_kept_sweep_estimates_other_points_without_a_dense_solve(setup):
         exact = eigen_analysis(model, point, vectors=False)
         assert estimate.basis_size > 0
         assert estimate.eigenvalues.size > 0
-        for value, bound in zip(estimate.eigenvalues, estimate.error_bound, strict=True):
+        for value, bound in zip(estimate.eigenvalues, estimate.absolute_error, strict=True):
             assert np.min(np.abs(exact.eigenvalues - value)) <= bound + 1e-9, (point, value)
         if estimate.stable is not None:
             decided += 1
             assert estimate.stable == exact.stable, point
-    assert decided >= 4  # the bounds are tight enough to decide away from the limit
+    assert decided >= 4  # the estimates are small enough to decide away from the limit
     assert dense_decompositions() > before  # the counter counts (the reference solves above)
     clear_sweep_starts()
