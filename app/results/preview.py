@@ -136,7 +136,7 @@ def preview(point: tuple, locus_key: tuple | None, dragged: str = "s0") -> Previ
                 stable, source = neighbours[0], LOCUS
             elif leading is not None:
                 stable, source = leading.real <= 0.0, INTERPOLATED
-    elif s0_limit is not None:
+    elif stable is None and s0_limit is not None:
         stable, source = False, ABOVE_LIMIT
     if stable is not None and leading is not None:
         return Preview(point, stable, source, s0_limit, lam, leading, leading_source, None, mu0)

@@ -96,3 +96,19 @@ def test_interpolation_along_the_branches():
     np.testing.assert_allclose(values, [-1.5 + 10.5j, -2 + 20j])
     assert between == (0.001, 0.003)
     assert stable == (True, False)
+
+
+def test_the_limit_alone_decides_where_no_locus_covers_the_point(monkeypatch):
+    """With s0*(v) known and no root locus through the point (none kept): stable below s0*,
+    unstable at or above it; the leading eigenvalue then comes from the reduced model, or none
+    is given."""
+    monkeypatch.setattr(compute, "known_point", lambda *args: None)
+    monkeypatch.setattr(compute, "known_locus", lambda *args: None)
+    monkeypatch.setattr(compute, "known_limit", lambda *args: compute.LimitResult(0.008, ""))
+    monkeypatch.setattr(compute, "reduced_estimate", lambda *args: None)
+    below = preview.preview((SET, RAIL, 0.0079, V_KMH, 100.0, 1000.0), None, "s0")
+    above = preview.preview((SET, RAIL, 0.008, V_KMH, 100.0, 1000.0), None, "s0")
+    assert (below.stable, below.source) == (True, preview.BELOW_LIMIT)
+    assert (above.stable, above.source) == (False, preview.ABOVE_LIMIT)
+    assert below.leading is None
+    assert below.s0_limit == 0.008
