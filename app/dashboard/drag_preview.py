@@ -9,8 +9,9 @@ what is known already, at most one reduced eigenproblem, never a dense eigen-ana
 previews of a session never queue: one runs at a time on the preview pool
 (:data:`app.services.thread_pools.PREVIEW_POOL`, below the first answers' priority) and only the
 newest value waits (:class:`app.services.thread_pools.LatestRequest`).  A release, a full answer
-or a rejection ends the drag: a preview still running is not shown.  A keyboard step sends both
-values at once and gets no preview, only its full answer.
+or a rejection ends the drag: a preview still running is not shown.  Previews start with a
+slider's second value before its release: a keyboard step sends one value and its release, and
+gets no preview, only its full answer.
 """
 
 from __future__ import annotations
@@ -27,9 +28,6 @@ from app.results.preview import PREVIEWED, Preview, describe, preview
 from app.services.thread_pools import PREVIEW_POOL, LatestRequest
 
 log = logging.getLogger(__name__)
-# a dragged value is previewed this long after it arrives [ms] (the newest one then): a keyboard
-# step's release, a few ms behind its value, arrives meanwhile and is not previewed
-PREVIEW_DELAY_MS = 25
 
 
 class DragPreview:
@@ -48,23 +46,29 @@ class DragPreview:
         self._saved_status: str | None = None  # the status the previews cover while shown
         self._preview_html = ""  # the status pane's text while a preview is shown
         self._waiting: tuple[str, float] | None = None  # the newest dragged value, not yet asked
+        self._moves = 0  # values sent since the last release
         self.shown = 0  # previews shown in this session (the browser test counts its own)
 
     def request(self, name: str, value) -> None:
         """A preview of the operating point with ``name`` (one of PREVIEWED) at the dragged
         ``value`` (display units); nothing if the value is the parameter's (a release or a
-        keyboard step: the full answer follows) or not a value the parameter takes.  Served, it
-        is decided :data:`PREVIEW_DELAY_MS` later, for the newest value then: a keyboard step
-        sends ``value`` and ``value_throttled`` a few milliseconds apart (on a loaded server
-        Panel handles them as two events), and its release comes first (no preview is
-        computed)."""
+        keyboard step: the full answer follows) or not a value the parameter takes.
+
+        Served, previews start with the second value a slider sends before its release: a
+        keyboard step sends one value and its release (a few milliseconds apart; on a loaded
+        server Panel may hand them on as two events), a drag sends a value per move.  The value
+        is taken up on the session's next tick (the newest one then), after a release that
+        arrived with it."""
         doc = served_document()
         if doc is None:
             self._request(None, name, value)
             return
+        self._moves += 1
+        if self._moves < 2:
+            return
         waiting, self._waiting = self._waiting, (name, value)
         if waiting is None:
-            doc.add_timeout_callback(partial(self._fire, doc), PREVIEW_DELAY_MS)
+            doc.add_next_tick_callback(partial(self._fire, doc))
 
     def _fire(self, doc) -> None:
         waiting, self._waiting = self._waiting, None
@@ -97,6 +101,7 @@ class DragPreview:
     def release(self) -> None:
         """The slider is let go (or stepped by a key): previews not yet shown are dropped."""
         self._drag += 1
+        self._moves = 0
         self._waiting = None
         self._requests.cancel()
 

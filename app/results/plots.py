@@ -216,15 +216,14 @@ class CreepPlot:
         self.curve = ColumnDataSource({"s": [], "mu": []})
         self.point = ColumnDataSource({"s": [], "mu": []})
         self.preview = ColumnDataSource({"s": [], "mu": []}, name="creep_preview")
-        curve = fig.line("s", "mu", source=self.curve, line_width=2, legend_label="μ(s, v)")
+        fig.line("s", "mu", source=self.curve, line_width=2, legend_label="μ(s, v)")
         fig.scatter("s", "mu", source=self.point, size=11, fill_color="#ff7f0e",
                     line_color="black", legend_label="operating point s0", level="overlay")
-        # the point and the preview on the overlay layer and out of the ranges' fit (the curve
-        # spans the point): an s0 step repaints them alone
+        # the point and the preview on the overlay layer: an s0 step repaints them alone (both
+        # lie inside the curve's span, so the ranges' fit does not move with them)
         fig.scatter("s", "mu", source=self.preview, size=11, fill_color="#ff7f0e",
                     fill_alpha=0.35, line_color="#ff7f0e", line_dash="dashed",
                     legend_label="preview (slider held)", level="overlay")
-        fig.x_range.renderers = fig.y_range.renderers = [curve]
         self.limit = Span(location=0.0, dimension="height", line_color=UNSTABLE,
                           line_dash="dashed", line_width=2, visible=False)
         self.maximum = Span(location=0.0, dimension="height", line_color="#777777",
