@@ -127,8 +127,7 @@ class RootLocusPlot:
                             color={"field": "value", "transform": self.mapper}, line_alpha=0.0)
         # the point's markers and a held slider's preview on the overlay layer: a new point
         # repaints them alone, not the thousands of the sweep's points and lines (a repaint of
-        # the whole plot per preview held a loaded browser ≈ 0.15 s each; per s0 step the
-        # browser's CPU went from 0.42-0.44 to 0.33-0.34 s)
+        # the whole plot per preview made a dragged handle lag behind the mouse)
         now = fig.scatter("x", "y", source=self.current, size=13, marker="diamond",
                           fill_color="#ff7f0e", line_color="black", legend_label="current point",
                           level="overlay")
