@@ -335,17 +335,17 @@ class RitzEstimate:
 
 def kept_sweep_estimate(model: BogieModel, op: OperatingPoint, first: OperatingPoint,
                         last: OperatingPoint, max_frequency_hz: float = 20.0,
-                        lambda_floor: float = 0.0) -> RitzEstimate | None:
+                        lambda_floor: float = 0.0, select=None) -> RitzEstimate | None:
     """The eigenvalues at ``op`` (any s0, v, N0, b_M) from the reduced model of the kept start of
-    a :func:`root_locus` sweep from ``first`` to ``last`` with the same ``max_frequency_hz``, or
-    None if no such sweep start is kept: one small eigenproblem and the residuals of its Ritz
+    a :func:`root_locus` sweep from ``first`` to ``last`` with the same ``max_frequency_hz`` and
+    ``select``, or None if no such sweep start is kept: one small eigenproblem and the residuals of its Ritz
     pairs in the full model, never a dense solve (a preview while a slider is dragged).  The
     basis holds the modes at the sweep's ends and middle; away from the sweep the error
     estimates grow and :attr:`RitzEstimate.stable` says when they no longer decide the verdict.
     ``lambda_floor`` [1/s]: errors relative to max(|λ|, floor)."""
     radius = 2 * np.pi * max_frequency_hz
     with _SWEEP_STARTS_LOCK:
-        start = _SWEEP_STARTS.get(_sweep_start_key(model, first, last, radius))
+        start = _SWEEP_STARTS.get(_sweep_start_key(model, first, last, radius, select))
     if start is None or start.model is not model:
         return None
     reduced = start.reduced
