@@ -4,12 +4,15 @@
 
 Starts ``bogie serve`` on a free port (a separate process, as users run it), then:
 
-1. single session: keyboard steps on the s0 slider handle (each a new value, so no cache
+1. single session: keyboard steps (PageUp: 0.0005) on the s0 slider handle (each a new value, so no cache
    hit); latency = key press → the browser holds new eigenvalues (root-locus current point)
    *and* new time histories (both must have changed; the status is sent with the eigenvalues).
    The steps follow each other at once (the next key press as soon as the previous result is
    in: a held arrow key); ``--isolated`` more steps are each taken after the session is idle
    (1 b: a reviewer moves a slider and looks);
+1 c. ``--drags``: on a page of its own, the s0 handle dragged with the mouse from 0.005 to
+   0.012 and back, 2 s each way (40 moves): the previews the status shows while the button is
+   held (app.dashboard.drag_preview), their number and rate;
 2. root-locus refresh: keyboard steps on the speed slider (new v → new s0*(v) and a new locus
    over s0); latency = key press → new (coarse, 25-point) locus branches in the browser, and
    key press → the dense 200-point locus has replaced it (its title no longer says
@@ -49,6 +52,9 @@ import served_app  # noqa: E402 - the scripts' own helpers
 from served_app import free_port  # noqa: E402 - also used by bench_nonlinear_app
 
 CHROMIUM = "/usr/bin/chromium"
+# an s0 step: PageUp moves the slider by five of its 0.0001 steps, 0.0005, the values the
+# benchmarks have always stepped through (0.005, 0.0055, … across s0* ≈ 0.0082 at 120 km/h)
+S0_KEY = "PageUp"
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 # the probe runs every 5 ms on the page's main thread while a step is measured, beside the work
@@ -150,6 +156,57 @@ async def wait_settled(page) -> None:
                                  timeout=300_000)
     await page.get_by_text("s0*(v): computing").first.wait_for(state="hidden", timeout=300_000)
     await asyncio.sleep(1.0)
+
+
+# JS: record every text of the status pane with its time [ms] (the previews of a held slider)
+WATCH_STATUS = """() => { const doc = Bokeh.documents[0];
+  const status = [...doc.all_models].find(m => (m.css_classes || []).includes('stability-status'));
+  window.statusLog = [];
+  status.properties.text.change.connect(() => window.statusLog.push([performance.now(), status.text]));
+}"""
+DRAG_S0 = (0.005, 0.012)  # the drag of s0 at 120 km/h, across s0* ≈ 0.0082 [-]
+DRAG_SECONDS, DRAG_MOVES = 2.0, 40
+
+
+async def drag_s0(page, start: float, end: float) -> tuple[int, float]:
+    """Drag the s0 handle with the mouse from ``start`` to ``end`` in DRAG_MOVES moves over
+    DRAG_SECONDS, hold it 0.4 s, release, wait for the full answer: (previews the status showed
+    while the button was held, their rate [1/s] from the first to the last)."""
+    low, high = await page.evaluate(
+        "() => { const m = [...Bokeh.documents[0].all_models].find(m => (m.css_classes || [])"
+        ".includes('ctl-s0')); return [m.start, m.end]; }")
+    track = await page.locator(".ctl-s0 .noUi-base").bounding_box()
+    handle = await page.locator(".ctl-s0 .noUi-handle").bounding_box()
+    x_of = lambda s0: track["x"] + (s0 - low) / (high - low) * track["width"]  # noqa: E731
+    y = handle["y"] + handle["height"] / 2
+    await page.evaluate("() => { window.statusLog.length = 0; }")
+    await page.mouse.move(handle["x"] + handle["width"] / 2, y)
+    await page.mouse.down()
+    t0 = time.perf_counter()
+    for k in range(1, DRAG_MOVES + 1):
+        await page.mouse.move(x_of(start + (end - start) * k / DRAG_MOVES), y)
+        await asyncio.sleep(max(0.0, t0 + DRAG_SECONDS * k / DRAG_MOVES - time.perf_counter()))
+    await asyncio.sleep(0.4)
+    times = [t for t, text in await page.evaluate("() => window.statusLog") if "preview" in text]
+    await page.mouse.up()
+    await page.wait_for_function("() => window.statusLog.length && "
+                                 "!window.statusLog.at(-1)[1].includes('preview')", timeout=120_000)
+    rate = (len(times) - 1) / ((times[-1] - times[0]) / 1e3) if len(times) > 1 else 0.0
+    return len(times), rate
+
+
+async def drags(browser, url: str, count: int) -> list[tuple[int, float]]:
+    """``count`` drags of s0 on a page of its own (the default point, 120 km/h), there and back,
+    after its s0*(v) and dense root locus are on screen."""
+    page = await open_page(browser, url)
+    await wait_settled(page)
+    await page.evaluate(WATCH_STATUS)
+    out = []
+    for k in range(count):
+        out.append(await drag_s0(page, *(DRAG_S0 if k % 2 == 0 else DRAG_S0[::-1])))
+        await asyncio.sleep(1.0)
+    await page.close()
+    return out
 
 
 async def settle_n0(page, presses: int) -> None:
@@ -275,7 +332,7 @@ async def session(page, seed: int, presses: int) -> list[float]:
     out = []
     for _ in range(presses):
         await asyncio.sleep(rng.uniform(0.3, 1.5))
-        out.append(await step(page, "ctl-s0", "ArrowRight", FAST))
+        out.append(await step(page, "ctl-s0", S0_KEY, FAST))
     return out
 
 
@@ -349,13 +406,13 @@ async def run(args) -> dict:
             await settle_n0(page, 1)
             await wait_settled(page)
             log("single session: s0 steps, then speed steps")  # own N0 = 99 kN: nothing cached from earlier runs
-            fast = [await step(page, "ctl-s0", "ArrowRight", FAST) for _ in range(args.presses)]
+            fast = [await step(page, "ctl-s0", S0_KEY, FAST) for _ in range(args.presses)]
             # the same steps one at a time: each after the previous one's work is done (its
             # s0*, locus, ranges and drawing), as a reviewer moves a slider and looks
             isolated = []
             for _ in range(args.isolated):
                 await wait_idle(page)
-                isolated.append(await step(page, "ctl-s0", "ArrowRight", FAST))
+                isolated.append(await step(page, "ctl-s0", S0_KEY, FAST))
             results["single_isolated_s"] = isolated
             speeds = [await speed_step(page) for _ in range(args.locus_presses)]
             results["single_fast_s"] = fast
@@ -363,6 +420,9 @@ async def run(args) -> dict:
             results["dense_locus_s"] = [dense for _, dense in speeds]
             results["errors_single"] = list(page.errors)
             await page.close()
+            if args.drags:
+                log(f"single session: {args.drags} drags of s0 (previews)")
+                results["drags"] = await drags(browser, url, args.drags)
             # 3: concurrent sessions, each with its own N0 (no shared cache hits)
             if args.sessions == 0:
                 return results
@@ -451,6 +511,9 @@ def main() -> None:
     parser.add_argument("--isolated", type=int, default=5,
                         help="s0 steps each after the session is idle (1 b)")
     parser.add_argument("--locus-presses", type=int, default=5)
+    parser.add_argument("--drags", type=int, default=4,
+                        help="mouse drags of s0 from 0.005 to 0.012 and back over 2 s each "
+                             "(1 c: the previews while the handle is held)")
     parser.add_argument("--sessions", type=int, default=10)
     parser.add_argument("--concurrent-presses", type=int, default=5)
     parser.add_argument("--mixed-presses", type=int, default=20,
@@ -487,6 +550,12 @@ def main() -> None:
     dense = results["dense_locus_s"]
     print(f"dense root locus (200 points) after a speed change: median "
           f"{statistics.median(dense) * 1e3:.0f} ms (n = {len(dense)}, max {max(dense) * 1e3:.0f})")
+    if results.get("drags"):
+        counts = [n for n, _ in results["drags"]]
+        rates = [r for _, r in results["drags"]]
+        print(f"s0 dragged 0.005 <-> 0.012 over 2 s: previews before the release median "
+              f"{statistics.median(counts):.0f} (min {min(counts)}), "
+              f"{statistics.median(rates):.1f} per second (min {min(rates):.1f}; n = {len(rates)})")
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1))
     errors = results["errors_single"] + results.get("errors_mixed", [])

@@ -5,7 +5,7 @@ nonlinear result on screen ≤ 1.5 s after a change, median; the linear path sti
 
 Starts ``bogie serve`` (helpers of ``scripts/bench_app.py``), opens one headless Chromium page,
 switches the creep model to nonlinear, settles on its own wheel force (nothing cached), then
-presses keyboard steps on the s0 slider.  Per press, two latencies from the key press: until the
+presses keyboard steps (PageUp: 0.0005) on the s0 slider.  Per press, two latencies from the key press: until the
 linear result is in the browser (new eigenvalues and new linear time histories, as
 ``bench_app.py`` measures) and until the nonlinear histories have changed too.  Prints medians
 and the single values; the machine is shared (say so when quoting).
@@ -23,12 +23,24 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import served_app
-from bench_app import ARGS, CHROMIUM, DATA, FAST, free_port, log, open_page, settle_n0, start_server, wait_settled
+from bench_app import (
+    ARGS,
+    CHROMIUM,
+    DATA,
+    FAST,
+    S0_KEY,
+    free_port,
+    log,
+    open_page,
+    settle_n0,
+    start_server,
+    wait_settled,
+)
 
 NONLINEAR = f"() => ({DATA})('nonlinear', 'y:ID1.disc_clutch.torque')"
 
 
-async def press(page, key: str = "ArrowRight", timeout: float = 120_000) -> tuple[float, float]:
+async def press(page, key: str = S0_KEY, timeout: float = 120_000) -> tuple[float, float]:
     """(seconds to the linear result, seconds to the nonlinear result) of one s0 step."""
     fast_before = (await page.evaluate(FAST)).split("|")
     slow_before = await page.evaluate(NONLINEAR)

@@ -58,6 +58,7 @@ SERVED_MODULES = {
     "tests/app/dashboard/test_dashboard.py",
     "tests/app/dashboard/test_dashboard_browser.py",
     "tests/app/dashboard/test_design_loads_browser.py",
+    "tests/app/dashboard/test_drag_preview_browser.py",
     "tests/app/dashboard/test_nonlinear_view_browser.py",
     "tests/app/dashboard/test_resonance_browser.py",
     "tests/app/dashboard/test_review_browser.py",

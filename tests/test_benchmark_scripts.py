@@ -31,6 +31,7 @@ ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
                  "ds0*/dp at known s0*", id="sensitivity"),
     pytest.param("bench_resonance.py", ["--speeds", "12", "--points", "200", "--repeat", "1"],
                  "Campbell diagram, 12 speeds", id="resonance"),
+    pytest.param("bench_preview.py", ["--quick"], "| b_M (reduced model) |", id="preview"),
 ])
 def test_benchmark_script_runs(script, arguments, expected):
     run = subprocess.run([sys.executable, str(ROOT / "scripts" / script), *arguments], cwd=ROOT,

@@ -2,7 +2,9 @@
 the creep model and the downloads.
 
 Controls are built per dashboard (never shared class attributes) and write into its parameters
-on ``value_throttled`` (slider release / keyboard step), so a drag triggers one computation.  Each
+on ``value_throttled`` (slider release / keyboard step), so a drag triggers one computation; while
+an operating-point slider is held, its ``value`` asks for a preview
+(:mod:`app.dashboard.drag_preview`).  Each
 control has a CSS class (``ctl-<parameter>``, ``case-stable``/``case-unstable``): Panel puts the
 label into the Bokeh model's title, and tests and scripts find the controls by their class.
 """
@@ -13,12 +15,14 @@ from functools import partial
 
 import panel as pn
 
+from app.results.preview import PREVIEWED
+
 PUBLISHED_SPEED_KMH = 120.0  # the speed of the study's two published cases [km/h]
 PUBLISHED_CASES = {"stable": 0.005, "unstable": 0.014}  # their creepage s0 [-]
 
 # parameter -> (label with unit, step, number format)
 SLIDERS = {
-    "s0": ("creepage s0 [-]", 0.0005, "0.0000"),
+    "s0": ("creepage s0 [-]", 0.0001, "0.0000"),
     "v": ("speed v [km/h]", 5.0, "0"),
     "N0": ("wheel force N0 [kN]", 1.0, "0"),
     "b_M": ("motor slope b_M [N m s/rad]", 100.0, "0"),
@@ -43,8 +47,9 @@ class ControlSlider(pn.widgets.FloatSlider):
 class Controls:
     """The controls column of one dashboard (``column``); ``sliders``: parameter -> slider.
 
-    ``dashboard``: its parameters (:data:`SLIDERS`, ``dt_auto``, ``rail``), ``warn(text)`` and
-    ``show_published_case(s0)``; ``creep_controls``: the nonlinear view's controls;
+    ``dashboard``: its parameters (:data:`SLIDERS`, ``dt_auto``, ``rail``), ``state()``,
+    ``warn(text)``, ``run_locked(function)``, ``show_published_case(s0)`` and ``drag_preview``
+    (:class:`app.dashboard.drag_preview.DragPreview`); ``creep_controls``: the nonlinear view's controls;
     ``downloads``: the download buttons."""
 
     def __init__(self, dashboard, creep_controls: list, downloads: list):
@@ -81,6 +86,9 @@ class Controls:
                                value=getattr(dashboard, name), format=fmt,
                                css_classes=[f"ctl-{name}"], sizing_mode="stretch_width")
         widget.param.watch(partial(self._set_control, name), "value_throttled")
+        if name in PREVIEWED:  # the operating point: a preview follows the held slider
+            widget.param.watch(lambda event: dashboard.drag_preview.request(name, event.new),
+                               "value")
         dashboard.param.watch(lambda event: setattr(widget, "value", event.new), name)
         return widget
 
@@ -88,7 +96,12 @@ class Controls:
         """A slider's released value into the parameter; a value the parameter refuses (out
         of its bounds, NaN, not a number: only a doctored client sends one) gives a notice and
         changes nothing."""
+        dashboard = self.dashboard
+        dashboard.drag_preview.release()
+        before = dashboard.state()
         try:
-            setattr(self.dashboard, name, event.new)
+            setattr(dashboard, name, event.new)
         except (ValueError, TypeError) as error:
-            self.dashboard.warn(f"{name}: value {str(event.new)[:40]} not used: {str(error)[:200]}")
+            dashboard.warn(f"{name}: value {str(event.new)[:40]} not used: {str(error)[:200]}")
+        if dashboard.state() == before:  # nothing to compute: the preview goes at once
+            dashboard.run_locked(dashboard.drag_preview.end)

@@ -36,6 +36,7 @@ from app.dashboard import layout
 from app.dashboard.controls import PUBLISHED_SPEED_KMH, Controls
 from app.dashboard.design_loads_view import DesignLoadsView
 from app.dashboard.downloads import Downloads
+from app.dashboard.drag_preview import DragPreview
 from app.dashboard.modes_view import ModeClickThrough
 from app.dashboard.nonlinear_view import NonlinearView
 from app.dashboard.panel_fixes import skip_detached_markup_models
@@ -43,7 +44,7 @@ from app.dashboard.resonance_view import ResonanceView
 from app.dashboard.scheduler import Scheduler
 from app.dashboard.sensitivity_view import SensitivityView
 from app.dashboard.session import post, run_locked, served_document, session_query
-from app.dashboard.stages import State
+from app.dashboard.stages import State, key_value
 from app.dashboard.studies_view import StudiesView
 from app.dashboard.url_state import make_query, parse_query
 from app.dashboard.variant_view import VariantView
@@ -155,6 +156,8 @@ class BogieDashboard(pn.viewable.Viewer):
         self.mode_plot = ModeShapePlot(m.positions, m.parameters["wheel_radius"])
         self.nonlinear = NonlinearView(self)  # creep model, anti-slip, overlays
         self.status = layout.html_pane("", css_classes=["stability-status"])
+        # a dragged operating-point slider's preview on the status and the markers
+        self.drag_preview = DragPreview(self)
         self.details = layout.html_pane("")
         self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
                                     css_classes=["model-notice"], sizing_mode="stretch_width")
@@ -233,8 +236,9 @@ class BogieDashboard(pn.viewable.Viewer):
     def state(self) -> State:
         """The parameters as the primitives a computation depends on (:mod:`app.dashboard.stages`)."""
         rnd = lambda x, n=6: float(round(x, n))  # noqa: E731 - cache keys without float noise
-        return State(self.set_key, self.rail, rnd(self.s0, 7), rnd(self.v, 3),
-                     rnd(self.N0, 3), rnd(self.b_M, 3), rnd(self.M0, 3), rnd(self.f, 3),
+        return State(self.set_key, self.rail, key_value("s0", self.s0), key_value("v", self.v),
+                     key_value("N0", self.N0), key_value("b_M", self.b_M), rnd(self.M0, 3),
+                     rnd(self.f, 3),
                      rnd(self.D, 5), None if self.dt_auto else rnd(self.dt, 4), rnd(self.t_end, 3),
                      self.locus)
 
@@ -326,6 +330,7 @@ class BogieDashboard(pn.viewable.Viewer):
     def show_fast(self, state: State, fast) -> None:
         """Show the first answer ``(point result, response result)`` for ``state``."""
         point, response = fast
+        self.drag_preview.end()
         self.point, self.response, self.error = point, response, ""
         self.notice.visible = False
         self.locus_plot.update_point(point)
@@ -414,6 +419,7 @@ class BogieDashboard(pn.viewable.Viewer):
     def reject(self, error: Exception) -> None:
         """The model rejects the parameters: say why, keep the last valid results on screen."""
         message = error.args[0] if error.args else str(error)
+        self.drag_preview.end()
         self.error = str(message)
         self.notice.object = (f"**The model rejects this combination:** {html.escape(str(message))}"
                               " — showing the last valid result.")

@@ -31,6 +31,10 @@ CSS = """
 .verdict-box {font-size: 20px; margin-top: 6px; color: #222} .verdict-box.green {background: #c8e6c9}
 .verdict-box.amber {background: #ffe0b2} .verdict-box.red {background: #ffcdd2}
 .verdict-box.pending {background: #eeeeee; font-size: 14px}
+.status-box.unknown {background: #888888}
+.status-box.preview {opacity: 0.5; border: 2px dashed #333; font-size: 24px}
+.status-box .preview-tag {display: block; font-size: 11px; font-weight: 400; letter-spacing: 0}
+.preview-text {font-size: 12px; line-height: 1.4; color: #444; padding-top: 3px}
 table.bogie {border-collapse: collapse; font-size: 12px; width: 100%}
 table.bogie th, table.bogie td {border-bottom: 1px solid #ddd; padding: 2px 6px; text-align: right}
 table.bogie td.text, table.bogie th.text {text-align: left}

@@ -25,6 +25,13 @@ from model import NoStabilityLimit, OperatingPointError, ParameterError
 
 MODEL_ERRORS = (OperatingPointError, ParameterError, NoStabilityLimit, ValueError,
                 np.linalg.LinAlgError)
+# decimals of each operating-point quantity in the cache keys (no float noise in the keys)
+KEY_DIGITS = {"s0": 7, "v": 3, "N0": 3, "b_M": 3}
+
+
+def key_value(name: str, value: float) -> float:
+    """``value`` of the operating-point quantity ``name`` as the cache keys hold it."""
+    return float(round(value, KEY_DIGITS[name]))
 
 
 @dataclass(frozen=True)

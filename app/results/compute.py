@@ -10,11 +10,15 @@ results for plotting.  Units: SI, except where a name says otherwise (``v_kmh`` 
 from __future__ import annotations
 
 import math
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
 import panel as pn
 
+from app.results.locus_geometry import locus_jumps, refine_grid
+from app.results.mode_drawing import point_displacements
 from model import (
     KMH,
     NoStabilityLimit,
@@ -39,13 +43,6 @@ LOCUS_MAX_HZ = 20.0  # branches tracked up to this frequency [Hz]
 LOCUS_LAMBDA_FLOOR = 1.0  # [1/s]
 LOCUS_POINTS = 25  # points of the coarse root-locus sweep (shown first, brackets s0*)
 LOCUS_DENSE_POINTS = 200  # points of the dense sweep that replaces it
-LOCUS_UNIFORM_SHARE = 0.3  # share of the dense points spread evenly (the rest follow the motion)
-LOCUS_JUMP_FACTOR = 2.5  # a step this many times as fast as both neighbouring steps is a jump
-LOCUS_JUMP_MIN = 0.5  # ... and longer than this in plot units (Re [1/s], Im [Hz]): line broken
-LOCUS_JUMP_LONG = 0.04  # a step longer than this share of the plot (Re and Im spans of the
-LOCUS_JUMP_SIDE = 1.5  # sweep) is a jump already when it is this many times as fast as one
-# neighbouring step: a branch accelerating into a collision of eigenvalues (steps 10, 16, 50,
-# then 5 [1/s]) is not resolved by any grid
 LOCUS_S0 = (0.001, 0.02)  # s0 range of the creepage sweep [-]
 LIMIT_XTOL = 1e-6  # s0*(v) to 1e-6 (shown with 5 decimals)
 LOCUS_V_KMH = (40.0, 200.0)  # speed range of the speed sweep [km/h]
@@ -77,6 +74,34 @@ RAINFLOW_BINS = 24  # bins of the rainflow matrix along the range and the mean
 
 class ModelRejected(ValueError):
     """A parameter combination the model rejects (message shown to the user)."""
+
+
+class Known:
+    """The results a cached function has computed, by its arguments, looked up without
+    computing anything (a dragged slider's preview asks only what is known).  Bounded like the
+    function's own cache; thread-safe."""
+
+    def __init__(self, size: int):
+        self.size = size
+        self._results: OrderedDict = OrderedDict()
+        self._lock = threading.Lock()
+
+    def remember(self, key: tuple, result) -> None:
+        with self._lock:
+            self._results[key] = result
+            self._results.move_to_end(key)
+            while len(self._results) > self.size:
+                self._results.popitem(last=False)
+
+    def get(self, key: tuple):
+        """The result for ``key`` if it was computed (and is still kept), else None."""
+        with self._lock:
+            return self._results.get(key)
+
+
+_KNOWN_POINTS = Known(256)  # point_result by its arguments
+_KNOWN_LIMITS = Known(128)  # limit_result by its arguments
+_KNOWN_LOCI = Known(128)  # locus_result / dense_locus_result by (arguments, dense)
 
 
 # --- model -----------------------------------------------------------------------------------
@@ -144,61 +169,6 @@ class PointResult:
     M_ad: float  # maximal adhesion moment 2 N0 r0 μ_max [N m]
 
 
-def drawing_owner(model_, point: str) -> tuple[str, bool]:
-    """(body whose coordinates move ``point``, whether the point has its own translations)."""
-    names = set(model_.dofs.names)
-    if f"{point}.x" in names:
-        return point, True
-    if point.startswith("secondary."):
-        return "BF", False
-    drive = point.split(".")[0]
-    return f"{drive}.stator", False
-
-
-def _point_displacements_direct(model_, q: np.ndarray) -> dict[str, np.ndarray]:
-    """:func:`point_displacements` point by point (u + θ × r for points carried by a body);
-    used once per model to build the linear map, and by the test that checks the map."""
-    index = {name: i for i, name in enumerate(model_.dofs.names)}
-    out: dict[str, np.ndarray] = {}
-    for point, position in model_.positions.items():
-        if point == "CB":  # longitudinal and vertical (its yaw turns it about its own point)
-            out[point] = np.array([q[index["CB.x"]].real, 0.0, q[index["CB.z"]].real])
-            continue
-        owner, own = drawing_owner(model_, point)
-        u = np.array([q[index[f"{owner}.{a}"]].real for a in ("x", "y", "z")])
-        theta = np.array([q[index[f"{owner}.{a}"]].real for a in ("rx", "ry", "rz")])
-        if not own:
-            u = u + np.cross(theta, np.asarray(position) - model_.positions[owner])
-        out[point] = u
-    return out
-
-
-def _displacement_map(model_) -> tuple[list[str], np.ndarray]:
-    """(drawn points, D) with the translations of all points = D Δq (3·points x n), built once
-    per model from the kinematics above (it is linear in Δq)."""
-    cached = model_.__dict__.get("_displacement_map")
-    if cached is None:
-        names = list(model_.positions)
-        columns = []
-        for j in range(model_.n):
-            unit = np.zeros(model_.n)
-            unit[j] = 1.0
-            moved = _point_displacements_direct(model_, unit)
-            columns.append(np.concatenate([moved[name] for name in names]))
-        cached = (names, np.array(columns).T)
-        model_.__dict__["_displacement_map"] = cached
-    return cached
-
-
-def point_displacements(model_, q: np.ndarray) -> dict[str, np.ndarray]:
-    """Real translation (x, y, z) [m per unit mode amplitude] of every drawn point of
-    ``model.positions`` for the displacement vector Δq (rigid-body kinematics for points carried
-    by a body: u + θ × r)."""
-    names, D = _displacement_map(model_)
-    moved = (D @ np.real(q)).reshape(len(names), 3)
-    return dict(zip(names, moved, strict=True))
-
-
 @pn.cache(max_items=256)
 def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
                  b_M: float) -> PointResult:
@@ -217,13 +187,22 @@ def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: fl
     law = creep_law(m.parameters, op.N0)
     s_max, mu_max = law.maximum(op.v)
     s_grid = np.linspace(0.0, max(0.03, 1.5 * op.s0), 301)
-    return PointResult(
+    point = PointResult(
         key=(params_path, rail, s0, v_kmh, N0_kN, b_M), eigenvalues=result.eigenvalues,
         stable=result.stable, max_real_part=result.max_real_part, flutter=result.flutter,
         divergence=result.divergence, n_rigid=result.n_rigid, modes=modes,
         real=result.real[:N_REAL_TABLE], creep_s=s_grid, creep_mu=np.asarray(law.mu(s_grid, op.v)),
         mu0=float(law.mu(op.s0, op.v)), s_max=s_max, mu_max=mu_max,
         M_ad=adhesion_moment(m.parameters, op.v, op.N0))
+    _KNOWN_POINTS.remember(point.key, point)
+    return point
+
+
+def known_point(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                b_M: float) -> PointResult | None:
+    """:func:`point_result` of these arguments if it has been computed, else None (nothing is
+    computed)."""
+    return _KNOWN_POINTS.get((params_path, rail, s0, v_kmh, N0_kN, b_M))
 
 
 @pn.cache(max_items=64)
@@ -269,9 +248,18 @@ def limit_result(params_path: str, rail: str, v_kmh: float, N0_kN: float,
     try:
         limit = stability_limit(m, v_kmh * KMH, N0_kN * 1e3, b_M, s0_low=LOCUS_S0[0] / 2,
                                 xtol=LIMIT_XTOL, bracket=bracket)
+        result = LimitResult(limit.s0_limit, "")
     except NoStabilityLimit as error:
-        return LimitResult(None, str(error))
-    return LimitResult(limit.s0_limit, "")
+        result = LimitResult(None, str(error))
+    _KNOWN_LIMITS.remember((params_path, rail, v_kmh, N0_kN, b_M), result)
+    return result
+
+
+def known_limit(params_path: str, rail: str, v_kmh: float, N0_kN: float,
+                b_M: float) -> LimitResult | None:
+    """:func:`limit_result` of these arguments if it has been computed, else None (nothing is
+    computed)."""
+    return _KNOWN_LIMITS.get((params_path, rail, v_kmh, N0_kN, b_M))
 
 
 # --- root locus --------------------------------------------------------------------------------
@@ -321,7 +309,9 @@ def locus_result(params_path: str, rail: str, parameter: str, fixed: float, N0_k
     """The coarse sweep (LOCUS_POINTS evenly spaced): tracked branches over s0 (at speed
     ``fixed`` [km/h]) or over v (at creepage ``fixed``).  Shown first; brackets s0*(v)."""
     shown = np.linspace(*_sweep_range(parameter), LOCUS_POINTS)
-    return _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=False)
+    locus = _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=False)
+    _KNOWN_LOCI.remember((params_path, rail, parameter, fixed, N0_kN, b_M, False), locus)
+    return locus
 
 
 @pn.cache(max_items=64)
@@ -331,83 +321,35 @@ def dense_locus_result(params_path: str, rail: str, parameter: str, fixed: float
     (:func:`refine_grid`); replaces the coarse one on screen."""
     coarse = locus_result(params_path, rail, parameter, fixed, N0_kN, b_M)
     shown = refine_grid(coarse.values, coarse.eigenvalues, LOCUS_DENSE_POINTS)
-    return _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=True)
+    locus = _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=True)
+    _KNOWN_LOCI.remember((params_path, rail, parameter, fixed, N0_kN, b_M, True), locus)
+    return locus
 
 
-def _step_lengths(eigenvalues: np.ndarray, re_unit: float, im_unit: float) -> np.ndarray:
-    """(n_points - 1, n_branches) step lengths of the branches, Re counted in ``re_unit`` and
-    Im in ``im_unit`` [1/s]."""
-    steps = np.diff(eigenvalues, axis=0)
-    return np.hypot(steps.real / re_unit, steps.imag / im_unit)
+def known_locus(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
+                b_M: float) -> LocusResult | None:
+    """The dense root locus of these arguments if it has been computed, else the coarse one,
+    else None (nothing is computed)."""
+    key = (params_path, rail, parameter, fixed, N0_kN, b_M)
+    return _KNOWN_LOCI.get((*key, True)) or _KNOWN_LOCI.get((*key, False))
 
 
-def _plot_shares(eigenvalues: np.ndarray) -> np.ndarray:
-    """Step lengths as shares of the plot: Re and Im divided by the sweep's spans of Re and Im
-    (the axes' extent when the whole sweep is shown)."""
-    finite = eigenvalues[np.isfinite(eigenvalues)]
-    spans = [np.ptp(part) if finite.size and np.ptp(part) > 0 else 1.0
-             for part in (finite.real, finite.imag)]
-    return _step_lengths(eigenvalues, *spans)
+def reduced_estimate(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
+                     b_M: float, point: tuple):
+    """The eigenvalues at ``point`` = (s0, v_kmh, N0_kN, b_M) from the reduced model of the
+    root locus of the other arguments (:func:`model.analysis.locus.kept_sweep_estimate`: one
+    small eigenproblem, no dense solve), or None if that sweep's start is not kept."""
+    from model.analysis.locus import kept_sweep_estimate
 
-
-def _plot_steps(eigenvalues: np.ndarray) -> np.ndarray:
-    """Step lengths in plot units (Re [1/s], Im [Hz])."""
-    return _step_lengths(eigenvalues, 1.0, 2 * math.pi)
-
-
-def refine_grid(values: np.ndarray, eigenvalues: np.ndarray, n_points: int) -> np.ndarray:
-    """``n_points`` parameter values from values[0] to values[-1], denser where the branches of
-    a coarse sweep (``eigenvalues`` at ``values``) move fast: each coarse interval gets a share
-    LOCUS_UNIFORM_SHARE / intervals of the points plus a share of the rest proportional to the
-    largest distance any branch travels across it on the plot (Re [1/s], Im [Hz])."""
-    values = np.asarray(values, dtype=float)
-    intervals = len(values) - 1
-    motion = np.nan_to_num(_plot_steps(eigenvalues).max(axis=1)) if eigenvalues.size else \
-        np.zeros(intervals)
-    weight = np.full(intervals, LOCUS_UNIFORM_SHARE / intervals)
-    if motion.sum() > 0:
-        weight += (1.0 - LOCUS_UNIFORM_SHARE) * motion / motion.sum()
+    m = model(params_path, rail)
+    low, high = _sweep_range(parameter)
+    if parameter == "s0":
+        ends = [operating_point(params_path, rail, x, fixed, N0_kN, b_M) for x in (low, high)]
     else:
-        weight = np.full(intervals, 1.0 / intervals)
-    steps = np.maximum(1, np.floor(weight / weight.sum() * (n_points - 1)).astype(int))
-    while steps.sum() < n_points - 1:  # hand the rounding remainder to the busiest intervals
-        steps[np.argmax(weight / steps)] += 1
-    pieces = [np.linspace(values[i], values[i + 1], steps[i] + 1)[:-1] for i in range(intervals)]
-    return np.concatenate([*pieces, values[-1:]])
-
-
-def locus_jumps(values: np.ndarray, eigenvalues: np.ndarray) -> np.ndarray:
-    """Steps that are jumps (a branch meeting another one and turning, or moving faster than the
-    grid resolves): per unit of the swept parameter, more than LOCUS_JUMP_FACTOR times as fast
-    as in both neighbouring steps of the same branch, and longer than LOCUS_JUMP_MIN plot units
-    (Re [1/s], Im [Hz]); or longer than LOCUS_JUMP_LONG of the plot (Re and Im measured in
-    shares of the sweep's spans, as they appear on the plot) and more than LOCUS_JUMP_SIDE times
-    as fast as one of its neighbouring steps (a branch accelerating into a collision with
-    another one grows its steps geometrically, 10, 16, 50 [1/s], and no grid resolves the last
-    ones).  The plots break the line there instead of drawing a straight segment across the
-    plane; the points themselves stay."""
-    steps = _plot_steps(eigenvalues)
-    if len(steps) < 3:
-        return np.zeros(steps.shape, dtype=bool)
-    rate = steps / np.diff(np.asarray(values, dtype=float))[:, None]
-    before = np.vstack([rate[1:2], rate[:-1]])  # the first / last step: their only neighbour
-    after = np.vstack([rate[1:], rate[-2:-1]])
-    both = (rate > LOCUS_JUMP_FACTOR * np.maximum(before, after)) & (steps > LOCUS_JUMP_MIN)
-    one = (rate > LOCUS_JUMP_SIDE * np.minimum(before, after)) & \
-        (_plot_shares(eigenvalues) > LOCUS_JUMP_LONG)
-    return both | one
-
-
-def broken_columns(series: np.ndarray, jumps: np.ndarray | None) -> list[np.ndarray]:
-    """One float array per branch (column of ``series``, (n_points, n_branches) real) with NaN
-    inserted at its jumps: Bokeh breaks a line at NaN."""
-    out = []
-    for b in range(series.shape[1]):
-        y = np.asarray(series[:, b], dtype=float)
-        if jumps is not None and jumps[:, b].any():
-            y = np.insert(y, np.flatnonzero(jumps[:, b]) + 1, np.nan)
-        out.append(np.ascontiguousarray(y))
-    return out
+        ends = [operating_point(params_path, rail, fixed, x, N0_kN, b_M) for x in (low, high)]
+    op = operating_point(params_path, rail, *point)
+    return kept_sweep_estimate(m, op, *ends, max_frequency_hz=LOCUS_MAX_HZ,
+                               lambda_floor=LOCUS_LAMBDA_FLOOR)
 
 
 # --- short-circuit response --------------------------------------------------------------------

@@ -16,7 +16,8 @@ import numpy as np
 from bokeh.models import ColumnDataSource, Label, Span
 from bokeh.palettes import Category10_10
 
-from app.results.compute import LocusResult, broken_columns
+from app.results.compute import LocusResult
+from app.results.locus_geometry import broken_columns
 from app.results.plots import UNSTABLE, new_figure
 
 FIG6_MAX_DAMPING = 0.3  # complex branches shown: damping ratio below this somewhere on the sweep

@@ -27,14 +27,15 @@ from bokeh.plotting import figure
 
 from app.results.compute import (
     FORCES,
+    N_COMPLEX_TABLE,
     RESPONSE_OUTPUTS,
     TORQUES,
     LimitResult,
     LocusResult,
     PointResult,
     ResponseView,
-    broken_columns,
 )
+from app.results.locus_geometry import broken_columns
 
 UNSTABLE = "#c0392b"
 STABLE = "#1e8449"
@@ -119,11 +120,20 @@ class RootLocusPlot:
                                        name="locus_points")
         self.current = ColumnDataSource({"x": [], "y": [], "mode": [], "zeta": [],
                                          "description": []}, name="locus_current")
+        # a dragged slider's preview of the point (app.results.preview), lighter than the point
+        self.preview = ColumnDataSource({"x": [], "y": []}, name="locus_preview")
         fig.multi_line("xs", "ys", source=self.lines, line_color="#999999", line_alpha=0.6)
         sweep = fig.scatter("x", "y", source=self.points, size=6,
                             color={"field": "value", "transform": self.mapper}, line_alpha=0.0)
+        # the point's markers and a held slider's preview on the overlay layer: a new point
+        # repaints them alone, not the thousands of the sweep's points and lines (a repaint of
+        # the whole plot per preview made a dragged handle lag behind the mouse)
         now = fig.scatter("x", "y", source=self.current, size=13, marker="diamond",
-                          fill_color="#ff7f0e", line_color="black", legend_label="current point")
+                          fill_color="#ff7f0e", line_color="black", legend_label="current point",
+                          level="overlay")
+        fig.scatter("x", "y", source=self.preview, size=13, marker="diamond",
+                    fill_color="#ff7f0e", fill_alpha=0.35, line_color="#ff7f0e",
+                    line_dash="dashed", legend_label="preview (slider held)", level="overlay")
         fig.legend.location = "top_left"
         fig.legend.label_text_font_size = "10px"
         self.colorbar = ColorBar(color_mapper=self.mapper, title="s0 [-]", width=10)
@@ -155,6 +165,18 @@ class RootLocusPlot:
                              "mode": [m.number for m in result.modes],
                              "zeta": [m.damping_ratio for m in result.modes],
                              "description": [m.description for m in result.modes]}
+
+    def update_preview(self, eigenvalues: np.ndarray | None) -> None:
+        """The previewed point's eigenvalues [1/s] (the lowest N_COMPLEX_TABLE complex ones, as
+        the current point shows), or none (None: the full answer replaced the preview)."""
+        if eigenvalues is None:
+            if len(self.preview.data["x"]):
+                self.preview.data = {"x": [], "y": []}
+            return
+        lam = np.asarray(eigenvalues)
+        lam = lam[np.isfinite(lam) & (lam.imag > 1e-9)]
+        lam = lam[np.argsort(lam.imag)][:N_COMPLEX_TABLE]
+        self.preview.data = {"x": lam.real, "y": lam.imag / (2 * math.pi)}
 
     def update_locus(self, locus: LocusResult) -> None:
         lam = locus.eigenvalues  # (points, branches)
@@ -192,9 +214,15 @@ class CreepPlot:
         fig = self.figure
         self.curve = ColumnDataSource({"s": [], "mu": []})
         self.point = ColumnDataSource({"s": [], "mu": []})
+        self.preview = ColumnDataSource({"s": [], "mu": []}, name="creep_preview")
         fig.line("s", "mu", source=self.curve, line_width=2, legend_label="μ(s, v)")
         fig.scatter("s", "mu", source=self.point, size=11, fill_color="#ff7f0e",
-                    line_color="black", legend_label="operating point s0")
+                    line_color="black", legend_label="operating point s0", level="overlay")
+        # the point and the preview on the overlay layer: an s0 step repaints them alone (both
+        # lie inside the curve's span, so the ranges' fit does not move with them)
+        fig.scatter("s", "mu", source=self.preview, size=11, fill_color="#ff7f0e",
+                    fill_alpha=0.35, line_color="#ff7f0e", line_dash="dashed",
+                    legend_label="preview (slider held)", level="overlay")
         self.limit = Span(location=0.0, dimension="height", line_color=UNSTABLE,
                           line_dash="dashed", line_width=2, visible=False)
         self.maximum = Span(location=0.0, dimension="height", line_color="#777777",
@@ -217,6 +245,14 @@ class CreepPlot:
         s0 = result.key[2]
         self.point.data = {"s": [s0], "mu": [result.mu0]}
         self.maximum.location = result.s_max
+
+    def update_preview(self, s0: float | None, mu0: float = math.nan) -> None:
+        """A dragged slider's previewed operating point (s0 [-], μ [-]), or none (None)."""
+        if s0 is None:
+            if len(self.preview.data["s"]):
+                self.preview.data = {"s": [], "mu": []}
+            return
+        self.preview.data = {"s": [s0], "mu": [mu0]}
 
     def update_limit(self, limit: LimitResult | None) -> None:
         ok = limit is not None and limit.s0_limit is not None

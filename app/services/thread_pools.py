@@ -40,6 +40,9 @@ SIDE_VIEW_POOL = prioritized_pool(2, SIDE_VIEW, "bogie-side-view")
 # next nonlinear history
 NONLINEAR_POOL = prioritized_pool(1, FOLLOW_UP, "bogie-nonlinear")
 SEARCH_POOL = prioritized_pool(1, SEARCH, "bogie-reaction")
+# a dragged slider's previews (app.results.preview: at most one reduced eigenproblem each) yield
+# the cores to the first answers, so a preview never delays the answer to the release
+PREVIEW_POOL = prioritized_pool(2, FOLLOW_UP, "bogie-preview")
 
 
 def ignore_outcome(future) -> None:
@@ -76,6 +79,13 @@ class LatestRequest:
         if start:
             self._pool.submit(self._run)
         return future
+
+    def cancel(self) -> None:
+        """Drop the request waiting in the queue, if any (a running one runs to its end)."""
+        with self._lock:
+            waiting, self._next = self._next, None
+        if waiting is not None:
+            waiting[0].cancel()
 
     def _run(self) -> None:
         with self._lock:

@@ -41,6 +41,23 @@ import scipy.linalg as sla
 from scipy.linalg.lapack import dgecon
 
 CACHED_POINTS = 8  # operating points whose decomposition is kept per model
+_DENSE_COUNT = [0]  # dense eigendecompositions of a full state matrix in this process
+_DENSE_COUNT_LOCK = threading.Lock()
+
+
+def dense_decompositions() -> int:
+    """How many dense eigendecompositions of a full (deflated) state matrix this process has
+    computed, with or without vectors (:attr:`LinearSystem.eigen`,
+    :meth:`LinearSystem.eigenvalues`): every eigen-analysis, stability-limit evaluation and
+    dense root-locus point costs one.  What a cheaper path (a preview from a reduced model)
+    promises not to spend is checked against it."""
+    with _DENSE_COUNT_LOCK:
+        return _DENSE_COUNT[0]
+
+
+def _count_dense() -> None:
+    with _DENSE_COUNT_LOCK:
+        _DENSE_COUNT[0] += 1
 
 
 def balancing_scale(A: np.ndarray, sweeps: int = 32) -> np.ndarray:
@@ -245,6 +262,7 @@ class LinearSystem:
         is adjacent, positive imaginary part first, exactly conjugate, as are its vectors."""
         def build():
             A22 = self.reduced[1]
+            _count_dense()
             scale = balancing_scale(A22)
             lam, Y = np.linalg.eig(A22 * scale[None, :] / scale[:, None])
             return lam, Y / np.linalg.norm(Y, axis=0), scale
@@ -316,6 +334,7 @@ class LinearSystem:
         """The non-rigid eigenvalues only [1/s] (no vectors; uses them if already computed)."""
         if "eigen" in self._cache:
             return self._cache["eigen"][0]
+        _count_dense()
         return sla.eigvals(self.reduced[1], overwrite_a=False, check_finite=False)
 
     def state_vectors(self) -> np.ndarray:

@@ -134,8 +134,10 @@ class Reduced:
         self.massless = np.arange(r_i, Phi.shape[1])  # the massless coordinates, kept
         self.M_Phi = model.M @ Phi
         self.K_Phi = model.K @ Phi
+        self.b_M = op.b_M  # the motor slope of C0 [N m s/rad]
         C0 = model.B + op.b_M * model.motor_pattern
         self.C0_Phi = C0 @ Phi
+        self.motor_Phi = model.motor_pattern @ Phi  # B_M Φ (b_M = 1)
         self.P_Phi = [P @ Phi for P in patterns]
         if any(np.any(P[massless]) or np.any(P[:, massless]) for P in patterns):
             raise ValueError("a creep pattern acts on a massless coordinate")
@@ -147,6 +149,7 @@ class Reduced:
         project = lambda X: self.Linv @ (Phi.T @ X) @ self.Linv.T  # noqa: E731
         self.K_r = project(self.K_Phi)
         self.C0_r = project(self.C0_Phi)
+        self.motor_r = project(self.motor_Phi)
         self.P_r = [project(P) for P in self.P_Phi]
 
     @property
@@ -165,19 +168,26 @@ class Reduced:
         ones; :func:`model.analysis.linear_system.first_order_matrix`)."""
         return first_order_matrix(np.eye(len(self.inertial)), C, K, self.inertial, self.massless)
 
-    def solve(self, c: np.ndarray):
-        """Ritz values and displacement vectors (Φ coordinates, unit norm) at coefficients c."""
+    def solve(self, c: np.ndarray, b_M: float | None = None):
+        """Ritz values and displacement vectors (Φ coordinates, unit norm) at coefficients c
+        (``b_M`` [N m s/rad]: another motor slope than the sweep's)."""
         r = self.size
         C = self.C0_r + sum(ck * Pk for ck, Pk in zip(c, self.P_r, strict=True))
+        if b_M is not None and b_M != self.b_M:
+            C = C + (b_M - self.b_M) * self.motor_r
         A = self.first_order(self.K_r, C)
         lam, V = np.linalg.eig(A)  # numpy releases the GIL: the points run on several threads
         X = self.Linv.T @ V[:r]  # back from mass-normalized to Φ coordinates
         X /= np.linalg.norm(X, axis=0)
         return lam, X
 
-    def damping_Phi(self, c: np.ndarray) -> np.ndarray:
-        """C(c) Φ: the full damping matrix at creep coefficients c times the basis [N s/m]."""
-        return self.C0_Phi + sum(ck * P for ck, P in zip(c, self.P_Phi, strict=True))
+    def damping_Phi(self, c: np.ndarray, b_M: float | None = None) -> np.ndarray:
+        """C(c) Φ: the full damping matrix at creep coefficients c (and motor slope ``b_M``
+        [N m s/rad], None: the sweep's) times the basis [N s/m]."""
+        C_Phi = self.C0_Phi + sum(ck * P for ck, P in zip(c, self.P_Phi, strict=True))
+        if b_M is not None and b_M != self.b_M:
+            C_Phi = C_Phi + (b_M - self.b_M) * self.motor_Phi
+        return C_Phi
 
     def error_estimate(self, c: np.ndarray, lam: np.ndarray, X: np.ndarray,
                        C_Phi: np.ndarray | None = None, floor: float = 1e-300) -> np.ndarray:
@@ -285,6 +295,70 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     _keep_sweep_start(key, model, start, inner)
     return RootLocus(parameter, values, tracks.eigenvalues, tracks.errors, tracks.dense, op,
                      start.reduced.size, tracks.refined, float(lambda_floor))
+
+
+@dataclass(frozen=True)
+class RitzEstimate:
+    """The eigenvalues at one operating point from the reduced model of a kept sweep
+    (:func:`kept_sweep_estimate`): no dense solve, each with its first-order error estimate."""
+
+    operating_point: OperatingPoint
+    eigenvalues: np.ndarray  # non-rigid Ritz values inside the sweep's controlled disc [1/s]
+    error_estimate: np.ndarray  # estimated error of each, relative to max(|λ|, lambda_floor)
+    lambda_floor: float  # [1/s]
+    basis_size: int  # columns of the sweep's basis Φ
+
+    @property
+    def absolute_error(self) -> np.ndarray:
+        """The estimated absolute error of each eigenvalue [1/s] (first order: the sweep's
+        measured errors are 10–30 times smaller; not a rigorous bound)."""
+        return self.error_estimate * np.maximum(np.abs(self.eigenvalues), self.lambda_floor)
+
+    @property
+    def leading(self) -> int:
+        """Index of the eigenvalue with the largest real part."""
+        return int(np.argmax(self.eigenvalues.real))
+
+    @property
+    def stable(self) -> bool | None:
+        """The verdict where the error estimates decide it: False if a real part exceeds its
+        estimated error, True if every real part stays ≤ 0 with its error added, None otherwise
+        (the estimate cannot tell; only the eigenvalues inside the disc are judged, as
+        :attr:`RootLocus.stable` does)."""
+        re, bound = self.eigenvalues.real, self.absolute_error
+        if np.any(re - bound > 0):
+            return False
+        if np.all(re + bound <= 0):
+            return True
+        return None
+
+
+def kept_sweep_estimate(model: BogieModel, op: OperatingPoint, first: OperatingPoint,
+                        last: OperatingPoint, max_frequency_hz: float = 20.0,
+                        lambda_floor: float = 0.0, select=None) -> RitzEstimate | None:
+    """The eigenvalues at ``op`` (any s0, v, N0, b_M) from the reduced model of the kept start of
+    a :func:`root_locus` sweep from ``first`` to ``last`` with the same ``max_frequency_hz`` and
+    ``select``, or None if no such sweep start is kept: one small eigenproblem and the residuals of its Ritz
+    pairs in the full model, never a dense solve (a preview while a slider is dragged).  The
+    basis holds the modes at the sweep's ends and middle; away from the sweep the error
+    estimates grow and :attr:`RitzEstimate.stable` says when they no longer decide the verdict.
+    ``lambda_floor`` [1/s]: errors relative to max(|λ|, floor)."""
+    radius = 2 * np.pi * max_frequency_hz
+    with _SWEEP_STARTS_LOCK:
+        start = _SWEEP_STARTS.get(_sweep_start_key(model, first, last, radius, select))
+    if start is None or start.model is not model:
+        return None
+    reduced = start.reduced
+    c = pattern_coefficients(model, op)
+    lam, X = reduced.solve(c, op.b_M)
+    # the basis's rigid-body modes give λ = 0 (dropped, as in the sweep); branches inside the
+    # disc where the sweep controls the error
+    keep = np.argsort(np.abs(lam))[model.rigid_body_modes.shape[1]:]
+    keep = np.sort(keep[np.abs(lam[keep]) < 1.5 * radius])
+    floor = max(float(lambda_floor), 1e-300)
+    estimate = reduced.error_estimate(c, lam[keep], X[:, keep],
+                                      C_Phi=reduced.damping_Phi(c, op.b_M), floor=floor)
+    return RitzEstimate(op, lam[keep], estimate, floor, reduced.size)
 
 
 def _sweep_points(model: BogieModel, op: OperatingPoint, parameter: str,

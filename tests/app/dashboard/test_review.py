@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from conftest import assert_self_contained_html
 
-from app.results import compute
+from app.results import compute, locus_geometry
 from app.results.eigenvalue_sweep import fig6_series
 
 # --- root locus: grid, jumps, broken lines -------------------------------------------------------
@@ -26,7 +26,7 @@ def test_refine_grid_is_denser_where_branches_move_fast():
     lam = np.zeros((11, 2), dtype=complex)
     lam[:, 0] = -1.0 + 2j * math.pi * 5.0  # a branch that does not move
     lam[6:, 1] = 10.0  # one that moves only across the interval [0.5, 0.6]
-    grid = compute.refine_grid(values, lam, 200)
+    grid = locus_geometry.refine_grid(values, lam, 200)
     assert len(grid) == 200
     assert grid[0] == values[0]
     assert grid[-1] == values[-1]
@@ -40,7 +40,7 @@ def test_refine_grid_is_denser_where_branches_move_fast():
 
 def test_refine_grid_without_motion_is_even():
     values = np.linspace(0.0, 1.0, 5)
-    grid = compute.refine_grid(values, np.ones((5, 3), dtype=complex), 201)
+    grid = locus_geometry.refine_grid(values, np.ones((5, 3), dtype=complex), 201)
     np.testing.assert_allclose(np.diff(grid), 1.0 / 200, rtol=1e-9)
 
 
@@ -48,10 +48,10 @@ def test_a_jump_breaks_the_line():
     values = np.linspace(0.0, 1.0, 50)
     lam = (-1.0 + 0.1 * values + 2j * math.pi * (3.0 + values))[:, None].astype(complex)
     lam[30:, 0] += 5.0  # a jump of 5 [1/s] between points 29 and 30
-    jumps = compute.locus_jumps(values, lam)
+    jumps = locus_geometry.locus_jumps(values, lam)
     assert jumps.shape == (49, 1)
     assert np.flatnonzero(jumps[:, 0]).tolist() == [29]
-    (re,) = compute.broken_columns(lam.real, jumps)
+    (re,) = locus_geometry.broken_columns(lam.real, jumps)
     assert len(re) == 51
     assert np.isnan(re[30])
     assert np.isfinite(np.delete(re, 30)).all()
@@ -60,7 +60,7 @@ def test_a_jump_breaks_the_line():
 def test_a_smooth_branch_has_no_jumps():
     values = np.linspace(0.0, 1.0, 200) ** 2  # uneven grid: the rate per unit decides, not steps
     lam = (np.exp(3 * values) * (-1 + 1j))[:, None]
-    assert not compute.locus_jumps(values, lam).any()
+    assert not locus_geometry.locus_jumps(values, lam).any()
 
 
 def test_an_unresolved_acceleration_breaks_the_line():
@@ -73,7 +73,7 @@ def test_an_unresolved_acceleration_breaks_the_line():
     lam[:, 0] = -80.0 - np.concatenate([[0.0], np.cumsum(steps)]) + 2j * math.pi * 10.0
     lam[:, 1] = np.linspace(-250.0, 0.0, len(lam)) + 2j * math.pi * np.linspace(0.0, 20.0, len(lam))
     values = np.linspace(0.001, 0.002, len(lam))
-    jumps = compute.locus_jumps(values, lam)
+    jumps = locus_geometry.locus_jumps(values, lam)
     assert np.flatnonzero(jumps[:, 0]).tolist() == [5, 6]
     assert not jumps[:, 1].any()
 
@@ -86,7 +86,7 @@ def test_fig6_series_splits_complex_and_real_branches():
     lam[:10, 2] = -1.0 + 2j * math.pi * 1.0  # complex (ζ = 0.16), then real
     lam[10:, 2] = -2.5
     locus = compute.LocusResult("s0", values, lam, lam.real.max(axis=1) <= 0, True,
-                                compute.locus_jumps(values, lam))
+                                locus_geometry.locus_jumps(values, lam))
     series = fig6_series(locus)
     assert len(series.x) == 2
     assert len(series.real_x) == 2

@@ -162,3 +162,36 @@ def test_a_negative_floor_is_refused():
     with pytest.raises(ValueError, match="lambda_floor"):
         root_locus(model, default_operating_point(parameters), "s0", [0.005, 0.006],
                    lambda_floor=-1.0)
+
+
+def test_a_kept_sweep_estimates_other_points_without_a_dense_solve(setup):
+    """The reduced model of a kept sweep (over s0 at 120 km/h) gives the eigenvalues at points
+    off the sweep — another creepage, speed, wheel force or motor slope — with no dense
+    eigendecomposition; each Ritz value inside the disc lies within its own error estimate (plus
+    1e-9 1/s) of an eigenvalue of the deflated dense solution, and the verdict, where the estimates
+    decide it, is the dense one's.  A sweep that is not kept gives None."""
+    from model.analysis.linear_system import dense_decompositions
+    from model.analysis.locus import kept_sweep_estimate
+
+    model, op, _, _ = setup
+    ends = [replace(op, s0=0.001), replace(op, s0=0.02)]
+    clear_sweep_starts()
+    assert kept_sweep_estimate(model, op, *ends, lambda_floor=1.0) is None
+    root_locus(model, ends[0], "s0", np.linspace(0.001, 0.02, 6), lambda_floor=1.0)
+    decided = 0
+    for point in (replace(op, s0=0.0079), replace(op, s0=0.0095), replace(op, v=150 / 3.6),
+                  replace(op, N0=1.2 * op.N0), replace(op, b_M=3 * op.b_M + 500.0)):
+        before = dense_decompositions()
+        estimate = kept_sweep_estimate(model, point, *ends, lambda_floor=1.0)
+        assert dense_decompositions() == before, point
+        exact = eigen_analysis(model, point, vectors=False)
+        assert estimate.basis_size > 0
+        assert estimate.eigenvalues.size > 0
+        for value, bound in zip(estimate.eigenvalues, estimate.absolute_error, strict=True):
+            assert np.min(np.abs(exact.eigenvalues - value)) <= bound + 1e-9, (point, value)
+        if estimate.stable is not None:
+            decided += 1
+            assert estimate.stable == exact.stable, point
+    assert decided >= 4  # the estimates are small enough to decide away from the limit
+    assert dense_decompositions() > before  # the counter counts (the reference solves above)
+    clear_sweep_starts()
