@@ -207,7 +207,10 @@ def soak(url: str, pid: int | None, minutes: float, interval: float = 1.0,
     t0 = time.monotonic()
     next_sample = t0
     changes = 0
-    values = [round(s0.start + k * s0.step, 6) for k in range(int((s0.end - s0.start) / s0.step))]
+    # the s0 values on the slider's page steps (0.0005): the values a reviewer steps through,
+    # revisited as the soak goes on
+    page = 5 * s0.step
+    values = [round(s0.start + k * page, 6) for k in range(int((s0.end - s0.start) / page))]
     rng = random.Random(7)
     try:
         while time.monotonic() - t0 < minutes * 60:

@@ -244,15 +244,15 @@ def _command_line(pid: int) -> str:
 
 def _slider_answer(page) -> float:
     """Seconds from a key press on the s0 slider until the browser shows the new eigenvalues
-    (one step up while s0 < 0.025, so the first 40 presses of a page from 0.005 ask for values
-    the server has not computed yet)."""
+    (one page step, 0.0005, up while s0 < 0.025, so the first 40 presses of a page from 0.005
+    ask for values the server has not computed yet, and a page's values repeat after 80)."""
     before = page.evaluate(FAST)
     handle = page.locator(".ctl-s0 .noUi-handle")
     handle.focus()
     start = time.perf_counter()
-    handle.press("ArrowRight" if page.evaluate(
+    handle.press("PageUp" if page.evaluate(
         "() => [...Bokeh.documents[0].all_models].find(m => (m.css_classes || [])"
-        ".includes('ctl-s0')).value") < 0.025 else "ArrowLeft")
+        ".includes('ctl-s0')).value") < 0.025 else "PageDown")
     page.wait_for_function(f"(before) => ({FAST})() !== before", arg=before, polling=5,
                            timeout=120_000)
     return time.perf_counter() - start
