@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-BOGIE = [sys.executable, "-m", "model"]
+BOGIE = [sys.executable, "-m", "app"]
 
 
 def timed(argv: list[str]) -> float:

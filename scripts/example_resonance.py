@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +24,10 @@ from model.analysis.frequency_response import MODEL_FREQUENCY_LIMIT_HZ, frequenc
 from model.mechanics.excitation import DEFAULT_ORDERS, load_excitation, parse_amplitudes, parse_orders
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from docs_numbers import write_results  # noqa: E402
+
 RIPPLE = "el:6=256,el:12=128"  # app.results.resonance.DEFAULT_RIPPLE
 DRIVE_TORQUES = ("ID1.driving_shaft.torque", "ID1.disc_clutch.torque", "ID2.driving_shaft.torque",
                  "ID2.disc_clutch.torque")
@@ -30,7 +35,8 @@ DRIVE_TORQUES = ("ID1.driving_shaft.torque", "ID1.disc_clutch.torque", "ID2.driv
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default=str(ROOT / "docs" / "results" / "resonance_example.json"))
+    parser.add_argument("--out", default=None,
+                        help="JSON file (default: docs/results/resonance_example.json)")
     args = parser.parse_args()
     parameters = load_parameters()
     model = build_model(parameters)
@@ -48,7 +54,6 @@ def main() -> None:
         peak, at = ripple.peak(name)
         ripple_peaks[name] = {"amplitude_Nm": peak, "v_kmh": at / KMH}
     data = {
-        "command": "scripts/example_resonance.py",
         "operating_point": {"s0": op.s0, "N0": op.N0, "b_M": op.b_M},
         "excitation": {"motor_pole_pairs": excitation.pole_pairs,
                        "pinion_teeth": excitation.pinion_teeth,
@@ -72,9 +77,11 @@ def main() -> None:
                        for name in DRIVE_TORQUES},
         "ripple": {"text": RIPPLE, "peaks": ripple_peaks},
     }
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(data, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    if args.out is None:
+        out = write_results("resonance_example", data, "scripts/example_resonance.py")
+    else:
+        out = Path(args.out)
+        out.write_text(json.dumps(data, indent=1, allow_nan=False) + "\n", encoding="utf-8")
     print(f"wrote {out}: {len(diagram.modes)} modes, {len(diagram.crossings)} crossings")
     for c in diagram.crossings[:8]:
         print(f"  {c.v_kmh:7.2f} km/h {c.f_hz:8.3f} Hz {c.order.name:8s} ζ = {c.zeta:.4f} "
