@@ -68,6 +68,8 @@ STEPS = (
          "docs/results/validation.json (Table 1 by rank, targets, real eigenvalues)"),
     Step("response", (_python("figures_response.py"),),
          "docs/results/response.json, assets/figures/response_*.png"),
+    Step("response-accuracy", (_python("response_accuracy.py"),),
+         "docs/results/response_accuracy.json (the closed form against exact references)"),
     Step("nonlinear", (_python("figures_nonlinear.py"),),
          "docs/results/nonlinear.json, assets/figures/nonlinear_*.png"),
     Step("sensitivity", (_python("figures_sensitivity.py"),),

@@ -92,14 +92,14 @@ def rank_table(model, parameters) -> tuple[dict, dict]:
     for k in range(10):
         description = mode_character(model, stable, stable.complex_index[k]).description
         descriptions.append(f"| {k + 1} | {MODE_SIGNATURES[k][0]} | {description} |")
-    reals = ["s0 = 0.005: " + ", ".join(f"{x:.4g}" for x in stable.real[:10]),
-             "s0 = 0.014: " + ", ".join(f"{x:+.4g}" for x in unstable.real[:10]),
+    reals = ["s0 = 0.005: " + ", ".join(f"{x:.4g}" for x in stable.real_eigenvalues[:10]),
+             "s0 = 0.014: " + ", ".join(f"{x:+.4g}" for x in unstable.real_eigenvalues[:10]),
              f"unstable pairs at s0 = 0.014: {unstable.flutter} in all, "
              f"{int(np.count_nonzero(unstable.complex_pairs[:10].real > 0))} among the first ten; "
              f"positive reals: {unstable.divergence}"]
     delta = np.abs(numbers["delta_im"])
     numbers |= {
-        "reals_005": stable.real[:10].tolist(), "reals_014": unstable.real[:10].tolist(),
+        "reals_005": stable.real_eigenvalues[:10].tolist(), "reals_014": unstable.real_eigenvalues[:10].tolist(),
         "n_rigid": int(stable.n_rigid), "flutter_014": int(unstable.flutter),
         "flutter_014_first_ten": int(np.count_nonzero(unstable.complex_pairs[:10].real > 0)),
         "unstable_ranks_014": [k + 1 for k in range(10) if unstable.complex_pairs[k].real > 0],

@@ -393,7 +393,17 @@ def eigen_sensitivities(model: BogieModel, op: OperatingPoint, indices: Iterable
 
     ``linked``: parameter names of :data:`LINKED` whose rows add the operating quantity's
     derivative (the operating point took them from the set).  ``describe=False`` skips the
-    energy shares and descriptions of the modes (empty; the caller has them already)."""
+    energy shares and descriptions of the modes (empty; the caller has them already).
+
+    Example::
+
+        >>> from model import build_model, default_operating_point, eigen_sensitivities, load_parameters
+        >>> parameters = load_parameters()
+        >>> model = build_model(parameters)
+        >>> s = eigen_sensitivities(model, default_operating_point(parameters), indices=[0])
+        >>> "disc_clutch_torsional_stiffness" in s.names
+        True
+    """
     linked = tuple(linked)
     for name in linked:
         if name not in LINKED:
@@ -528,7 +538,17 @@ def limit_sensitivity(model: BogieModel, v: float, N0: float, b_M: float,
                       parameters: Iterable[str] | None = None) -> LimitSensitivity:
     """ds0*/dp at speed ``v`` [m/s] for every parameter (or those named) and v, N0, b_M.
 
-    ``s0_limit``: the limit if already known (else :func:`model.analysis.stability.stability_limit`)."""
+    ``s0_limit``: the limit if already known (else :func:`model.analysis.stability.stability_limit`).
+
+    Example::
+
+        >>> from model import KMH, build_model, limit_sensitivity, load_parameters
+        >>> parameters = load_parameters()
+        >>> limit = limit_sensitivity(build_model(parameters), 120 * KMH, parameters["wheel_force"],
+        ...                           parameters["motor_slope"])
+        >>> round(limit.s0_limit, 4)
+        0.0082
+    """
     linked = tuple(linked)
     wanted = list(SCHEMA) if parameters is None else list(parameters)
     for name in wanted:
@@ -642,7 +662,17 @@ def peak_load_sensitivities(parameters: Parameters, op: OperatingPoint,
 
     Step ``step`` relative (10⁻³): the truncation error is O(step²) ≈ 10⁻⁶ relative, the closed
     form's own error (≈ 10⁻⁷ of the response, docs/response.md) divided by the step ≈ 10⁻⁴.
-    Cost: two model assemblies, eigendecompositions and responses per parameter."""
+    Cost: two model assemblies, eigendecompositions and responses per parameter.
+
+    Example::
+
+        >>> from model import default_operating_point, load_parameters, peak_load_sensitivities
+        >>> parameters = load_parameters()
+        >>> peaks = peak_load_sensitivities(parameters, default_operating_point(parameters),
+        ...                                 names=["gear_ratio"])
+        >>> peaks.normalized.shape                      # parameters x outputs
+        (1, 4)
+    """
     import time
 
     from model.analysis.response import short_circuit_response

@@ -219,7 +219,7 @@ def evaluate_by_rank(parameters: Parameters, model=None, complete: Callable | No
     below = eigen_analysis(model, reference_point(parameters, LIMIT_CHECK), vectors=False)
     return RankEvaluation(result.stable, result.character_ok, result.matched,
                           result.driving_shaft, result.max_real_stable,
-                          unstable.complex_pairs[:len(TABLE1_IM_HZ)], unstable.real,
+                          unstable.complex_pairs[:len(TABLE1_IM_HZ)], unstable.real_eigenvalues,
                           below.max_real_part)
 
 
