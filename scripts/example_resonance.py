@@ -63,6 +63,7 @@ def main() -> None:
         "orders": DEFAULT_ORDERS, "participation": DEFAULT_PARTICIPATION,
         "model_frequency_limit_hz": MODEL_FREQUENCY_LIMIT_HZ,
         "campbell": {"basis_size": diagram.basis_size, "dense_points": diagram.dense_points},
+        "modes_count": len(diagram.modes), "crossings_count": len(diagram.crossings),
         "modes": [{"name": m.name, "f_hz_5": float(m.f_hz[0]),
                    "f_hz_120": float(m.f_hz[index_120]), "f_hz_200": float(m.f_hz[-1]),
                    "zeta_120": float(m.zeta[index_120])} for m in diagram.modes],

@@ -9,7 +9,8 @@ docs/own-bogie.md, as numbers the pages quote.
   half car body, the bogie [kg];
 * ``operating``: the creep coefficients at 120 km/h (b11 at s0 = 0.005 and 0.014, the steepest
   N0 μ'/v at s ≈ 0) and the rotor speed;
-* ``variant``: the driving shaft 30 % softer (``driving_shaft_stiffness`` × 0.7) against the
+* ``variant``: the driving shaft 30 % softer (``driving_shaft_stiffness`` × 0.7, rounded to
+  10⁴ N m/rad as a user would type it) against the
   bundled set at s0 = 0.005, 120 km/h — what ``bogie compare`` and the dashboard's Variant tab
   show (:func:`model.studies.compare.compare_designs`).
 """
@@ -31,7 +32,7 @@ from model import KMH, OperatingPoint, build_model, creep_coefficients, load_par
 from model.analysis.eigen import bogie_system  # noqa: E402
 from model.studies.compare import compare_designs  # noqa: E402
 
-SOFTER = 0.7  # the variant's driving shaft stiffness / the bundled one
+SOFTER = 0.7  # the variant's driving shaft stiffness / the bundled one (rounded to 10⁴ N m/rad)
 
 
 def layout(model, op) -> dict:
@@ -74,7 +75,8 @@ def operating(model, parameters) -> dict:
 
 
 def variant(parameters) -> dict:
-    softer = parameters.replace(driving_shaft_stiffness=SOFTER * parameters["driving_shaft_stiffness"])
+    stiffness = round(SOFTER * parameters["driving_shaft_stiffness"], -4)  # as the page writes it
+    softer = parameters.replace(driving_shaft_stiffness=stiffness)
     comparison = compare_designs(parameters, softer, 0.005, 120.0).as_dict()
     base, other = comparison["base"], comparison["variant"]
     frequency_change = max(abs(b["im_hz"] / a["im_hz"] - 1)

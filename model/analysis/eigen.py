@@ -167,7 +167,7 @@ def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) 
     """All eigenvalues (and eigenvectors) at ``op`` with the rigid-body ones deflated.
 
     With ``vectors`` the decomposition is cached for the operating point (the response reuses
-    it); without, a point already decomposed is not decomposed again, and a new one is not kept
+    it); without, a point already decomposed is not decomposed again, and a new one is not cached
     (root finding and sweeps would only evict the points the user is looking at).
 
     Example::

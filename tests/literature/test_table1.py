@@ -1,12 +1,12 @@
 """Literature tests: the calibrated model against the published results of Zeman & Hlaváč
-(shared/spec/reference-results.md: Table 1, Table 2, stability limit, operating data).
+(CITATION.cff: Table 1, Table 2, stability limit, operating data).
 
 Table 1 is compared **by rank**, as the study lists it ("the first ten pairs of complex conjugate
 eigenvalues sequenced according to magnitude of imaginary parts"): the model's k-th complex pair
 by imaginary part against the published k-th, and it must have Table 2's k-th character
 (``calibration_targets.MODE_SIGNATURES``, optimal one-to-one assignment over the lowest pairs).
 
-Tolerances (the issue's acceptance limits, justified):
+Tolerances (the acceptance limits, justified):
 
 * imaginary parts by rank 5 %: Table 1 gives 4 significant digits, but the study's parameters
   were not published; ours are estimates calibrated to the table within physical bounds, and
@@ -230,7 +230,7 @@ def test_two_divergent_reals_at_large_creepage(unstable):
     asserted: +0.062 is 1 % of the larger, a near-cancellation of ID2's creep and motor slope
     that no independently derived b_M can be asked to reproduce (docs/validation.md)."""
     assert unstable.divergence == 2
-    assert unstable.real[0] == pytest.approx(DIVERGENCE_RATES[0], rel=0.3)
+    assert unstable.real_eigenvalues[0] == pytest.approx(DIVERGENCE_RATES[0], rel=0.3)
 
 
 @pytest.mark.xfail(bool(MISSED_PATTERN), strict=True, reason="documented miss: " + MISSED_PATTERN)

@@ -245,7 +245,7 @@ def test_eigen_json_contract(capsys, model):
     assert np.allclose([row["re"] for row in data["complex"]], result.complex_pairs[:6].real,
                        rtol=1e-9, atol=1e-9 * np.abs(result.eigenvalues).max())
     assert np.allclose(im, result.complex_pairs[:6].imag / (2 * np.pi), rtol=1e-9)
-    assert np.allclose(re, result.real[:6], rtol=1e-9, atol=1e-9 * np.abs(result.eigenvalues).max())
+    assert np.allclose(re, result.real_eigenvalues[:6], rtol=1e-9, atol=1e-9 * np.abs(result.eigenvalues).max())
 
 
 def test_eigen_human_readable(capsys):
