@@ -22,7 +22,7 @@ ELSEWHERE = {
     "v": ("`--v` [km/h]", "`v` [m/s], `v_kmh`"),
     "N0": ("`--n0` [N]", "`N0` [N], `wheel_force`"),
     "b_M": ("`--bm` [N m s/rad]", "`b_M` [N m s/rad], `motor_slope`"),
-    "rail": ("`--rail`", "`rail`"),
+    "rail": ("`--rail` (`bogie envelope`, `report`, `study map`)", "`rail`"),
     "M0": ("`--m0` [N m]", "`M0` [N m]"),
     "f": ("`--f` [Hz]", "`f` [Hz]"),
     "D": ("`--decay` [-]", "`D` [-]"),
