@@ -90,3 +90,23 @@ def test_results_of_another_parameter_set_are_a_disagreement(tmp_path, results, 
     found, count = check_pages(tmp_path, results=results)
     assert count == 1
     assert [item.page for item in found] == ["docs/results/x.json"]
+
+
+def test_the_regeneration_command_runs_every_results_script():
+    """Each results file names the script that wrote it, and that script is a step of
+    ``scripts/regenerate_docs_results.py`` (one command regenerates them all)."""
+    import regenerate_docs_results
+
+    steps = {part for step in regenerate_docs_results.STEPS for command in step.commands
+             for part in command if part.startswith("scripts/")}
+    for path in sorted((ROOT / "docs" / "results").glob("*.json")):
+        command = json.loads(path.read_text(encoding="utf-8"))["command"]
+        assert command.split()[0] in steps, path.name
+
+
+def test_no_tag_starts_a_line():
+    """A line that starts with ``<!--`` is an HTML block on GitHub: the rest of the line would
+    lose its markdown.  A tag follows its number, so it never starts a line."""
+    for page in docs_numbers.pages():
+        for number, line in enumerate(page.read_text(encoding="utf-8").splitlines(), start=1):
+            assert not line.startswith("<!--="), f"{page.name}:{number}"
