@@ -14,7 +14,6 @@ with vectors is shared with the short-circuit response through :func:`bogie_syst
 from __future__ import annotations
 
 import warnings
-
 from dataclasses import dataclass
 from functools import cached_property
 

@@ -9,7 +9,7 @@ import sys
 from conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "scripts"))
-import parameter_schema  # noqa: E402
+import parameter_schema
 
 PAGE = (ROOT / "docs" / "own-bogie.md").read_text(encoding="utf-8")
 
