@@ -83,7 +83,7 @@ MISSED_TWO_DIVERGENCES = ("two positive real eigenvalues, +33.27 and +31.11 1/s 
                           "published")
 MISSED_PATTERN = ("unstable among the first ten at s0 = 0.014: pairs 1, 3, 9, 10 (published 3, "
                   "7, 8, 9, 10): the vehicle's longitudinal motion against ID2's disc clutch "
-                  "(+1.99 1/s at 0.006 Hz), ID1's rotor-frame pitch pair (+2.96 at 2.86 Hz) and "
+                  "(+1.99 1/s at 0.001 Hz), ID1's rotor-frame pitch pair (+2.96 at 2.86 Hz) and "
                   "the wheelsets' yaw modes (+3.83 at 9.77 Hz, +2.54 at 11.61 Hz); the "
                   "wheelsets' longitudinal modes stay damped (-2.01 at 8.43 Hz, -1.73 at 9.24 Hz)")
 
