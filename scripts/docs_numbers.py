@@ -50,7 +50,7 @@ PARAMETER_SOURCES = {"calibrated": ROOT / "assets" / "parameters" / "calibrated.
                      "estimate": ROOT / "assets" / "parameters" / "estimate.toml"}
 
 TAG = re.compile(r"<!--=(?P<ref>[^<>]*?)-->")
-BLOCK = re.compile(r"<!--begin=(?P<ref>[^<>]*?)-->\n(?P<body>.*?)\n?<!--end-->", re.S)
+BLOCK = re.compile(r"<!--begin=(?P<ref>[^<>]*?)-->\n(?P<body>.*?)<!--end-->", re.S)
 SUPERSCRIPT = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺", "0123456789-+")
 TO_SUPERSCRIPT = str.maketrans("0123456789-+", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺")
 MINUS = "−"  # U+2212, the minus sign of the pages
@@ -291,10 +291,13 @@ def check_text(text: str, page: str, sources: Sources, update: bool = False
         if not isinstance(expected, str):
             found.append(Disagreement(page, line, block["ref"], "(block)", "not a text"))
             continue
-        if block["body"].strip("\n") != expected.strip("\n"):
-            found.append(Disagreement(page, line, block["ref"], "(block)", "the results' text differs"))
+        differs = block["body"].strip("\n") != expected.strip("\n")
+        if differs or not block["body"].endswith("\n"):  # <!--end--> on a line of its own
+            found.append(Disagreement(page, line, block["ref"], "(block)",
+                                      "the results' text differs" if differs else
+                                      "<!--end--> must start a line (after a table or a code fence)"))
             if update:
-                pieces.append(text[position:block.start("body")] + expected.strip("\n"))
+                pieces.append(text[position:block.start("body")] + expected.strip("\n") + "\n")
                 position = block.end("body")
     pieces.append(text[position:])
     text = "".join(pieces)

@@ -33,6 +33,40 @@ DRIVE_TORQUES = ("ID1.driving_shaft.torque", "ID1.disc_clutch.torque", "ID2.driv
                  "ID2.disc_clutch.torque")
 
 
+MODE_KEYS = (  # the modes the page discusses: a key each, found by the words of its description
+    ("driving_shaft_1", ("twisting of driving shaft 1",)),
+    ("driving_shaft_2", ("twisting of driving shaft 2",)),
+    ("rotor_disc_clutch_1", ("torsion of rotor 1", "twisting of disc clutch 1")),
+    ("frame_pitch", ("pitch of bogie frame",)),
+    ("wheelsets_longitudinal_pitch", ("longitudinal–pitch of wheelset",)),
+    ("motors_vertical_pitch", ("vertical–pitch of TM",)),
+)
+
+
+def mode_key(name: str) -> str | None:
+    """The page's key of a mode (None: a mode the page does not discuss)."""
+    for key, words in MODE_KEYS:
+        if all(w in name for w in words):
+            return key
+    return None
+
+
+def keyed(modes, crossings) -> tuple[dict, dict]:
+    """The page's modes by key and their crossings by key and order (``frame_pitch.el:1``), so
+    that the page's numbers do not depend on the order of the lists."""
+    by_mode = {}
+    for m in modes:
+        key = mode_key(m["name"])
+        if key is not None and key not in by_mode:
+            by_mode[key] = m
+    by_crossing = {}
+    for c in crossings:
+        key = mode_key(c["mode"])
+        if key is not None:
+            by_crossing.setdefault(f"{key}.{c['order']}", c)
+    return by_mode, by_crossing
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default=None,
@@ -78,6 +112,7 @@ def main() -> None:
                        for name in DRIVE_TORQUES},
         "ripple": {"text": RIPPLE, "peaks": ripple_peaks},
     }
+    data["mode"], data["crossing"] = keyed(data["modes"], data["crossings"])
     if args.out is None:
         out = write_results("resonance_example", data, "scripts/example_resonance.py")
     else:

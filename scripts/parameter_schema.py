@@ -1,6 +1,7 @@
 """The parameter file's schema as the table of docs/own-bogie.md: every name, its unit, what it
 is, the values the model accepts, the bundled default and, for the parameters ``bogie calibrate``
-fits, the calibration's bounds — read from ``model/mechanics/parameters.py`` (``SCHEMA``) and
+fits, the calibration's bounds — read from ``model/mechanics/parameters.py`` (``SCHEMA``, the
+dynamics; ``ASSESSMENT_SCHEMA``, the strength data of ``bogie assess``) and
 ``model/studies/calibration_bounds.py`` (``FREE_PARAMETERS``).
 
     .venv/bin/python scripts/parameter_schema.py     # docs/results/parameters.json, prints the table
@@ -22,6 +23,7 @@ SECTIONS = {  # the first parameter of each group of the schema -> its heading
     "wheel_radius": "wheel, rail and contact", "polach_mu0": "creep law (Polach)",
     "wheelbase": "geometry", "car_body_mass": "masses and inertias",
     "driving_shaft_stiffness": "stiffnesses", "primary_damping_z": "damping and the motor",
+    "wheel_seat_diameter": "strength data of the checks (`bogie assess`; not the dynamics)",
 }
 
 
@@ -44,14 +46,14 @@ def _valid(low: float, high: float, low_allowed: bool) -> str:
 
 def schema_table() -> str:
     """Markdown: one row per parameter of the schema, in its order."""
-    from model.mechanics.parameters import SCHEMA, load_parameters
+    from model.mechanics.parameters import ALL_SCHEMA, load_parameters
     from model.studies.calibration_bounds import FREE_PARAMETERS
 
     defaults = load_parameters()
     free = {f.name: f for f in FREE_PARAMETERS}
     lines = ["| name | unit | what it is | valid | default (calibrated set) | calibrated within |",
              "|---|---|---|---|---|---|"]
-    for name, (unit, description, (low, high, low_allowed)) in SCHEMA.items():
+    for name, (unit, description, (low, high, low_allowed)) in ALL_SCHEMA.items():
         if name in SECTIONS:
             lines.append(f"| **{SECTIONS[name]}** | | | | | |")
         bounds = f"{_number(free[name].low)} … {_number(free[name].high)}" if name in free else "—"
@@ -87,12 +89,13 @@ def example_output() -> str:
 def main() -> None:
     from docs_numbers import write_results
 
-    from model.mechanics.parameters import SCHEMA
+    from model.mechanics.parameters import ALL_SCHEMA, ASSESSMENT_SCHEMA, SCHEMA
     from model.studies.calibration_bounds import FREE_PARAMETERS
 
     table = schema_table()
     print(table)
-    data = {"blocks": {"schema": table, "example_output": example_output()}, "count": len(SCHEMA),
+    data = {"blocks": {"schema": table, "example_output": example_output()},
+            "count": len(ALL_SCHEMA), "dynamics": len(SCHEMA), "strength": len(ASSESSMENT_SCHEMA),
             "calibrated": len(FREE_PARAMETERS)}
     print(f"wrote {write_results('parameters', data, 'scripts/parameter_schema.py')}")
 

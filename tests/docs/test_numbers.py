@@ -76,6 +76,16 @@ def test_disagreements_are_found_and_updated(results):
     assert [item.quoted for item in again] == ["1.0"]  # a missing key is left to the author
 
 
+def test_a_block_end_marker_must_start_a_line(results):
+    """After a table's last row or a code fence the marker on the same line would glue to it (a
+    fence would not close): such a block is a disagreement, and ``--update`` puts the marker on a
+    line of its own."""
+    glued = "<!--begin=x/table-->\n| a |\n|---|<!--end-->\n"
+    found, updated, _ = check_text(glued, "page.md", Sources(results), update=True)
+    assert len(found) == 1
+    assert updated == "<!--begin=x/table-->\n| a |\n|---|\n<!--end-->\n"
+
+
 def test_a_tag_without_a_number_before_it_is_a_disagreement(results):
     found, _, _ = check_text("the peak<!--=x/peak-->", "page.md", Sources(results))
     assert len(found) == 1

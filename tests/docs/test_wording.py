@@ -23,7 +23,7 @@ HISTORY = {
     "work session": r"\b(?:third|fourth|fifth|sixth|seventh|eighth|ninth|tenth|last|earlier)\s+sessions?\b"
                     r"|\bwork(?:ing)?\s+session|\bsessions of work",
     "round of work": rf"\b{_ORDINAL}\s+round\b|\brounds? of work|\bafter this round|\bin this round",
-    "tried, not kept": r"\bnot kept\b|\btried and (?:rejected|dropped)|\bTried and (?:rejected|dropped)",
+    "tried, not kept": r"\b[Tt]ried(?:,| and)? (?:not kept|rejected|dropped)|\bmeasured, not kept",
     "for the record": r"\bfor the record\b",
     "commit reference": r"\bcommits?\s+[0-9a-f]{7,40}\b",
     "the lead": r"\bthe lead(?: engineer)?\b(?! screw)",
@@ -141,6 +141,7 @@ def test_the_patterns_find_history(text, label):
 @pytest.mark.parametrize("text", [
     "one study per session", "each session has its own dashboard", "the session's document lock",
     "this session's study is still waiting", "a second session's study waits",
+    "or None if that sweep's start is not kept",
     "rounding-level wiggles", "round(t_end·fs)", "a stick–slip cycle round the creep maximum",
     "the previous valid state kept", "log₂ 32 = 5 doubling steps", "a known issue of SciPy",
 ])
