@@ -3,7 +3,7 @@
 A number the code computes is quoted in README.md and docs/*.md with a **tag** right after it, an
 HTML comment that GitHub does not show::
 
-    ID1's driving shaft peaks at 19.4<!--=response/stable/ID1.driving_shaft.torque/peak *1e-3--> kN m
+    ID1's driving shaft peaks at 19.4<!--=response/stable/outputs/ID1.driving_shaft.torque/peak *1e-3--> kN m
 
 The tag names a results file and a path inside it: ``response`` is ``docs/results/response.json``
 (written by a script under ``scripts/``, listed in ``scripts/regenerate_docs_results.py``), the
