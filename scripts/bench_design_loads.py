@@ -17,7 +17,7 @@ In one run, calibrated set, all 20 outputs, 2 s at 10 kHz unless said otherwise:
    brute-force equivalent is 360 single responses).
 2. **a nonlinear scenario** (the envelope's chunk with ``--creep nonlinear``: one
    ``nonlinear_response`` and its peaks) at s0 = 0.014, 120 km/h, cold and warm, against
-   ``scipy.signal.lsim`` of the *linear* system on the same grid (the reference of the issue's
+   ``scipy.signal.lsim`` of the *linear* system on the same grid (the reference of the
    target ≤ 1×, as in ``bench_nonlinear.py``); best of 3, lsim in between.
 3. **parallel efficiency**: a nonlinear envelope of ``--scenarios`` scenarios (s0 = 0.005, 0.014
    × speeds × continuity roots × a phase grid, horizon ``--scenario-t-end``) serially in this

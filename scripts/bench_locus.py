@@ -81,7 +81,8 @@ def main() -> None:
 
     print(f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()},"
           f" numpy {np.__version__}, one BLAS thread")
-    print(f"model: {model.n} DOF, state {2 * model.n}; locus: {args.points} points s0 = "
+    print(f"model: {model.n} coordinates (the naive QZ pencil {2 * model.n} × {2 * model.n}); locus: "
+          f"{args.points} points s0 = "
           f"{s0[0]:g}…{s0[-1]:g} at {op.v_kmh:g} km/h, {locus.eigenvalues.shape[1]} branches tracked")
     print()
     print("| task | method | time | ratio |")

@@ -14,7 +14,7 @@ excitation, anti-slip off (a plain ODE for Radau), all 20 outputs.
   the same point, e.g. another anti-slip delay, costs);
 * first call in this process: the same as cold, plus the first imports of the step loop;
 * lsim: ``scipy.signal.lsim`` on the *linear* system (eq. 20) with the sampled M_C, as in
-  ``bench_response.py`` — the reference the issue's target is stated against;
+  ``bench_response.py`` — the reference the target is stated against;
 * Radau: ``scipy.integrate.Radau`` on the same nonlinear system written out independently here
   (``M q̈ + B_nl q̇ + K q = f M_C + G N0 [μ(s0 + H q̇/v) − μ(s0)]`` from the model's matrices,
   exact Jacobian), rtol 1e-8, stopped after ``--radau-budget`` CPU seconds: its time for 2 s and

@@ -161,7 +161,9 @@ def main() -> None:
         elif k < steps:
             name += f" (0…{t_radau_end:g} s only)"
         rows[name] = (t_radau, error(y_radau @ C.T, reference[:done]) if done else np.nan)
-    print(f"system: {model.n} DOF, state {2 * model.n}, {len(outputs.names)} outputs, "
+    system = bogie_system(model, op)
+    print(f"system: {model.n} coordinates, {system.N} states ({len(system.eigen[0])} deflated), "
+          f"{len(outputs.names)} outputs, "
           f"{steps} points ({args.t_end:g} s at {args.fs:g} Hz); method {method}, "
           f"rounding-error indicator {estimate:.1e} (not a bound); reference (exact stepping) took {t_reference:.2f} s")
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "

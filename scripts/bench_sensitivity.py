@@ -9,7 +9,7 @@ In one run, on the calibrated set at s0 = 0.005, 120 km/h:
 * sensitivities: every parameter and s0, v, N0, b_M for the ten lowest modes
   (:func:`model.analysis.sensitivity.eigen_sensitivities`, the decomposition cached, ``describe=False``)
   plus ds0*/dp at a known s0* (:func:`model.analysis.sensitivity.limit_sensitivity`, its eigenvalues-only
-  analysis at s0* included); the ratio (reference + sensitivities)/reference is the issue's
+  analysis at s0* included); the ratio (reference + sensitivities)/reference is the
   "≤ 2×" target; the modes' energy shares and descriptions are timed separately;
 * cold: the derivative matrices of the parameter set (complex step, once per set);
 * peak loads: central differences of the response for three parameters (cost per parameter);

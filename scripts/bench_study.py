@@ -26,7 +26,7 @@ N0 and b_M of the set.  In the same run:
    2¹⁰-sample Sobol study of 12 parameters (Saltelli: 2¹⁰ × (12 + 2) limit searches).
 
 On a machine shared with other jobs the times and the efficiency are disturbed: the script
-prints the load average before and after; re-run it on an idle machine for the record.
+prints the load average before and after; re-run it on an idle machine for figures to compare.
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ Writes under ``--out``:
   characteristic (s0 = 0.005 and 0.014, 120 km/h);
 * ``nonlinear_reaction_time.png`` — peak(τ) of ID2's limited torques against the delay τ, and
   the required reaction time against the limit (M_ad … a design strength), 120 and 200 km/h;
-* ``nonlinear_numbers.json`` — every number quoted in docs/nonlinear.md (also printed).
+and ``docs/results/nonlinear.json``: every number docs/nonlinear.md quotes (also printed).
 
 ``--quick`` uses a coarser delay grid (for a check of the script, not for the docs).
 matplotlib is used here only (test extra).
@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import matplotlib
@@ -36,7 +37,14 @@ from model.analysis.nonlinear import AntiSlip, nonlinear_response
 from model.analysis.response import ShortCircuit, dominant_frequencies, short_circuit_response
 from model.mechanics.operating_point import OperatingPoint, creep_law
 
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from docs_numbers import write_results  # noqa: E402
+
 CASES = [(0.005, 120.0), (0.014, 120.0), (0.005, 200.0), (0.014, 200.0)]
+CASE_KEYS = {(0.005, 120.0): "stable_120", (0.014, 120.0): "unstable_120",
+             (0.005, 200.0): "stable_200", (0.014, 200.0): "unstable_200"}
 COLORS = {"ID1": "tab:red", "ID2": "tab:blue"}
 RIM_STYLE = {"rim12": "-", "rim14": ":"}
 PARTING = 0.05  # linear and nonlinear "part" when they differ by 5 % of the linear total so far
@@ -54,7 +62,7 @@ def case_numbers(model, op, fs):
     nl = nonlinear_response(model, op, ShortCircuit(), 2.0, fs)
     lin = short_circuit_response(model, op, ShortCircuit(), 2.0, fs)
     long = nonlinear_response(model, op, ShortCircuit(), 6.0, 5000.0)
-    numbers = {"M_ad": nl.limits["M_ad"], "mu_max": nl.mu_max}
+    numbers = {"M_ad": nl.limits["M_ad"], "mu_max": nl.mu_max, "slip_speed_0": op.s0 * op.v}
     late = long.t >= 4.0
     for drive in ("ID1", "ID2"):
         name = f"{drive}.disc_clutch.torque"
@@ -65,6 +73,7 @@ def case_numbers(model, op, fs):
             "disc_clutch_peak_nonlinear": abs(nl.peaks[name]),
             "disc_clutch_peak_linear": abs(lin.peaks[name]),
             "disc_clutch_peak_over_M_ad": abs(nl.peaks[name]) / nl.limits["M_ad"],
+            "disc_clutch_peak_linear_over_M_ad": abs(lin.peaks[name]) / nl.limits["M_ad"],
             "disc_clutch_min_nonlinear": float(nl.outputs[name].min()),
             "disc_clutch_min_linear": float(lin.outputs[name].min()),
             "disc_clutch_swing_2s_nonlinear": float(0.5 * np.ptp(nl.outputs[name][nl.t >= 1.5])),
@@ -75,6 +84,9 @@ def case_numbers(model, op, fs):
             "creepage_min": float(creep.min()), "creepage_max": float(creep.max()),
             "creepage_at_6s": float(creep[-1].mean()),
             "slip_velocity_max": float(np.abs(creep).max() * op.v),
+            "slip_velocity_at_6s": float(creep[-1].mean() * op.v),
+            "disc_clutch_steady_over_M_ad": lin.steady[name] / nl.limits["M_ad"],
+            "disc_clutch_late_mean_over_M_ad": float(y_late.mean()) / nl.limits["M_ad"],
         }
     return nl, lin, long, numbers
 
@@ -169,7 +181,13 @@ def figure_reaction(curves, out: Path) -> None:
 
 
 def reaction_numbers(result) -> dict:
+    peaks = result.peak_torque / result.limit
+    rising = np.flatnonzero(peaks >= peaks.max() - 1e-3)
+    flat = np.flatnonzero(np.abs(peaks - peaks[0]) <= 1e-3)
     return {"required_delay_s": result.required_delay, "reason": result.reason,
+            "flat_until_s": float(result.delays[flat[-1]]) if len(flat) else None,
+            "full_from_s": float(result.delays[rising[0]]),
+            "peak_over_limit_max": float(peaks.max()),
             "detection_time_s": result.detection_time,
             "reaction_after_fault_s": result.reaction_after_fault,
             "limit": result.limit, "unprotected_peak_over_limit":
@@ -195,7 +213,7 @@ def main() -> None:
         op = default_operating_point(parameters, s0, v)
         nl, lin, long, case = case_numbers(model, op, 10_000.0)
         runs[(s0, v)] = (nl, lin, long, case)
-        numbers["cases"][f"s0={s0:g}, v={v:g}"] = case
+        numbers["cases"][CASE_KEYS[(s0, v)]] = case
         print(f"s0 = {s0:g}, {v:g} km/h: " + json.dumps(case), flush=True)
     figure_histories(runs, out)
     figure_creepage(runs, out, s_max)
@@ -204,27 +222,28 @@ def main() -> None:
     for v in (120.0, 200.0):
         op = default_operating_point(parameters, 0.014, v)
         curves[v] = required_reaction_time(model, op, delays=delays)
-        numbers["reaction"][f"v={v:g}, M_ad"] = reaction_numbers(curves[v])
-        numbers["reaction"][f"v={v:g}, curve"] = {
+        key = f"{v:g}"
+        numbers["reaction"][key] = {"M_ad": reaction_numbers(curves[v])}
+        numbers["reaction"][key]["curve"] = {
             "delays_s": curves[v].delays.tolist(),
             "peak_over_M_ad": (curves[v].peak_torque / curves[v].limit).tolist()}
         strength = 1.03 * curves[v].limit
         design = required_reaction_time(model, op, limit=strength, delays=delays)
-        numbers["reaction"][f"v={v:g}, strength 1.03 M_ad"] = reaction_numbers(design)
+        numbers["reaction"][key]["strength_1.03"] = reaction_numbers(design)
         both = required_reaction_time(model, op, delays=delays[:3], drives=("ID1", "ID2"))
-        numbers["reaction"][f"v={v:g}, both drives"] = reaction_numbers(both) | {
+        numbers["reaction"][key]["both_drives"] = reaction_numbers(both) | {
             "fault_drive_peaks_over_M_ad": {k: x / both.limit
                                             for k, x in both.fault_drive_peaks.items()}}
-        print(f"reaction {v:g} km/h: " + json.dumps(numbers["reaction"][f"v={v:g}, M_ad"]),
+        print(f"reaction {v:g} km/h: " + json.dumps(numbers["reaction"][key]["M_ad"]),
               flush=True)
     figure_reaction(curves, out)
     # sensitivity to the assumptions at s0 = 0.014, 120 km/h
     base = AntiSlip()
     op = default_operating_point(parameters, 0.014, 120.0)
     variants = {
-        "threshold 0.1 m/s": AntiSlip(threshold=0.1), "threshold 1.0 m/s": AntiSlip(threshold=1.0),
-        "rate 5 1/s": AntiSlip(rate=5.0), "rate 50 1/s": AntiSlip(rate=50.0),
-        "floor 0.3": AntiSlip(floor=0.3), "floor 0.6": AntiSlip(floor=0.6),
+        "threshold_0.1": AntiSlip(threshold=0.1), "threshold_1.0": AntiSlip(threshold=1.0),
+        "rate_5": AntiSlip(rate=5.0), "rate_50": AntiSlip(rate=50.0),
+        "floor_0.3": AntiSlip(floor=0.3), "floor_0.6": AntiSlip(floor=0.6),
     }
     for label, protection in variants.items():
         result = required_reaction_time(model, op, anti_slip=protection, delays=delays)
@@ -234,11 +253,12 @@ def main() -> None:
         op_n = OperatingPoint(0.014, 120.0 / 3.6, factor * parameters["wheel_force"],
                               parameters["motor_slope"])
         result = required_reaction_time(model, op_n, anti_slip=base, delays=delays)
-        numbers["sensitivity"][f"N0 x {factor:g}"] = reaction_numbers(result)
+        numbers["sensitivity"][f"N0_x{factor:g}"] = reaction_numbers(result)
         print(f"sensitivity N0 x {factor:g}: " + json.dumps(numbers["sensitivity"][
-            f"N0 x {factor:g}"]), flush=True)
-    (out / "nonlinear_numbers.json").write_text(json.dumps(numbers, indent=1))
-    print(f"wrote {out}/nonlinear_*.png and nonlinear_numbers.json")
+            f"N0_x{factor:g}"]), flush=True)
+    print(f"wrote {out}/nonlinear_*.png")
+    if args.params is None and not args.quick:
+        print(f"wrote {write_results('nonlinear', numbers, 'scripts/figures_nonlinear.py')}")
 
 
 if __name__ == "__main__":

@@ -14,12 +14,15 @@ both 5–95 % bands with their medians, the published 0.0082 at 120 km/h).  ``--
 computes a 25 × 6 stability map (≈ 10 s, serial) and renders the dashboard's Studies figure with
 the posterior band over it in headless Chromium (/usr/bin/chromium):
 ``uncertainty_band_app.png``.  The two studies take ≈ 35 CPU-s each (n = 32, six speeds).
+
+Writes ``docs/results/posterior.json``: the numbers and tables docs/sensitivity.md §5b quotes.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
@@ -34,6 +37,47 @@ from model.mechanics.parameters import load_parameters, parameter_hash
 from model.studies.calibration_targets import STABILITY_LIMIT
 from model.studies.posterior import linearized_posterior
 from model.studies.uncertainty import UNCERTAIN_PARAMETERS
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from docs_numbers import write_results  # noqa: E402
+
+LABELS = {"s0_limit_120": "s0*(120 km/h)", "s0_limit_200": "s0*(200 km/h)",
+          "s0_limit_40": "s0*(40 km/h)", "s0_limit_250": "s0*(250 km/h)",
+          "mode2_im_hz": "mode 2 (rotor torsion, DC) [Hz]",
+          "peak.ID1.driving_shaft.torque": "peak ID1 driving-shaft torque [N m]",
+          "peak.ID2.disc_clutch.torque": "peak ID2 disc-clutch torque [N m]"}
+
+
+def _value(x: float) -> str:
+    return f"{x:.5f}" if abs(x) < 0.1 else (f"{x:.3g}" if abs(x) < 100 else f"{x:,.0f}".replace(",", " "))
+
+
+def band_table(prior: dict, posterior: dict) -> str:
+    """Markdown: each output of LABELS, its calibrated value, the prior and posterior 5–95 % bands
+    and their widths (relative to the calibrated value)."""
+    rows = ["| output | calibrated | prior 5–95 % | width | posterior 5–95 % | width |",
+            "|---|---|---|---|---|---|"]
+    a = {o["name"]: o for o in prior["outputs"]}
+    b = {o["name"]: o for o in posterior["outputs"]}
+    for key, label in LABELS.items():
+        o, q = a[key], b[key]
+        rows.append(f"| {label} | {_value(o['nominal'])} | {_value(o['p5'])} – {_value(o['p95'])} | "
+                    f"{100 * (o['p95'] - o['p5']) / abs(o['nominal']):.0f} % | {_value(q['p5'])} – "
+                    f"{_value(q['p95'])} | {100 * (q['p95'] - q['p5']) / abs(q['nominal']):.1f} % |")
+    return "\n".join(rows)
+
+
+def clipped_per_parameter(data: dict) -> dict:
+    """How many sampled coordinates sit on an end of their range, per parameter."""
+    samples = np.array(data["samples"], dtype=float)
+    counts = {}
+    for j, p in enumerate(data["parameters"]):
+        low, high = p.get("low"), p.get("high")
+        counts[p["name"]] = int(np.sum(np.isclose(samples[:, j], low, rtol=1e-12)
+                                       | np.isclose(samples[:, j], high, rtol=1e-12)))
+    return counts
 
 
 def limits(data: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -71,6 +115,9 @@ def main() -> None:
     cost = time.perf_counter() - began
     print(f"cost: one eigen-analysis with vectors {reference * 1e3:.0f} ms; the linearized "
           f"posterior {cost:.2f} s = {cost / reference:.0f}x (machine shared)\n")
+    numbers: dict = {"blocks": {}, "parameters": {}}
+    pin = ["| parameter | prior sd | posterior sd | ratio | pinned by (the two largest entries of its "
+           "Jacobian column) |", "|---|---|---|---|---|"]
     print(f"{'parameter':<34} {'prior sd ln p':>13} {'posterior':>10} {'ratio':>6}  "
           "largest whitened Jacobian entries ∂r/∂ln p")
     for j, (name, s0, s) in enumerate(zip(post.names, post.prior_sd_log, post.sd_log, strict=True)):
@@ -78,11 +125,20 @@ def main() -> None:
         lead = ", ".join(f"{post.targets[i][:24]} {column[i]:+.3g}"
                          for i in np.argsort(-np.abs(column))[:2])
         print(f"{name:<34} {s0:>13.3f} {s:>10.3f} {s / s0:>6.2f}  {lead}")
+        top = [(post.targets[i], column[i]) for i in np.argsort(-np.abs(column))[:2]]
+        pin.append(f"| {name} | {s0:.3f} | {s:.3f} | {s / s0:.2f} | "
+                   + ", ".join(f"{t} ({x:+.{2 if abs(x) < 10 else 0}f})".replace("(-", "(−")
+                               for t, x in top) + " |")
+        numbers["parameters"][name] = {"prior_sd": float(s0), "posterior_sd": float(s),
+                                       "ratio": float(s / s0),
+                                       "largest_entry": float(np.abs(column).max())}
+    numbers["blocks"]["pinned"] = "\n".join(pin)
     print("targets used:", len(post.targets), "dropped:", list(post.dropped) or "none")
     k = post.targets.index("creep maximum s (stability-limit proxy)")
     g = post.jacobian[k] * post.sigmas[k]  # ∂ ln s_max(120) / ∂θ
     print(f"linear sd of ln s_max(120 km/h): prior {np.sqrt(g @ (post.prior_sd_log**2 * g)):.4f}, "
           f"posterior {np.sqrt(g @ post.covariance_log @ g):.4f}")
+    numbers["linear_sd_ln_smax_120"] = float(np.sqrt(g @ post.covariance_log @ g))
 
     studies = {}
     for label, path in (("prior", args.prior), ("posterior", args.posterior)):
@@ -92,6 +148,25 @@ def main() -> None:
         studies[label] = data
         samples = np.array(data["samples"], dtype=float)
         mean = np.log([parameters[p["name"]] for p in data["parameters"]])
+        mean_ = np.log([parameters[p["name"]] for p in data["parameters"]])
+        study = numbers.setdefault(label, {})
+        study |= {"clipped": int(data.get("clipped_coordinates", 0)),
+                  "coordinates": int(np.array(data["samples"]).size),
+                  "clipped_by_parameter": clipped_per_parameter(data),
+                  "sd_g_theta": float(np.std((np.log(np.array(data["samples"], dtype=float)) - mean_) @ g)),
+                  "outputs": {o["name"]: {k: o[k] for k in ("nominal", "p5", "p50", "p95")}
+                              for o in data["outputs"]},
+                  "width": {o["name"]: (o["p95"] - o["p5"]) / abs(o["nominal"]) for o in data["outputs"]},
+                  "band_low": {o["name"]: o["p5"] / o["nominal"] - 1 for o in data["outputs"]},
+                  "band_high": {o["name"]: o["p95"] / o["nominal"] - 1 for o in data["outputs"]}}
+        modes = [w for k, w in study["width"].items() if k.endswith("_im_hz")]
+        study["mode_width_max"], study["mode_width_min"] = max(modes), min(modes)
+        others = [w for k, w in study["width"].items()
+                  if k.endswith("_im_hz") and k not in ("mode2_im_hz", "mode7_im_hz")]
+        study["mode_width_others_max"] = max(others)
+        values_ = np.array(data["values"], dtype=float)
+        column = [o["name"] for o in data["outputs"]].index("s0_limit_120")
+        study["sd_ln_s0_120"] = float(np.nanstd(np.log(values_[:, column])))
         print(f"\n{label}: {data['method']}, n = {data['base_samples']}, {data['runs']} runs, "
               f"{data.get('clipped_coordinates', 0)} coordinates clipped; sampled sd of "
               f"g·(ln p − ln p_set) = {np.std((np.log(samples) - mean) @ g):.4f}")
@@ -101,6 +176,7 @@ def main() -> None:
             theta = stats.norm.ppf(np.clip(u, 1e-12, 1 - 1e-12)) @ np.linalg.cholesky(
                 post.covariance_log).T
             print(f"  the same points unclipped: sd of g·(ln p − ln p_set) = {np.std(theta @ g):.4f}")
+            study["sd_g_theta_unclipped"] = float(np.std(theta @ g))
         values = np.array(data["values"], dtype=float)
         for j, o in enumerate(data["outputs"]):
             width = o["p95"] - o["p5"]
@@ -129,6 +205,15 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     fig.savefig(out / "uncertainty_prior_posterior.png", dpi=110)
     print(f"\nwrote {out / 'uncertainty_prior_posterior.png'}")
+    numbers["blocks"]["bands"] = band_table(studies["prior"], studies["posterior"])
+    s120 = numbers["prior"]["outputs"]["s0_limit_120"]
+    numbers["prior_vs_published_120"] = [s120["p5"] / STABILITY_LIMIT - 1, s120["p95"] / STABILITY_LIMIT - 1]
+    numbers["peak_shrink"] = {k: numbers["prior"]["width"][k] / numbers["posterior"]["width"][k]
+                              for k in numbers["prior"]["width"] if k.startswith("peak.")}
+    numbers["published_limit"] = STABILITY_LIMIT
+    print(numbers["blocks"]["pinned"], numbers["blocks"]["bands"], sep="\n\n")
+    if not args.app:
+        print(f"wrote {write_results('posterior', numbers, 'scripts/figures_posterior.py')}")
     if args.app:
         app_figure(parameters, Path(args.posterior), out / "uncertainty_band_app.png")
 

@@ -12,11 +12,17 @@
 
 Values are totals (pre-fault + perturbation) unless a label says Δ.  matplotlib is used here
 only (test extra), never in model/ or app/.
+
+Also writes ``docs/results/response.json``: the numbers docs/response.md quotes (peaks, swings,
+limit crossings, dominant frequencies, the drive modes of the model, the ratio of ID1's to ID2's
+loads, the growth of the unstable case at 2 s and 5 s, the defaults of the excitation and the
+sizes of the closed form).
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import matplotlib
@@ -25,8 +31,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from model import build_model, default_operating_point, load_parameters
+from model import build_model, default_operating_point, eigen_analysis, load_parameters
+from model.analysis.eigen import bogie_system
+from model.analysis.modes import mode_character
 from model.analysis.response import ShortCircuit, short_circuit_response
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from docs_numbers import write_results  # noqa: E402
 
 COLORS = {"ID1": "tab:red", "ID2": "tab:blue"}
 
@@ -129,6 +142,104 @@ def figure_unstable(result, out: Path) -> None:
     plt.close(fig)
 
 
+DRIVE_PARTS = ("driving_shaft.torque", "disc_clutch.torque", "claw_clutch.torque", "gear_mesh.force")
+
+
+def drive_modes(model, op) -> dict:
+    """Frequency [Hz] of the complex mode with the largest strain-energy share of ID1's disc
+    clutch and of ID1's driving shaft (as tests/literature/test_response_literature.py finds
+    them)."""
+    result = eigen_analysis(model, op)
+    best = {"ID1.disc_clutch": (0.0, 0.0), "ID1.driving_shaft": (0.0, 0.0)}
+    for index in result.complex_index:
+        lam = result.eigenvalues[index]
+        if lam.imag / (2 * np.pi) > 2000.0:
+            break
+        strain = mode_character(model, result, index).strain
+        for group in best:
+            if strain.get(group, 0.0) > best[group][0]:
+                best[group] = (strain[group], float(lam.imag / (2 * np.pi)))
+    return {group: hz for group, (_, hz) in best.items()}
+
+
+def summary(result, names) -> dict:
+    """Per output: total peak and time, perturbation peak and time, pre-fault value, max, min,
+    dominant frequencies."""
+    return {name: {"peak": result.peaks[name], "peak_time": result.peak_times[name],
+                   "swing": result.perturbation_peaks[name],
+                   "swing_time": result.perturbation_peak_times[name],
+                   "steady": result.steady[name], "max": float(result.outputs[name].max()),
+                   "min": float(result.outputs[name].min()),
+                   "dominant_hz": list(result.dominant_frequencies[name])} for name in names}
+
+
+def crossings(result) -> dict:
+    return {f"{c.output}>{c.limit_name}": c.time for c in result.limit_crossings}
+
+
+def id1_over_id2(result, t_max: float) -> dict:
+    """|Δ| peak of ID1 over that of ID2, per drive part, over 0…t_max."""
+    window = result.t <= t_max
+    ratios = {}
+    for part in DRIVE_PARTS:
+        id1 = np.abs(result.perturbation(f"ID1.{part}")[window]).max()
+        id2 = np.abs(result.perturbation(f"ID2.{part}")[window]).max()
+        ratios[part] = float(id1 / id2)
+    ratios["smallest"] = min(ratios.values())
+    return ratios
+
+
+def numbers(model, parameters, stable, unstable) -> dict:
+    names = [f"{drive}.{part}" for drive in ("ID1", "ID2") for part in DRIVE_PARTS] + [
+        f"{drive}.wheelset.adhesion_moment" for drive in ("ID1", "ID2")]
+    op = stable.operating_point
+    excitation = stable.excitation
+    decay = excitation.D * 2 * np.pi * excitation.f
+    total_motor = stable.motor_torque + stable.M_C
+    long_stable = short_circuit_response(model, op, ShortCircuit(), 5.0, 2000.0)
+    long_unstable = short_circuit_response(model, unstable.operating_point, ShortCircuit(), 5.0,
+                                           2000.0)
+    at = {t: int(np.argmin(np.abs(long_stable.t - t))) for t in (2.0, 4.0, 5.0)}
+    system = bogie_system(model, op)
+    values = system.eigen[0]
+    pairs = int(np.count_nonzero(values.imag > 0))
+    reals = int(np.count_nonzero(values.imag == 0))
+    unstable_dc = unstable.perturbation("ID1.disc_clutch.torque")
+    return {
+        "excitation": {"M0": excitation.M0, "f": excitation.f, "D": excitation.D,
+                       "decay_rate": decay, "envelope_0.1": float(np.exp(-decay * 0.1)),
+                       "envelope_0.2": float(np.exp(-decay * 0.2)),
+                       "phase_shift": stable.phase_shift, "motor_torque": stable.motor_torque,
+                       "M0_over_M": excitation.M0 / stable.motor_torque,
+                       "total_motor_torque_min": float(total_motor.min())},
+        "modes_hz": drive_modes(model, op),
+        "M_ad": stable.limits["M_ad"],
+        "stable": {"outputs": summary(stable, names), "crossings": crossings(stable),
+                   "id1_over_id2_2s": id1_over_id2(stable, 2.0),
+                   "id1_over_id2_0.4s": id1_over_id2(stable, 0.4),
+                   "ID2.disc_clutch.torque_at": {f"{t:g}": float(long_stable.outputs[
+                       "ID2.disc_clutch.torque"][i]) for t, i in at.items()},
+                   "ID2.driving_shaft.torque_perturbation_at": {f"{t:g}": float(
+                       long_stable.perturbation("ID2.driving_shaft.torque")[i])
+                       for t, i in at.items()},
+                   "ID2.driving_shaft.torque_peak_0.5s": float(np.abs(stable.outputs[
+                       "ID2.driving_shaft.torque"][stable.t <= 0.5]).max()),
+                   "ID1_disc_clutch_half_period": 0.5 / drive_modes(model, op)["ID1.disc_clutch"]},
+        "unstable": {"outputs": summary(unstable, names), "crossings": crossings(unstable),
+                     "ID1.disc_clutch.torque_at_2s": float(unstable.outputs[
+                         "ID1.disc_clutch.torque"][-1]),
+                     "ID1.disc_clutch.perturbation_max_2s": float(np.abs(unstable_dc).max()),
+                     "ID1.disc_clutch.torque_at_5s": float(long_unstable.outputs[
+                         "ID1.disc_clutch.torque"][-1]),
+                     "truncated_at_5s": long_unstable.truncated_at,
+                     "dominant_hz": list(unstable.dominant_frequencies["ID1.disc_clutch.torque"])},
+        "sizes": {"outputs": len(stable.outputs), "samples": len(stable.t),
+                  "states": int(system.N), "deflated_states": len(values),
+                  "modal_terms": pairs + reals, "complex_pairs": pairs, "real_modes": reals,
+                  "augmented_states": int(system.N) + 3},
+    }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--params", default=None)
@@ -154,6 +265,9 @@ def main() -> None:
               f"{stable.perturbation_peak_times[name]:.3f} s, dominant "
               f"{stable.dominant_frequencies[name]} Hz")
     print(f"wrote 5 figures to {out}/")
+    if args.params is None:
+        data = numbers(model, parameters, stable, unstable)
+        print(f"wrote {write_results('response', data, 'scripts/figures_response.py')}")
 
 
 if __name__ == "__main__":

@@ -57,7 +57,7 @@ def golden_data(parameters) -> dict:
         points.append({
             "s0": s0, "v_kmh": SPEED_KMH, "N0": N0, "b_M": b_M,
             "complex": [[float(z.real), float(z.imag)] for z in complex_pairs],
-            "real": [float(x) for x in result.real[:N_REAL]],
+            "real": [float(x) for x in result.real_eigenvalues[:N_REAL]],
             "max_real_part": result.max_real_part,
             "stable": result.stable,
             "motor_torque": motor_torque(parameters, op),

@@ -67,7 +67,7 @@ def cmd_eigen(args: argparse.Namespace) -> None:
                      "description": text}
                     for lam, text in zip(result.complex_pairs[: args.count], descriptions,
                                          strict=False)]
-    real_rows = [{"re": float(value)} for value in result.real[: args.count]]
+    real_rows = [{"re": float(value)} for value in result.real_eigenvalues[: args.count]]
     data = {"operating_point": op.as_dict(), "stable": result.stable,
             "max_real_part": result.max_real_part, "flutter_pairs": result.flutter,
             "divergent_real": result.divergence, "rigid_body": result.n_rigid,

@@ -191,7 +191,7 @@ def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: fl
         key=(params_path, rail, s0, v_kmh, N0_kN, b_M), eigenvalues=result.eigenvalues,
         stable=result.stable, max_real_part=result.max_real_part, flutter=result.flutter,
         divergence=result.divergence, n_rigid=result.n_rigid, modes=modes,
-        real=result.real[:N_REAL_TABLE], creep_s=s_grid, creep_mu=np.asarray(law.mu(s_grid, op.v)),
+        real=result.real_eigenvalues[:N_REAL_TABLE], creep_s=s_grid, creep_mu=np.asarray(law.mu(s_grid, op.v)),
         mu0=float(law.mu(op.s0, op.v)), s_max=s_max, mu_max=mu_max,
         M_ad=adhesion_moment(m.parameters, op.v, op.N0))
     _KNOWN_POINTS.remember(point.key, point)

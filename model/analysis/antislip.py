@@ -96,6 +96,18 @@ def required_reaction_time(model: BogieModel, op: OperatingPoint,
     20 ms); ``drives`` whose disc clutch and driving shaft torques are limited; ``progress``
     gets a line after each delay of the grid; ``checkpoint`` is handed to every run
     (:func:`model.analysis.nonlinear.nonlinear_response`: what it raises ends the search).
+
+    Example::
+
+        >>> import numpy as np
+        >>> from model import (build_model, default_operating_point, load_parameters,
+        ...                    required_reaction_time)
+        >>> parameters = load_parameters()
+        >>> model = build_model(parameters)
+        >>> result = required_reaction_time(model, default_operating_point(parameters, s0=0.014),
+        ...                                 delays=np.array([0.0, 0.5]), fs=2000.0)
+        >>> result.reason in ("found", "no delay suffices", "every delay suffices")
+        True
     """
     excitation = ShortCircuit() if excitation is None else excitation
     base = AntiSlip() if anti_slip is None else anti_slip

@@ -197,7 +197,21 @@ def campbell(model: BogieModel, op: OperatingPoint, v_values, orders: tuple[Orde
              max_frequency_hz: float = MODEL_FREQUENCY_LIMIT_HZ, rtol: float = CAMPBELL_RTOL,
              workers: int = 2) -> CampbellDiagram:
     """The Campbell diagram over the speeds ``v_values`` [m/s] at ``op``'s creepage, wheel force
-    and motor slope (module docstring); severities per unit torque of ``input``."""
+    and motor slope (module docstring); severities per unit torque of ``input``.
+
+    Example::
+
+        >>> import numpy as np
+        >>> from model import KMH, build_model, campbell, default_operating_point, load_parameters
+        >>> from model.mechanics.excitation import load_excitation, parse_orders
+        >>> parameters = load_parameters()
+        >>> model = build_model(parameters)
+        >>> speeds = np.linspace(20, 180, 9) * KMH                 # [m/s]
+        >>> diagram = campbell(model, default_operating_point(parameters, v_kmh=100), speeds,
+        ...                    parse_orders("el:6,mesh:1"), load_excitation())
+        >>> sorted({c.order.name for c in diagram.crossings})
+        ['el:6', 'mesh:1']
+    """
     v = check_speeds(v_values)
     if not 0 <= participation_threshold <= 1:
         raise CampbellError(f"the participation threshold must be in [0, 1], got "

@@ -13,6 +13,7 @@ with vectors is shared with the short-circuit response through :func:`bogie_syst
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -101,9 +102,17 @@ class EigenResult:
         return self.eigenvalues[self.complex_index]
 
     @property
-    def real(self) -> np.ndarray:
-        """Real eigenvalues from the largest down [1/s]."""
+    def real_eigenvalues(self) -> np.ndarray:
+        """Real eigenvalues from the largest down [1/s] (the real ones, not the real parts)."""
         return self.eigenvalues.real[self.real_index]
+
+    @property
+    def real(self) -> np.ndarray:
+        """Deprecated name of :attr:`real_eigenvalues` (it is not the real parts, as numpy's
+        ``.real`` would be); warns, and goes in the next release."""
+        warnings.warn("EigenResult.real is deprecated: use EigenResult.real_eigenvalues (the real "
+                      "eigenvalues, largest first)", DeprecationWarning, stacklevel=2)
+        return self.real_eigenvalues
 
     @property
     def max_real_part(self) -> float:
@@ -120,7 +129,7 @@ class EigenResult:
         """Number of positive real eigenvalues (a real eigenvalue zero to rounding, |λ| <=
         :data:`NEUTRAL_RTOL` max|λ|, is neutral: a rigid-body motion's velocity without any
         damping, e.g. the vehicle rolling freely at b_M = 0)."""
-        values = self.real
+        values = self.real_eigenvalues
         tolerance = NEUTRAL_RTOL * np.abs(self.eigenvalues).max()
         return int(np.count_nonzero(values > tolerance))
 
@@ -157,8 +166,20 @@ def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) 
     """All eigenvalues (and eigenvectors) at ``op`` with the rigid-body ones deflated.
 
     With ``vectors`` the decomposition is cached for the operating point (the response reuses
-    it); without, a point already decomposed is not decomposed again, and a new one is not kept
-    (root finding and sweeps would only evict the points the user is looking at)."""
+    it); without, a point already decomposed is not decomposed again, and a new one is not cached
+    (root finding and sweeps would only evict the points the user is looking at).
+
+    Example::
+
+        >>> from model import build_model, default_operating_point, eigen_analysis, load_parameters
+        >>> parameters = load_parameters()
+        >>> model = build_model(parameters)
+        >>> result = eigen_analysis(model, default_operating_point(parameters, s0=0.014))
+        >>> result.stable, result.flutter > 0, result.divergence
+        (False, True, 2)
+        >>> bool(result.real_eigenvalues[0] > 0)        # the largest real eigenvalue [1/s]
+        True
+    """
     n_rigid = model.rigid_body_modes.shape[1]
     if not vectors:
         cache = model.__dict__.get("_systems")

@@ -302,7 +302,17 @@ def frequency_response(model: BogieModel, op: OperatingPoint, input: str = DEFAU
     """H(f) from ``input`` to the outputs (default: every named output) at ``op`` on the
     resonance-refined grid over [f_lo, f_hi] [Hz] with ``points`` log-spaced base points, the
     static gain at f = 0 first; peaks (local maxima of |H| at least ``min_peak`` of the output's
-    largest |H|) refined by golden-section search."""
+    largest |H|) refined by golden-section search.
+
+    Example::
+
+        >>> from model import build_model, default_operating_point, frequency_response, load_parameters
+        >>> parameters = load_parameters()
+        >>> frf = frequency_response(build_model(parameters), default_operating_point(parameters))
+        >>> peak = max(frf.peaks[frf.output("ID1.driving_shaft.torque")], key=lambda p: p.abs)
+        >>> round(peak.f_hz)                            # the driving shaft's mode [Hz]
+        298
+    """
     check_band(f_lo, f_hi, points)
     if not 0 <= min_peak < 1:
         raise FrequencyResponseError(f"min_peak must be in [0, 1), got {min_peak!r}")

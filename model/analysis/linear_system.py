@@ -64,8 +64,8 @@ def balancing_scale(A: np.ndarray, sweeps: int = 32) -> np.ndarray:
     """Diagonal balancing of A by powers of 2: ``d`` such that ``D⁻¹ A D`` (D = diag(d)) has
     equal 1-norms of row i and column i without the diagonal, for every i (as far as powers of 2
     allow).  All rows are updated at once, ``d_i ← d_i·2^round(½ log2(r_i/c_i))``, two
-    matrix-vector products per sweep, until no factor changes (≈ 1 ms for N = 384 against ≈ 6 ms
-    for LAPACK's sequential dgebal; on the bogie the eigenvector matrix of the result is 5x
+    matrix-vector products per sweep, until no factor changes (a fraction of the time
+    of LAPACK's sequential dgebal on the bogie's state matrix; on the bogie the eigenvector matrix of the result is 5x
     better conditioned).  Any diagonal similarity is exact: the balancing only affects rounding.
     Zero rows or columns keep d_i = 1."""
     magnitude = np.abs(A)

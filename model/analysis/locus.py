@@ -282,7 +282,19 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     ``select``: None (every mode inside the disc) or a hashable callable ``select(model, point,
     eigenvalues) -> bool mask`` over the eigenvalues of :func:`eigen_analysis` at ``point``: the
     modes (inside the disc) whose vectors form the basis at each of the three exact points and,
-    at the first, the branches tracked (module docstring, step 5)."""
+    at the first, the branches tracked (module docstring, step 5).
+
+    Example::
+
+        >>> import numpy as np
+        >>> from model import build_model, default_operating_point, load_parameters, root_locus
+        >>> parameters = load_parameters()
+        >>> model = build_model(parameters)
+        >>> locus = root_locus(model, default_operating_point(parameters), "s0",
+        ...                    np.linspace(0.002, 0.016, 8))
+        >>> locus.eigenvalues.shape[0]                  # one row per swept value
+        8
+    """
     if not (math.isfinite(lambda_floor) and lambda_floor >= 0):
         raise ValueError(f"lambda_floor must be a finite value >= 0 [1/s], got {lambda_floor!r}")
     values, points, coefficients = _sweep_points(model, op, parameter, values)

@@ -311,6 +311,17 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     ``checkpoint``: called between blocks of BLOCK_STEPS integration steps; whatever it raises
     ends the run and reaches the caller (a caller's cancellation: an interactive session that no
     longer wants the result stops it within one block, not at the end of the run).
+
+    Example::
+
+        >>> from model import (AntiSlip, build_model, default_operating_point, load_parameters,
+        ...                    nonlinear_response)
+        >>> parameters = load_parameters()
+        >>> model = build_model(parameters)
+        >>> r = nonlinear_response(model, default_operating_point(parameters, s0=0.014), t_end=0.5,
+        ...                        fs=5000.0, anti_slip=AntiSlip(enabled=True, delay=0.1))
+        >>> bool(abs(r.peaks["ID2.disc_clutch.torque"]) < 2 * r.limits["M_ad"])   # bounded
+        True
     """
     excitation = ShortCircuit() if excitation is None else excitation
     request = _check_inputs(model, op, t_end, fs, creep, anti_slip, outputs, strength, keep_states,

@@ -559,6 +559,18 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
 
     ``t_end`` [s] horizon (0 < t_end ≤ 60), ``fs`` [Hz] output sampling rate (the grid is
     ``t = k/fs``, k = 0 … round(t_end fs)); ``outputs`` names (default: all loads of both drives).
+
+    Example::
+
+        >>> from model import (ShortCircuit, build_model, default_operating_point, load_parameters,
+        ...                    short_circuit_response)
+        >>> parameters = load_parameters()
+        >>> model = build_model(parameters)
+        >>> r = short_circuit_response(model, default_operating_point(parameters, s0=0.005),
+        ...                            ShortCircuit(M0=50e3, f=90.0, D=0.04), t_end=0.5, fs=5000.0)
+        >>> swing = abs(r.perturbation_peaks["ID1.disc_clutch.torque"])   # [N m]
+        >>> bool(swing > r.limits["M_ad"]), r.units["ID1.disc_clutch.torque"]
+        (True, 'N m')
     """
     excitation = ShortCircuit() if excitation is None else excitation
     n_points = time_grid_points(t_end, fs)

@@ -386,14 +386,19 @@ def _subsystem_of(model: BogieModel) -> np.ndarray:
 
 def eigen_sensitivities(model: BogieModel, op: OperatingPoint, indices: Iterable[int] | None = None,
                         linked: Iterable[str] = (), parameters: Iterable[str] | None = None,
-                        result: EigenResult | None = None,
-                        describe: bool = True) -> EigenSensitivities:
+                        result: EigenResult | None = None, describe: bool = True) -> EigenSensitivities:
     """dλ/dp at ``op`` for the eigenvalues ``indices`` of the eigen-analysis (default: the ten
     lowest complex pairs), every parameter (or those named in ``parameters``) and s0, v, N0, b_M.
 
     ``linked``: parameter names of :data:`LINKED` whose rows add the operating quantity's
     derivative (the operating point took them from the set).  ``describe=False`` skips the
-    energy shares and descriptions of the modes (empty; the caller has them already)."""
+    energy shares and descriptions of the modes (empty; the caller has them already).
+    Example:
+        >>> from model import build_model, default_operating_point, eigen_sensitivities, load_parameters
+        >>> p = load_parameters(); s = eigen_sensitivities(build_model(p), default_operating_point(p), indices=[0])
+        >>> "disc_clutch_torsional_stiffness" in s.names
+        True
+    """
     linked = tuple(linked)
     for name in linked:
         if name not in LINKED:
@@ -528,7 +533,13 @@ def limit_sensitivity(model: BogieModel, v: float, N0: float, b_M: float,
                       parameters: Iterable[str] | None = None) -> LimitSensitivity:
     """ds0*/dp at speed ``v`` [m/s] for every parameter (or those named) and v, N0, b_M.
 
-    ``s0_limit``: the limit if already known (else :func:`model.analysis.stability.stability_limit`)."""
+    ``s0_limit``: the limit if already known (else :func:`model.analysis.stability.stability_limit`).
+    Example:
+        >>> from model import KMH, build_model, limit_sensitivity, load_parameters
+        >>> p = load_parameters()
+        >>> round(limit_sensitivity(build_model(p), 120 * KMH, p["wheel_force"], p["motor_slope"]).s0_limit, 4)
+        0.0082
+    """
     linked = tuple(linked)
     wanted = list(SCHEMA) if parameters is None else list(parameters)
     for name in wanted:
@@ -633,8 +644,7 @@ class PeakLoadSensitivity:
 
 def peak_load_sensitivities(parameters: Parameters, op: OperatingPoint,
                             names: Iterable[str] | None = None, step: float = PEAK_STEP,
-                            t_end: float = 0.5, fs: float = 10_000.0,
-                            progress=None) -> PeakLoadSensitivity:
+                            t_end: float = 0.5, fs: float = 10_000.0, progress=None) -> PeakLoadSensitivity:
     """Sensitivities of the peak ID1/ID2 disc-clutch and driving-shaft torques (totals) to each
     parameter by central differences of the closed-form response, evaluated **at the nominal
     peak's sample** (envelope theorem: the peak is stationary in time, so moving its time changes
@@ -642,7 +652,14 @@ def peak_load_sensitivities(parameters: Parameters, op: OperatingPoint,
 
     Step ``step`` relative (10⁻³): the truncation error is O(step²) ≈ 10⁻⁶ relative, the closed
     form's own error (≈ 10⁻⁷ of the response, docs/response.md) divided by the step ≈ 10⁻⁴.
-    Cost: two model assemblies, eigendecompositions and responses per parameter."""
+    Cost: two model assemblies, eigendecompositions and responses per parameter.
+
+    Example (parameters x outputs):
+        >>> from model import default_operating_point, load_parameters, peak_load_sensitivities
+        >>> p = load_parameters(); peaks = peak_load_sensitivities(p, default_operating_point(p), names=["gear_ratio"])
+        >>> peaks.normalized.shape
+        (1, 4)
+    """
     import time
 
     from model.analysis.response import short_circuit_response

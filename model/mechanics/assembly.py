@@ -416,7 +416,15 @@ def assembled_matrices(parameters: Parameters) -> tuple[np.ndarray, np.ndarray, 
 
 
 def build_model(parameters: Parameters) -> BogieModel:
-    """Assemble the constant matrices of the bogie for a parameter set."""
+    """Assemble the constant matrices of the bogie for a parameter set.
+
+    Example::
+
+        >>> from model import build_model, load_parameters
+        >>> model = build_model(load_parameters())
+        >>> model.n, model.dofs.names[0]                # coordinates, the first one's name
+        (197, 'ID1.rotor.ry')
+    """
     p = parameters
     asm, dofs, positions = _assemble(p)
     n = len(dofs)

@@ -60,6 +60,16 @@ class OperatingPoint:
 
 def default_operating_point(parameters: Parameters, s0: float = 0.005,
                             v_kmh: float = 120.0) -> OperatingPoint:
+    """The operating point (s0 [-], v_kmh [km/h]) with the set's wheel force N0 and motor slope
+    b_M.
+
+    Example::
+
+        >>> from model import default_operating_point, load_parameters
+        >>> op = default_operating_point(load_parameters(), s0=0.005, v_kmh=120)
+        >>> op.s0, round(op.v, 3)                       # v in m/s inside
+        (0.005, 33.333)
+    """
     return OperatingPoint.from_kmh(s0, v_kmh, parameters["wheel_force"], parameters["motor_slope"])
 
 

@@ -318,7 +318,17 @@ def _default_strength_data() -> tuple[dict[str, float], dict[str, str]]:
 
 
 def load_parameters(path: str | Path | None = None) -> Parameters:
-    """Read a parameter file; ``None`` gives the calibrated default set."""
+    """Read a parameter file; ``None`` gives the calibrated default set.
+
+    Example::
+
+        >>> from model import load_parameters
+        >>> parameters = load_parameters()              # the calibrated default set
+        >>> parameters["wheel_force"]                   # N0 [N]
+        100000.0
+        >>> parameters.replace(driving_shaft_stiffness=6e6)["driving_shaft_stiffness"]
+        6000000.0
+    """
     path = Path(path) if path is not None else CALIBRATED_FILE
     if not path.is_file():
         raise ParameterError(f"parameter file '{path}' does not exist")

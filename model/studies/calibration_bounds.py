@@ -29,9 +29,8 @@ CREEP_SHAPE_PARAMETERS = (
                    "spec's starting fit (600)"),
 )
 # stage J: the structure, the dampers and the motor slope against Table 1.  Inertias and
-# stiffnesses within about x3 of their estimate and within what the part can be; bounds that the
-# previous calibration sat on (frame roll inertia 5 000, stator pitch inertia 557 kg m^2) are
-# tightened to physical limits of the frame (4.9 t with its equipment) and a 2.6 t motor with
+# stiffnesses within about x3 of their estimate and within what the part can be: the inertias
+# within the physical limits of the frame (4.9 t with its equipment) and of a 2.6 t motor with
 # its gear housing
 STRUCTURAL_PARAMETERS = (
     ParameterRange("secondary_stiffness_z", 2e5, 1.8e6, "x3 around 0.6 MN/m (1.26 Hz with 28 t)"),

@@ -25,7 +25,7 @@ from model.mechanics.parameters import Parameters
 V_REF = 120 * KMH  # [m/s]
 S0_STABLE, S0_UNSTABLE = 0.005, 0.014
 
-# --- published targets (Zeman & Hlaváč; see shared/spec/reference-results.md) -------------------
+# --- published targets (Zeman & Hlaváč, Table 1 and the operating data; CITATION.cff) -----------
 TABLE1_IM_HZ = (1.262, 2.694, 5.425, 5.449, 6.176, 8.503, 8.583, 9.183, 12.208, 12.58)
 DRIVING_SHAFT_HZ = 298.4
 MOTOR_TORQUE = 12_800.0  # [N m] at both creepages
@@ -219,7 +219,7 @@ def evaluate_by_rank(parameters: Parameters, model=None, complete: Callable | No
     below = eigen_analysis(model, reference_point(parameters, LIMIT_CHECK), vectors=False)
     return RankEvaluation(result.stable, result.character_ok, result.matched,
                           result.driving_shaft, result.max_real_stable,
-                          unstable.complex_pairs[:len(TABLE1_IM_HZ)], unstable.real,
+                          unstable.complex_pairs[:len(TABLE1_IM_HZ)], unstable.real_eigenvalues,
                           below.max_real_part)
 
 

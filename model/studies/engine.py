@@ -43,8 +43,8 @@ from functools import partial
 BLAS_ENVIRONMENT = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 SCHEDULER_VARIABLE = "DASK_SCHEDULER_ADDRESS"
 # Dask's nanny starts workers with MALLOC_TRIM_THRESHOLD_=65536 (to return memory to the OS).
-# Setting it disables glibc's dynamic mmap threshold, so every array above 128 KiB (the 193 x 193
-# and 384 x 384 matrices of an eigen-analysis) is mmap-ed, page-faulted and unmapped again: a
+# Setting it disables glibc's dynamic mmap threshold, so every array above 128 KiB (the
+# coordinate-sized and state-sized matrices of an eigen-analysis) is mmap-ed, page-faulted and unmapped again: a
 # chunk cost 1.6-1.8x the CPU time in a worker that it costs in a plain process (measured).
 # Unset for the local cluster; for ``dask worker`` set the environment variable
 # DASK_DISTRIBUTED__NANNY__PRE_SPAWN_ENVIRON__MALLOC_TRIM_THRESHOLD_=None (docs/cluster.md).

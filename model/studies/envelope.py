@@ -454,7 +454,23 @@ def envelope(study: EnvelopeStudy, arrays: dict[str, np.ndarray]) -> Envelope:
 def run_envelope(study: EnvelopeStudy, parameters: Parameters, map_unordered=None,
                  progress=None) -> Envelope:
     """Every scenario of ``study`` (``map_unordered``: the study engine's, default in this
-    process) and its envelope, without a store."""
+    process) and its envelope, without a store.
+
+    Example::
+
+        >>> from model import EnvelopeStudy, KMH, build_model, load_parameters, run_envelope
+        >>> from model.studies.envelope import resolve_outputs
+        >>> from model import default_operating_point
+        >>> parameters = load_parameters()
+        >>> op = default_operating_point(parameters)
+        >>> names = ["ID1.driving_shaft.torque"]
+        >>> outputs, units = resolve_outputs(build_model(parameters), op, names, "linear")
+        >>> study = EnvelopeStudy(s0=(0.005,), v=(120 * KMH,), N0=(op.N0,), b_M=(op.b_M,),
+        ...                       outputs=outputs, units=units, fault="all", t_end=0.5)
+        >>> envelope = run_envelope(study, parameters)
+        >>> envelope.outputs[0].max > 2e4               # the worst fault instant [N m]
+        True
+    """
     from model.studies.engine import serial_map_unordered
     from model.studies.store import run_in_memory
 

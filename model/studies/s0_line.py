@@ -22,7 +22,7 @@ without (the first creepage and the grid creepage of the most negative b11, the 
 creep slope, the most destabilizing point) and one small eigenproblem per point (2r − 2
 unknowns: the rigid-body zeros of the reduced model are deflated once per line).
 
-**The basis** (tenth session): the anchor's exact eigenvectors of the selection below and the
+**The basis**: the anchor's exact eigenvectors of the selection below and the
 *creep responses* ``T_a(σ)⁻¹ G`` (T_a(λ) = λ²M + λC_a + K at the anchor, G the four
 longitudinal creep patterns, :func:`model.mechanics.operating_point.longitudinal_creep_pattern`).  Along a
 line only b11 changes, by a rank-4 term: an eigenpair (μ, x) at b11 = c solves
@@ -37,7 +37,7 @@ of 69–71 for the exact eigenvectors at both ends (BENCHMARKS.md, "Parameter st
 The dense eigenvalues at the first creepage and at the b11 minimum check the basis: every
 eigenvalue there that the selection would take must have a Ritz value within
 10⁻⁴·max(|λ|, 1 1/s); if one has none, the basis falls back to the exact eigenvectors at both
-ends (the ninth session's), and at that creepage as a third anchor if its check still fails.
+ends, and at that creepage as a third anchor if its check still fails.
 Its properties:
 
 What a point reports is a property of **all** eigenvalues, not only of tracked branches:
@@ -503,10 +503,9 @@ def s0_line(model: BogieModel, s0_values, v: float, N0: float, b_M: float,
     point, exact to the convergence tolerance, checked at every point; a point that fails the
     checks is solved by a full eigen-analysis and counted in ``fallbacks``), "reduced" (the
     default: :func:`reduced_s0_line`, ``max_frequency_hz`` and ``rtol`` apply) or "dense"
-    (:func:`dense_line`).  The default stays "reduced" because it is cheaper: measured on the
-    shared machine, a map point cost 0.35 of an eigenvalues-only analysis with "reduced" and
-    1.26 with "continuation" (BENCHMARKS.md); in the tenth session 0.18–0.19 with
-    "reduced" and 20–26 ms a point (≈ 0.8) with "continuation"."""
+    (:func:`dense_line`).  The default is "reduced" because it is cheaper: a map point costs
+    about 0.2 of an eigenvalues-only analysis with "reduced" and about 1 with "continuation"
+    (BENCHMARKS.md, "Parameter studies")."""
     if method == "reduced":
         return reduced_s0_line(model, s0_values, v, N0, b_M, max_frequency_hz, rtol,
                                s0_limit_xtol)

@@ -1,9 +1,9 @@
 """Literature tests: the published qualitative facts of the short-circuit response.
 
 Source: V. Zeman, Z. Hlaváč, "Dynamic wheelset drive load of the railway vehicle caused by
-short-circuit motor moment", Applied and Computational Mechanics (Plzeň) — as restated in
-/work/shared/spec/reference-results.md.  The paper's figures are not available as data, so the
-statements are qualitative; each tolerance below says why it is what it is.
+short-circuit motor moment", Applied and Computational Mechanics (Plzeň) (CITATION.cff).
+The paper's figures are not available as data, so the statements are qualitative; each
+tolerance below says why it is what it is.
 
 The frequencies are compared with the model's OWN eigenfrequencies of the corresponding modes
 (identified by strain energy: twisting of ID1's disc clutch, twisting of ID1's driving shaft),

@@ -167,19 +167,29 @@ def test_bad_export_target(capsys, tmp_path, monkeypatch, arguments):
 
 
 @pytest.mark.parametrize(("arguments", "mention"), [
-    pytest.param(["--max-evaluations", "0"], "--max-evaluations", id="no evaluations"),
-    pytest.param(["--max-evaluations", "x"], "--max-evaluations", id="not a number"),
+    pytest.param([], "--out FILE is required", id="no output"),
+    pytest.param(["--max-evaluations", "3"], "--out FILE is required", id="no output, a budget"),
+    pytest.param(["--out", "set.toml", "--max-evaluations", "0"], "--max-evaluations",
+                 id="no evaluations"),
+    pytest.param(["--out", "set.toml", "--max-evaluations", "x"], "--max-evaluations",
+                 id="not a number"),
     pytest.param(["--out", "/no/such/directory/set.toml"], "does not exist", id="missing dir"),
-    pytest.param(["--start", "/no/such/start.toml"], "does not exist", id="missing start"),
+    pytest.param(["--out", "set.toml", "--start", "/no/such/start.toml"], "does not exist",
+                 id="missing start"),
 ])
 def test_bad_calibrate_arguments_change_nothing(capsys, tmp_path, monkeypatch, arguments,
                                                 mention):
-    """Rejected before any search: one line, exit 2, no file written."""
+    """Rejected before any search: one line, exit 2, no file written — the bundled default
+    set above all (``bogie calibrate`` writes only to ``--out``)."""
+    from model.mechanics.parameters import CALIBRATED_FILE
+
+    bundled = CALIBRATED_FILE.read_bytes()
     monkeypatch.chdir(tmp_path)
     code, out, err = run(["calibrate", *arguments], capsys)
     assert_one_line_error(code, out, err)
     assert mention in err
     assert list(tmp_path.iterdir()) == []
+    assert CALIBRATED_FILE.read_bytes() == bundled
 
 
 # a process start costs ~1–2 s (numpy, scipy): one case in the fast set, the others slow
@@ -235,7 +245,7 @@ def test_eigen_json_contract(capsys, model):
     assert np.allclose([row["re"] for row in data["complex"]], result.complex_pairs[:6].real,
                        rtol=1e-9, atol=1e-9 * np.abs(result.eigenvalues).max())
     assert np.allclose(im, result.complex_pairs[:6].imag / (2 * np.pi), rtol=1e-9)
-    assert np.allclose(re, result.real[:6], rtol=1e-9, atol=1e-9 * np.abs(result.eigenvalues).max())
+    assert np.allclose(re, result.real_eigenvalues[:6], rtol=1e-9, atol=1e-9 * np.abs(result.eigenvalues).max())
 
 
 def test_eigen_human_readable(capsys):

@@ -145,7 +145,7 @@ def test_views_show_the_current_point(dash):
     assert len(dash.locus_plot.lines.data["xs"]) == dash.locus_result.eigenvalues.shape[1]
     # tables: one row per complex pair / real eigenvalue, in Table 1 / Table 2 layout
     assert dash.click.table.descriptions == [mode.description for mode in dash.point.modes]
-    assert f"{result.real[0]:+.4g}" in dash.eigen_table.object
+    assert f"{result.real_eigenvalues[0]:+.4g}" in dash.eigen_table.object
 
 
 @pytest.mark.slow

@@ -18,7 +18,7 @@ package), never from numbers typed in here.  Tolerances, and why:
   difference, as the 1e-6 above.
 * **1 % of the peak** for "the closed form is within a 36-instant grid": the grid misses the worst
   phase by at most 5°, so by at most 1 − cos 5° = 0.38 % of the oscillating part.
-* **1e-6 relative** for the equivalent ranges against ``rainflow.count_cycles`` (the issue's
+* **1e-6 relative** for the equivalent ranges against ``rainflow.count_cycles`` (the
   target; both sum the same terms in another order).
 * The plots are float32 (half the bytes to the browser): 1e-6 relative against the float64
   results.

@@ -3,7 +3,7 @@
 A ``bogie serve`` process of its own, with a studies folder made here, is driven by headless
 Chromium.  A page is a hand-made client too: it sets any model's value from the page (hidden and
 disabled widgets included, and a Select's options, which a browser can send as well), which
-reaches the server as if typed (tests/../shared/guide/testing-the-app.md).
+reaches the server as if typed.
 
 * **No network address from a browser.**  A listener of this test counts connections while every
   TextInput and Select of every tab, and the query string, carry its address in the forms Dask

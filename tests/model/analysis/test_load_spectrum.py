@@ -4,7 +4,7 @@ damage-equivalent range, and agreement with the ``rainflow`` package on the mode
 Tolerances: the known signals are sums of sines sampled where the sines take the values 0 and ±1
 (cos(nπ/2) is 0 only to ≈ 6e-17), so their ranges are exact to rounding: 1e-12 relative.  Against
 the ``rainflow`` package's own aggregation (``count_cycles``) the equivalent ranges agree within
-1e-6 relative (the issue's target; the two sum the same terms in another order, so they agree to
+1e-6 relative (the target; the two sum the same terms in another order, so they agree to
 ≈ 1e-15) and the cycle totals exactly.
 """
 

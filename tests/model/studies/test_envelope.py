@@ -4,7 +4,7 @@ case, the scenario grid and its envelope against brute force (single responses).
 Tolerances, and why:
 
 * **1e-6 of each output's peak** (family and envelope against single ``short_circuit_response``
-  runs): the issue's target.  Both sides are the same exact closed form, so they agree far better
+  runs): the target.  Both sides are the same exact closed form, so they agree far better
   (measured ≤ 7.3e-9 of the perturbation peak at s0 = 0.005, ≤ 5e-13 at 0.014: the modal form
   skips a decayed mode's terms below 1e-13 of the largest term, and which terms are skipped
   depends on the input); 1e-6 is also the modal form's own error against the exact reference
@@ -12,10 +12,10 @@ Tolerances, and why:
   orders of magnitude more.
 * **1e-9 of the peak** for "every fault instant ≥ any grid of fault instants": both sides are
   formed from the same three responses, so the inequality a + √(b² + c²) ≥ a + b cos φ + c sin φ
-  holds to rounding (≈ 1e-15 relative); 1e-9 is the issue's figure.
+  holds to rounding (≈ 1e-15 relative); 1e-9 is the target.
 * **1 % of the peak** for "every fault instant within a 360-phase grid": the grid misses the
   worst phase by at most 0.5°, so the gap is at most √(b² + c²)(1 − cos 0.5°) = 3.8e-5 of the
-  oscillating part (the issue's target is 1 %).
+  oscillating part (the target is 1 %).
 """
 
 from __future__ import annotations
