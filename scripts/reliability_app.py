@@ -190,9 +190,16 @@ def isolation(url: str, sessions: int) -> dict:
 # --- 2. soak -------------------------------------------------------------------------------------
 
 def soak(url: str, pid: int | None, minutes: float, interval: float = 1.0,
-         sample_every: float = 10.0) -> dict:
+         sample_every: float = 10.0, s0_values: list[float] | None = None,
+         speeds_kmh: list[float] | None = None, warm: float = 0.0) -> dict:
     """One session changing a control every ``interval`` s for ``minutes``; server memory [MB]
-    sampled every ``sample_every`` s (``pid``: the server process; None: this process)."""
+    sampled every ``sample_every`` s (``pid``: the server process; None: this process).
+
+    The creepages visited are ``s0_values`` (default: every page step of the s0 slider, 0.0005)
+    and the speeds ``speeds_kmh`` [km/h] (default 80…160 km/h).  ``warm``: first visit every
+    combination once, wait for its first answer and ``warm`` s more for the slower stages
+    (the dense root locus, the assessment), so that the memory samples (taken after it) see
+    the caches already holding every result the soak asks for: what grows then is a leak."""
     from bokeh.client import pull_session
 
     _register_panel_models()
@@ -210,8 +217,21 @@ def soak(url: str, pid: int | None, minutes: float, interval: float = 1.0,
     # the s0 values on the slider's page steps (0.0005): the values a reviewer steps through,
     # revisited as the soak goes on
     page = 5 * s0.step
-    values = [round(s0.start + k * page, 6) for k in range(int((s0.end - s0.start) / page))]
+    values = s0_values or [round(s0.start + k * page, 6)
+                           for k in range(int((s0.end - s0.start) / page))]
+    speeds = speeds_kmh or [80.0, 100.0, 120.0, 140.0, 160.0]
     rng = random.Random(7)
+    warm_seconds = 0.0
+    if warm:
+        for speed in speeds:
+            for value in values:
+                if (value, speed) == (s0.value, v.value):
+                    continue
+                _wait_change(session, fast, lambda value=value, speed=speed: (
+                    _release(v, speed), _release(s0, value)), timeout=120)
+                _pause(session, warm)
+        warm_seconds = time.monotonic() - t0
+        t0 = next_sample = time.monotonic()
     try:
         while time.monotonic() - t0 < minutes * 60:
             now = time.monotonic()
@@ -221,7 +241,7 @@ def soak(url: str, pid: int | None, minutes: float, interval: float = 1.0,
             changes += 1
             try:
                 if changes % 10 == 0:
-                    speed = rng.choice([80.0, 100.0, 120.0, 140.0, 160.0])
+                    speed = rng.choice(speeds)
                     if speed != v.value:
                         _release(v, speed)
                 else:
@@ -244,7 +264,7 @@ def soak(url: str, pid: int | None, minutes: float, interval: float = 1.0,
         mean_t, mean_m = statistics.fmean(ts), statistics.fmean(ms)
         slope = sum((t - mean_t) * (m - mean_m) for t, m in half) / max(
             sum((t - mean_t) ** 2 for t in ts), 1e-9) * 60
-    return {"minutes": minutes, "changes": changes, "timeouts": errors,
+    return {"minutes": minutes, "changes": changes, "timeouts": errors, "warm_s": warm_seconds,
             "median_latency_s": statistics.median(latencies) if latencies else None,
             "rss_start_mb": warm[0], "rss_end_mb": samples[-1][1],
             "rss_max_mb": max(m for _, m in samples), "growth_mb": samples[-1][1] - warm[0],

@@ -57,15 +57,20 @@ def test_fuzz_of_queries_values_and_uploads(own_server, reliability):
 
 
 def test_short_soak_memory(own_server, reliability):
-    """20 s of a control changed every second (the 10-minute run is the script's).  Bound:
-    the server process grows by less than 200 MB — caches are bounded
-    (pn.cache max_items), so a leak per change would show as steady growth long before that
-    in the long run; here the check is that nothing explodes and the changes are answered."""
+    """A control changed every second for 20 s (the 10-minute run is the script's), over eight
+    operating points (four creepages on the slider's page steps, two speeds) that a warm pass
+    has computed first, waiting 3 s at each for the slower stages.  Every answer is then in a
+    cache, so the server's memory has no reason to grow: the bound, 50 MB, is what a leak of
+    one short-circuit history per change (2.7 MB, 20 changes) would exceed; measured here the
+    growth is about 1 MB.  From cold, the first minute fills the caches by several hundred MB
+    (bounded by their max_items; the boundary soak and the 10-minute run measure that)."""
     result = in_thread(reliability.soak, own_server[0], own_server[1], minutes=20 / 60,
-                       sample_every=5.0)
+                       sample_every=5.0, s0_values=[0.004, 0.0045, 0.005, 0.0055],
+                       speeds_kmh=[120.0, 140.0], warm=3.0)
     assert result["changes"] >= 10
     assert result["timeouts"] == 0
-    assert result["rss_end_mb"] - result["samples"][0][1] < 200
+    growth = result["rss_end_mb"] - result["samples"][0][1]
+    assert growth < 50, result["samples"]
 
 
 def test_sigterm_stops_the_server_at_once(tmp_path):
