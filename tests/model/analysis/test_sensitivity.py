@@ -109,20 +109,30 @@ def test_against_finite_differences(setup, s0):
             h = min(h, 1e-3 * abs(value))  # a/b (1.629; next node 1.667): stay between its nodes
         if name == "polach_kA":  # at its upper bound 1: the law is analytic beyond it
             h = min(h, 0.01)
-        ev = {c: _eigenvalues(parameters, model, op, name, value + c * h / 4)
-              for c in (-32, -16, -8, -4, -2, -1, -0.5, 0.5, 1, 2, 4, 8, 16, 32)}
+        ev: dict[float, np.ndarray] = {}  # eigenvalues at value + c h/4, computed when needed
+
+        def at(c, name=name, value=value, h=h, ev=ev):
+            if c not in ev:
+                ev[c] = _eigenvalues(parameters, model, op, name, value + c * h / 4)
+            return ev[c]
+
         pick = lambda e, target: e[np.argmin(np.abs(e - target))]  # noqa: E731
+        influence = abs(value) * largest / np.abs(lam).min()
+        tolerance = 1e-5 if value == 0.0 or influence >= WEAK else WEAK_TOLERANCE
         errors = []
         # steps h/8 … 4h: the best step of the reference is not known.  h/8 since the set
         # calibrated by rank: its wheelsets' yaw pair (12.04 / 12.07 Hz) lies near the frame's
         # lateral–roll (12.42 Hz) and bends strongly with the frame's and motors' roll inertias
-        # (best error at h/4 … 4h 6.9e-5 and 4.0e-5, at h/8 4.7e-6 and 5.1e-6)
-        for k in (0.5, 1, 2, 4, 8, 16):
-            fd = np.array([(-pick(ev[2 * k], t) + 8 * pick(ev[k], t) - 8 * pick(ev[-k], t)
-                            + pick(ev[-2 * k], t)) / (12 * k * h / 4) for t in lam])
+        # (best error at h/4 … 4h 6.9e-5 and 4.0e-5, at h/8 4.7e-6 and 5.1e-6).  The parameter
+        # passes when any step's error is within the tolerance: the steps are tried in the order
+        # they are most often the best, and the first within it ends the search (the eigenvalues
+        # of the remaining steps, two full analyses per step, are not computed).
+        for k in (1, 2, 0.5, 4, 8, 16):
+            fd = np.array([(-pick(at(2 * k), t) + 8 * pick(at(k), t) - 8 * pick(at(-k), t)
+                            + pick(at(-2 * k), t)) / (12 * k * h / 4) for t in lam])
             errors.append(np.abs(analytic - fd)[~near_defective].max() / np.abs(fd).max())
-        influence = abs(value) * largest / np.abs(lam).min()
-        tolerance = 1e-5 if value == 0.0 or influence >= WEAK else WEAK_TOLERANCE
+            if errors[-1] <= tolerance:
+                break
         if min(errors) > tolerance:
             failures.append(f"{name}: {min(errors):.2e} (influence {influence:.1e})")
     assert not failures, f"at s0 = {s0}: " + ", ".join(failures)
