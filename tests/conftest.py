@@ -45,16 +45,18 @@ def _one_blas_thread():
 #
 # A work unit goes to one worker as a whole.  Tests that share something expensive built once per
 # worker run in one unit: every test of a module that serves the dashboard or drives a browser
-# (one server in this process, one Chromium; the attacks on a ``bogie serve`` process of their own
-# and its reliability runs, whose servers have cluster workers of their own: two such at once
-# would overload two cores), the image build, the Dask cluster of the engine tests.  The other
+# (one server in this process, one Chromium, the attacks on a ``bogie serve`` process of their own
+# whose cluster workers must not meet another server's), the image build, the Dask cluster of the
+# engine tests.  The reliability runs on a fresh ``bogie serve`` of their own (no browser, no
+# timing bound: their waits are minutes) are a unit apart, started right after the served unit,
+# so that they run on the other core beside its browser tests (the file order puts those first),
+# not beside the attacks' timing of a slider answer.  The other
 # test modules go as one unit each (their module fixtures are built once), but for the few whose
 # tests are long and share nothing costly: those go test by test, so that both cores work on them.
 # The units are named from the test's id alone (``work_unit``): the scheduler sees nothing else.
 SERVED_FIXTURES = {"app_server", "chromium", "own_server"}
 SERVED_MODULES = {
     "tests/app/server/test_boundary.py",
-    "tests/app/server/test_reliability.py",
     "tests/app/dashboard/test_dashboard.py",
     "tests/app/dashboard/test_dashboard_browser.py",
     "tests/app/dashboard/test_design_loads_browser.py",
@@ -65,8 +67,10 @@ SERVED_MODULES = {
     "tests/app/dashboard/test_uncertainty_band_browser.py",
     "tests/app/dashboard/test_verdicts_browser.py",
 }
+OWN_SERVER_MODULES = {"tests/app/server/test_reliability.py"}
 GROUPS = {
     **dict.fromkeys(SERVED_MODULES, "served"),
+    **dict.fromkeys(OWN_SERVER_MODULES, "own-server"),
     "tests/image/test_docker_image.py": "image",
     "tests/model/studies/test_engine.py": "dask-cluster",
 }
@@ -78,7 +82,7 @@ TEST_BY_TEST = {
     "tests/app/cli/test_cli_antislip.py",
     "tests/test_benchmark_scripts.py",
 }
-FIRST = ("image", "served", "dask-cluster")  # the longest units start first
+FIRST = ("image", "served", "own-server", "dask-cluster")  # the longest units start first
 
 
 def work_unit(nodeid: str) -> str:
@@ -110,7 +114,8 @@ def pytest_collection_modifyitems(config, items):
     serves the app or drives a browser outside the served modules is refused: it would start a
     second server or browser beside the first."""
     strays = sorted({item.nodeid.split("::", 1)[0] for item in items
-                     if SERVED_FIXTURES & set(item.fixturenames)} - SERVED_MODULES)
+                     if SERVED_FIXTURES & set(item.fixturenames)}
+                    - SERVED_MODULES - OWN_SERVER_MODULES)
     if strays:
         raise pytest.UsageError(f"tests/conftest.py: add {', '.join(strays)} to SERVED_MODULES "
                                 "(it serves the app or drives a browser)")

@@ -439,7 +439,7 @@ def test_five_sessions_queue_with_one_running(setup, chromium):
         for page in pages:
             _tab(page, "Studies")
             _fill(page, "study-s0-points", "40")
-            _fill(page, "study-v-points", "24")  # 960 points, 24 s0-lines: several seconds
+            _fill(page, "study-v-points", "16")  # 640 points, 16 s0-lines: several seconds
         idle = [_slider_answer(pages[0]) for _ in range(5)]
         ahead: dict[int, int] = {}  # page -> studies ahead of it when it asked
         for index, page in enumerate(pages):
