@@ -17,10 +17,27 @@ from bokeh.models import ColumnDataSource, FactorRange, HoverTool, Span
 from bokeh.plotting import figure
 
 from model.analysis.assessment import KIND_NAMES, VERDICT_WORDS, verdict_colour
+from model.analysis.response import ShortCircuit
 from model.mechanics.operating_point import KMH, OperatingPoint
-from model.studies.assessment import Assessment, AssessmentOptions, assess
+from model.studies.assessment import (
+    Assessment,
+    AssessmentOptions,
+    LoadCase,
+    assessed_outputs,
+    assessment_of,
+    short_circuit_case,
+    starting_case,
+    unstable_adhesion_case,
+)
 
 CASE_COLOURS = {"short_circuit": "#1f77b4", "unstable_adhesion": "#d62728", "starting": "#2ca02c"}
+
+
+def _parameters(params_path: str, rail: str, strength: tuple):
+    from app.results import compute
+
+    parameters = compute.parameters(params_path, rail)
+    return parameters.replace(**dict(strength)) if strength else parameters
 
 
 @pn.cache(max_items=16)
@@ -28,15 +45,14 @@ def assessment_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_k
                       b_M: float, M0_kN: float, f: float, D: float,
                       strength: tuple = ()) -> Assessment:
     """The assessment at an operating point (primitives: the cache key), with the strength data
-    ``strength`` ((name, value) pairs) replacing the set's."""
-    from app.results import compute
+    ``strength`` ((name, value) pairs) replacing the set's.  The same as
+    :func:`model.studies.assessment.assess` with these options; its unstable case is cached
+    apart (:func:`unstable_case`): at a stable point it is the default one, which a step of
+    the creepage or the speed leaves as it was."""
     from model.analysis.eigen import bogie_system
-    from model.analysis.response import ShortCircuit
     from model.studies.maps import cached_model
 
-    parameters = compute.parameters(params_path, rail)
-    if strength:
-        parameters = parameters.replace(**dict(strength))
+    parameters = _parameters(params_path, rail, strength)
     op = OperatingPoint(s0, v_kmh * KMH, N0_kN * 1e3, b_M)
     stable = float(np.max(bogie_system(cached_model(parameters), op).eigenvalues().real)) <= 1e-6
     excitation = ShortCircuit(M0=M0_kN * 1e3, f=f, D=D)
@@ -45,7 +61,24 @@ def assessment_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_k
     else:
         options = AssessmentOptions(N0=op.N0, b_M=b_M, excitation=excitation, unstable_s0=s0,
                                     unstable_v=op.v)
-    return assess(parameters, options)
+    outputs = assessed_outputs(parameters)
+    unstable = unstable_case(params_path, rail, options.unstable_s0,
+                             round(options.unstable_v / KMH, 9), N0_kN, b_M, M0_kN, f, D,
+                             strength)
+    return assessment_of(parameters, [short_circuit_case(parameters, outputs, options), unstable,
+                                      starting_case(parameters, outputs, options)])
+
+
+@pn.cache(max_items=16)
+def unstable_case(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
+                  b_M: float, M0_kN: float, f: float, D: float, strength: tuple = ()) -> LoadCase:
+    """The unstable_adhesion case at (``s0``, ``v_kmh`` [km/h]) with nonlinear creep and the
+    default anti-slip protection (:func:`model.studies.assessment.unstable_adhesion_case`)."""
+    parameters = _parameters(params_path, rail, strength)
+    options = AssessmentOptions(N0=N0_kN * 1e3, b_M=b_M,
+                                excitation=ShortCircuit(M0=M0_kN * 1e3, f=f, D=D),
+                                unstable_s0=s0, unstable_v=v_kmh * KMH)
+    return unstable_adhesion_case(parameters, assessed_outputs(parameters), options)
 
 
 def indicator_html(result: Assessment | None, note: str = "") -> str:

@@ -286,11 +286,23 @@ def assess(parameters: Parameters, options: AssessmentOptions | None = None,
     the study engine's ``map_unordered`` (default: in this process) with ``progress(finished,
     total, elapsed [s])`` after each point; the other two cases are single runs here."""
     options = AssessmentOptions() if options is None else options
+    outputs = assessed_outputs(parameters)
+    return assessment_of(parameters, [
+        short_circuit_case(parameters, outputs, options, map_unordered, progress),
+        unstable_adhesion_case(parameters, outputs, options),
+        starting_case(parameters, outputs, options)])
+
+
+def assessed_outputs(parameters: Parameters) -> list[str]:
+    """The outputs whose loads the checks take (each drive component's section torque)."""
+    return list(dict.fromkeys(c.output for c in drive_components(parameters)))
+
+
+def assessment_of(parameters: Parameters, cases: list[LoadCase]) -> Assessment:
+    """Every check of the set's drive components under ``cases`` (computed by the case functions
+    above with :func:`assessed_outputs`; a caller may keep a case that its inputs leave unchanged,
+    as the dashboard keeps the unstable case while only the short circuit's creepage moves)."""
     components = drive_components(parameters)
-    outputs = list(dict.fromkeys(c.output for c in components))
-    cases = [short_circuit_case(parameters, outputs, options, map_unordered, progress),
-             unstable_adhesion_case(parameters, outputs, options),
-             starting_case(parameters, outputs, options)]
     checks = []
     for case in cases:
         for component in components:

@@ -1,0 +1,49 @@
+"""The dashboard's assessment (:func:`app.results.verdicts.assessment_result`, its unstable case
+cached apart) is :func:`model.studies.assessment.assess` with the same options, check by check."""
+
+from __future__ import annotations
+
+import pytest
+
+from app.results import compute, verdicts
+from model.analysis.response import ShortCircuit
+from model.mechanics.operating_point import KMH
+from model.studies.assessment import AssessmentOptions, assess
+
+
+def _same(a, b) -> None:
+    assert [c.name for c in a.cases] == [c.name for c in b.cases]
+    assert len(a.checks) == len(b.checks)
+    for x, y in zip(a.checks, b.checks, strict=True):
+        assert (x.component, x.kind, x.load_case) == (y.component, y.kind, y.load_case)
+        assert x.load == pytest.approx(y.load, rel=1e-12)
+        assert x.safety_factor == pytest.approx(y.safety_factor, rel=1e-12)
+    assert a.governing.component == b.governing.component
+    assert a.governing.load_case == b.governing.load_case
+
+
+@pytest.mark.slow
+def test_dashboard_assessment_is_the_models_at_a_stable_point_and_after_a_step():
+    parameters = compute.parameters("", "calibrated")
+    N0, b_M = parameters["wheel_force"], parameters["motor_slope"]
+    excitation = ShortCircuit(M0=50e3, f=90.0, D=0.04)
+    for s0 in (0.005, 0.0055):  # the second reuses the cached unstable case of the first
+        shown = verdicts.assessment_result("", "calibrated", s0, 120.0, N0 / 1e3, b_M, 50.0,
+                                           90.0, 0.04)
+        expected = assess(parameters, AssessmentOptions(s0=(s0,), v=(120.0 * KMH,), N0=N0,
+                                                        b_M=b_M, excitation=excitation))
+        _same(shown, expected)
+
+
+@pytest.mark.slow
+def test_dashboard_assessment_is_the_models_at_an_unstable_point():
+    """Beyond the limit the unstable case is the operating point's own and the short circuit
+    takes the default grid."""
+    parameters = compute.parameters("", "calibrated")
+    N0, b_M = parameters["wheel_force"], parameters["motor_slope"]
+    shown = verdicts.assessment_result("", "calibrated", 0.012, 140.0, N0 / 1e3, b_M, 50.0,
+                                       90.0, 0.04)
+    expected = assess(parameters, AssessmentOptions(
+        N0=N0, b_M=b_M, excitation=ShortCircuit(M0=50e3, f=90.0, D=0.04), unstable_s0=0.012,
+        unstable_v=140.0 * KMH))
+    _same(shown, expected)
