@@ -343,7 +343,9 @@ class BogieDashboard(pn.viewable.Viewer):
         self.when_shown("sensitivity", self.sensitivity.request, self, state)
         self.when_shown("design-loads", self.design_loads.request_worst_case, state)
         self.resonances.request(state)  # computed while its tab is open
-        self.verdicts.request(state)  # the indicator is on the first screen
+        # the indicator is on the first screen; served, it is computed after the root locus's
+        # and s0*(v)'s follow-ups (Scheduler._limit_done)
+        self.verdicts.request(state, after_follow_ups=True)
         # the nonlinear result follows; the peak table shows the history of the creep model in
         # use (show_history, called by the nonlinear view)
         self.nonlinear.on_fast(state)

@@ -197,6 +197,10 @@ class Scheduler:
     def _limit_done(self, doc, state: State, future) -> None:
         self._follow_up_done(doc, state, future, "stability limit", self.dashboard.show_limit,
                              lambda: self._limit_current(state))
+        # s0*(v) is the last follow-up (after the dense root locus when one was needed): the
+        # verdict of the same state starts now (its own check skips a superseded state)
+        if not future.cancelled():
+            post(doc, self.dashboard.verdicts.start, state)
 
     def _follow_up_done(self, doc, state: State, future, what: str, show, current) -> None:
         """A follow-up's result (``None``: skipped) is shown with ``show(state, result)`` if

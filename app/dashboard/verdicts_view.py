@@ -68,6 +68,7 @@ class VerdictsView:
         self._requests = LatestRequest(SIDE_VIEW_POOL, dashboard.alive)
         self.strength: tuple = ()  # uploaded strength data ((name, value), …)
         self.result = None  # the assessment on screen
+        self._after_follow_ups = None  # the key waiting for its state's follow-ups (served)
         self.rows: list[dict] = []
         self._waiting: tuple | None = None  # not served: the key to assess when the tab opens
         self._tab_open = False
@@ -108,9 +109,12 @@ class VerdictsView:
         return (state.params_path, state.rail, state.s0, state.v, state.N0, state.b_M, state.M0,
                 state.f, state.D, self.strength)
 
-    def request(self, state) -> None:
+    def request(self, state, after_follow_ups: bool = False) -> None:
         """Assess ``state``'s operating point (served: on a worker thread; not served, as in
-        tests without a server: when the Verdicts tab is opened)."""
+        tests without a server: when the Verdicts tab is opened).  ``after_follow_ups``: the
+        dashboard's scheduler starts it with :meth:`start` once the dense root locus and s0*(v)
+        of that state are done (its short-circuit envelope, mostly Python, would share the GIL
+        with them and delay them by about a second after a speed step)."""
         key = self._key(state)
         doc = pn.state.curdoc
         if doc is None or doc.session_context is None:
@@ -121,6 +125,20 @@ class VerdictsView:
                 self.indicator.object = indicator_html(None, "open the Verdicts tab")
             return
         self.indicator.object = indicator_html(None, "computing…")
+        if after_follow_ups:
+            self._after_follow_ups = key
+            return
+        self._submit(doc, state, key)
+
+    def start(self, state) -> None:
+        """The follow-ups of ``state`` are done: assess it if it is the one waiting for them."""
+        key = self._key(state)
+        doc = pn.state.curdoc
+        if key == self._after_follow_ups and doc is not None:
+            self._after_follow_ups = None
+            self._submit(doc, state, key)
+
+    def _submit(self, doc, state, key) -> None:
         future = self._requests.submit(self._compute_if_current, state, key)
         ignore_outcome(future)
         future.add_done_callback(partial(self._done, doc, key))
