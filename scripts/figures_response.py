@@ -33,7 +33,7 @@ import numpy as np
 
 from model import build_model, default_operating_point, eigen_analysis, load_parameters
 from model.analysis.eigen import bogie_system
-from model.analysis.modes import mode_character
+from model.analysis.modes import strongest_strain_modes
 from model.analysis.response import ShortCircuit, short_circuit_response
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -147,18 +147,10 @@ DRIVE_PARTS = ("driving_shaft.torque", "disc_clutch.torque", "claw_clutch.torque
 
 def drive_modes(model, op) -> dict:
     """Frequency [Hz] of the complex mode with the largest strain-energy share of ID1's disc
-    clutch and of ID1's driving shaft (as tests/literature/test_response_literature.py finds
-    them)."""
-    result = eigen_analysis(model, op)
-    best = {"ID1.disc_clutch": (0.0, 0.0), "ID1.driving_shaft": (0.0, 0.0)}
-    for index in result.complex_index:
-        lam = result.eigenvalues[index]
-        if lam.imag / (2 * np.pi) > 2000.0:
-            break
-        strain = mode_character(model, result, index).strain
-        for group in best:
-            if strain.get(group, 0.0) > best[group][0]:
-                best[group] = (strain[group], float(lam.imag / (2 * np.pi)))
+    clutch and of ID1's driving shaft (:func:`model.analysis.modes.strongest_strain_modes`, as
+    tests/literature/test_response_literature.py finds them)."""
+    best = strongest_strain_modes(model, eigen_analysis(model, op),
+                                  ("ID1.disc_clutch", "ID1.driving_shaft"))
     return {group: hz for group, (_, hz) in best.items()}
 
 

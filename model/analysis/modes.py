@@ -260,3 +260,21 @@ def describe_modes(model: BogieModel, result: EigenResult, indices) -> list[str]
 
 def mode_character(model: BogieModel, result: EigenResult, index: int) -> ModeCharacter:
     return characterize(model, result.eigenvalues[index], result.mode_shape(index))
+
+
+def strongest_strain_modes(model: BogieModel, result: EigenResult, groups,
+                           max_frequency_hz: float = 2000.0) -> dict[str, tuple[float, float]]:
+    """For each strain group (e.g. ``"ID1.disc_clutch"``): (its strain-energy share [-], the
+    frequency Im λ / 2π [Hz]) of the complex mode up to ``max_frequency_hz`` in which its share
+    is largest; (0, 0) if no mode strains it."""
+    best = {group: (0.0, 0.0) for group in groups}
+    for index in result.complex_index:
+        lam = result.eigenvalues[index]
+        if lam.imag / (2 * np.pi) > max_frequency_hz:
+            break
+        strain = mode_character(model, result, index).strain
+        for group in best:
+            share = strain.get(group, 0.0)
+            if share > best[group][0]:
+                best[group] = (share, float(lam.imag / (2 * np.pi)))
+    return best
