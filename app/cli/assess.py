@@ -9,7 +9,8 @@ drives checked in the three load cases, with safety factors and the governing ch
 
 A LIST is ``A,B,C`` or ``A:B:N``, increasing; speeds in km/h.  ``--s0``/``--v`` are the short-circuit
 case's grid (stable creepages only), as ``bogie envelope --phase all`` takes them; without
-``--t-end`` its horizon covers ID2's quasi-static take-over.  That grid runs on the study engine as
+``--t-end`` its horizon covers the settling to the static response of the vehicle's
+deceleration.  That grid runs on the study engine as
 the envelope does (a local Dask cluster by default, ``--scheduler`` a running one, ``--serial`` in
 this process); the other two cases are single runs in this process.  ``--json`` prints
 ``{"load_cases": [...], "checks": [...], "governing": {...}}``
@@ -53,8 +54,8 @@ def register(subparsers) -> None:
     add_wheel_force_and_motor_slope(p)
     add_rail(p)
     add_short_circuit(p, phase=None)  # every fault instant: no --phase
-    add_time_grid(p, "short_circuit horizon (default: until ID2's quasi-static take-over is "
-                  "within 1 %% of its end, at least 2 s, at most 60 s)",
+    add_time_grid(p, "short_circuit horizon (default: until the quasi-static part is within "
+                  "1 %% of the static response to the lost torque, at least 2 s, at most 60 s)",
                   "sampling rate of every history", t_end_default=None)
     unstable = p.add_argument_group("unstable_adhesion (nonlinear creep, ID2's anti-slip "
                                     "protection)")
@@ -113,13 +114,17 @@ def assessment_table(result) -> str:
     lines += ["", f"{'component':<20} {'check':<16} {'load case':<18} {'load [N m]':>11} "
                   f"{'capacity [N m]':>14} {'safety factor':>13} {'required':>8}  "
                   f"{'verdict':<12}  at"]
+    notes = list(dict.fromkeys(c.note for c in result.checks if c.note))  # numbered in order
     for c in result.checks:
         at = "steady" if math.isnan(c.time) else f"t = {c.time:.4g} s"
         if "v_kmh" in c.scenario:
             at += f", s0 = {c.scenario['s0']:.4g}, {c.scenario['v_kmh']:g} km/h"
+        if c.note:
+            at += f" [{notes.index(c.note) + 1}]"
         lines.append(f"{c.component:<20} {KIND_NAMES[c.kind]:<16} {c.load_case:<18} "
                      f"{c.load:>11.4g} {c.capacity:>14.4g} {c.safety_factor:>13.3g} "
                      f"{c.required:>8.3g}  {VERDICT_WORDS[verdict_colour(c)]:<12}  {at}")
+    lines += [f"[{k}] {note}" for k, note in enumerate(notes, start=1)]
     g = result.governing
     failed = sum(not c.ok for c in result.checks)
     lines += ["", f"governing: {g.component} ({KIND_NAMES[g.kind]}) in {g.load_case}: safety "

@@ -29,7 +29,7 @@ from model.mechanics.parameters import ASSESSMENT_SCHEMA, ParameterError
 
 MAX_STRENGTH_BYTES = 50_000
 COLUMNS = ("component", "check", "load case", "load [kN m]", "capacity [kN m]", "safety factor",
-           "required", "verdict", "where")
+           "required", "verdict", "where", "note")
 
 
 def strength_from_toml(data: bytes, base) -> tuple:

@@ -107,7 +107,7 @@ def check_rows(result: Assessment) -> list[dict]:
                      "capacity [kN m]": round(c.capacity / 1e3, 2),
                      "safety factor": round(c.safety_factor, 3), "required": c.required,
                      "verdict": VERDICT_WORDS[verdict_colour(c)], "colour": verdict_colour(c),
-                     "where": where, "output": c.output,
+                     "where": where, "note": c.note, "output": c.output,
                      "s0": c.scenario.get("s0"), "v_kmh": c.scenario.get("v_kmh")})
     return rows
 
@@ -117,14 +117,15 @@ def checks_html(result: Assessment) -> str:
     head = ("<table class='bogie'><tr><th class='text'>component</th><th class='text'>check</th>"
             "<th class='text'>load case</th><th>load [kN m]</th><th>capacity [kN m]</th>"
             "<th>safety factor</th><th>required</th><th class='text'>verdict</th>"
-            "<th class='text'>where</th></tr>")
+            "<th class='text'>where</th><th class='text'>note</th></tr>")
     body = "".join(
         f"<tr><td class='text'>{html.escape(r['component'])}</td><td class='text'>{r['check']}</td>"
         f"<td class='text'>{r['load case']}</td><td>{r['load [kN m]']:.4g}</td>"
         f"<td>{r['capacity [kN m]']:.4g}</td><td class='{'' if r['colour'] == 'green' else 'bad'}'>"
         f"{r['safety factor']:.3g}</td><td>{r['required']:.3g}</td>"
         f"<td class='text'>{r['verdict']}</td>"
-        f"<td class='text'>{html.escape(r['where'])}</td></tr>" for r in check_rows(result))
+        f"<td class='text'>{html.escape(r['where'])}</td>"
+        f"<td class='text'>{html.escape(r['note'])}</td></tr>" for r in check_rows(result))
     cases = "".join(
         f"<li><b>{c.name}</b> ({'steady' if c.horizon is None else f'horizon {c.horizon:g} s'})"
         f": {html.escape(c.description)}</li>" for c in result.cases)

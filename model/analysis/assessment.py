@@ -156,6 +156,7 @@ class Check:
     signed_load: float = math.nan  # the value whose magnitude is the load [N m]
     time: float = math.nan  # when it occurs [s] (nan: a steady case)
     scenario: dict = field(default_factory=dict)  # where: s0, v_kmh, phase_s, …
+    note: str = ""  # what qualifies the load (e.g. linear creep beyond the adhesion limit)
 
     @property
     def utilisation(self) -> float:
@@ -168,17 +169,18 @@ class Check:
                 "safety_factor": self.safety_factor, "required": self.required,
                 "ok": self.ok, "inputs": dict(self.inputs), "signed_load": self.signed_load,
                 "time_s": None if math.isnan(self.time) else self.time,
-                "scenario": dict(self.scenario)}
+                "scenario": dict(self.scenario), "note": self.note}
 
 
 def verify(component: Component, load_case: str, load: float, signed_load: float = math.nan,
-           time: float = math.nan, scenario: dict | None = None) -> Check:
-    """The check of ``component`` under the largest |torque| ``load`` [N m] of ``load_case``."""
+           time: float = math.nan, scenario: dict | None = None, note: str = "") -> Check:
+    """The check of ``component`` under the largest |torque| ``load`` [N m] of ``load_case``
+    (``note``: what qualifies that load, shown beside it)."""
     load = abs(float(load))
     factor = component.capacity / load if load > 0 else math.inf
     return Check(component.name, component.kind, component.output, load_case, load,
                  component.capacity, factor, component.required, factor >= component.required,
-                 component.inputs, float(signed_load), float(time), dict(scenario or {}))
+                 component.inputs, float(signed_load), float(time), dict(scenario or {}), note)
 
 
 def governing(checks: list[Check]) -> Check:

@@ -150,9 +150,9 @@ def make_anchor(model: BogieModel, op: OperatingPoint) -> Anchor:
     """One eigendecomposition with vectors at ``op`` (not cached: a line's anchors are its own)."""
     system = state_space(model).system(damping_matrix(model, op))
     U, V = update_vectors(model)
-    r = model.rigid_body_modes.shape[1]
-    U2 = system.deflation.apply_transpose(U)[r:]
-    V2 = system.deflation.apply_transpose(V)[r:]
+    r = system.rigid_count
+    U2 = system.deflation.to_deflated(U)[r:]
+    V2 = system.deflation.rows(V.T).T[r:]
     lam, Yb, scale = system.eigen
     Ut = system.solve_eigenvectors(U2 / scale[:, None])
     Vt = (V2 * scale[:, None]).T @ Yb

@@ -53,7 +53,7 @@ class StateSpace:
         """The first-order form with damping ``B_total`` (input: M_C, as :func:`bogie_system`)."""
         m = self.model
         return LinearSystem(m.M, B_total, m.K, m.short_circuit_force, m.rigid_body_modes,
-                            self.inverse_mass)
+                            self.inverse_mass, m.rolling_mode[:, None])
 
     def state_matrix(self, B_total: np.ndarray) -> np.ndarray:
         """A (N x N) with damping ``B_total`` [1/s and 1/s² blocks]."""
@@ -145,6 +145,13 @@ class EigenResult:
         return q / q[np.argmax(np.abs(q))]
 
 
+def rigid_zero_count(model: BogieModel) -> int:
+    """The exact zero eigenvalues of the bogie at every operating point: one per rigid-body mode
+    (``K r = 0``) and one more for the velocity of the vehicle rolling without slip, which no
+    damping meets (:attr:`model.mechanics.assembly.BogieModel.rolling_mode`)."""
+    return model.rigid_body_modes.shape[1] + 1
+
+
 def bogie_system(model: BogieModel, op: OperatingPoint, cached: bool = True) -> LinearSystem:
     """The bogie at ``op`` as a :class:`LinearSystem` (input: the short-circuit torque M_C on
     ID1's rotor and stator).  ``cached``: kept with the last few operating points of the model, so
@@ -180,7 +187,7 @@ def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) 
         >>> bool(result.real_eigenvalues[0] > 0)        # the largest real eigenvalue [1/s]
         True
     """
-    n_rigid = model.rigid_body_modes.shape[1]
+    n_rigid = rigid_zero_count(model)
     if not vectors:
         cache = model.__dict__.get("_systems")
         system = cache.peek(op) if cache is not None else None

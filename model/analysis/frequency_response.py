@@ -144,10 +144,10 @@ def modal_transfer(system: LinearSystem, C: np.ndarray, b: np.ndarray) -> ModalT
     """The modal form of ``C (sI − A)⁻¹ b`` (C: p x N state output rows, b: N state input) from
     the system's cached eigendecomposition (module docstring)."""
     lam, Y, _, cond, scale = system.modal
-    r = system.R.shape[1]
+    r = system.rigid_count
     deflation = system.deflation
-    bz = deflation.apply_transpose(b)
-    CQ = deflation.apply_transpose(C.T).T
+    bz = deflation.to_deflated(b)
+    CQ = deflation.rows(C)
     b1, b2 = bz[:r], bz[r:]
     C1, C2 = CQ[:, :r], CQ[:, r:].copy()
     # an output that a rigid-body motion does not change (every element load) has C₁ = 0 but for

@@ -22,7 +22,18 @@ every coordinate but only the velocities of the inertial ones, ``x = [q; v]``, `
     q̇_i = v,     q̇_m = −B_mm⁻¹ (K_m q + B_mi v − f_m u),
     M_ii v̇ = −K_i q − B_ii v − B_im q̇_m + f_i u.
 
-Without massless coordinates this is the form above.  The full velocity is ``q̇ = V x + …`` with
+Without massless coordinates this is the form above.
+
+Free rigid motions.  A rigid-body mode that no damping meets either (``K r = 0`` and ``B r = 0``:
+the vehicle rolling without slip, with no running resistance in the model) gives a second exact
+zero: its velocity state ``[0; r_i]`` is mapped by A onto the rigid subspace,
+``A [0; r_i] = [r; 0]`` (a Jordan chain).  Such modes are given as ``free`` (n x k, in the span of
+R) and deflated with the others: Q1 spans ``[[R, 0], [0, F_i]]`` and
+
+    Qᵀ A Q = [[N, A12], [0, A22]],   N nilpotent (N² = 0),
+
+so that a constant input gives the deflated coordinates a ramp and the free motion a uniform
+acceleration (:meth:`LinearSystem.step_particular`).  The full velocity is ``q̇ = V x + …`` with
 ``V`` = the first n rows of A (:attr:`LinearSystem.velocity_map`; plus ``B_mm⁻¹ f_m u`` if an
 input acts on a massless coordinate, which the bogie's inputs never do); a generalized force
 enters as :meth:`LinearSystem.input_map`.  A rigid-body mode ``r`` (its massless part included:
@@ -127,6 +138,71 @@ class Deflation:
         return self.apply(np.eye(self.size, self.rank))
 
 
+class RigidDeflation:
+    """The deflation of a system's exact zero eigenvalues: ``W = T Q P`` with Q = [Q1 Q2] the
+    orthogonal :class:`Deflation` of the rigid positions [R; 0] and, for each free velocity
+    state x_v = [0; F_i] (module docstring), an elementary (Gauss) transform
+    ``T = I + (x_v − e_c) e_cᵀ`` that makes the state coordinate c (the free motion's heaviest
+    velocity, where x_v is scaled to 1) that velocity; P orders the coordinates [rigid, free,
+    rest].  An orthogonal reflector of x_v would mix the velocity rows of every body, stiff and
+    soft (their scales span ten orders of magnitude), and cost the slow eigenvalues six digits;
+    T only adds multiples of the heaviest body's row.  ``W⁻¹ A W = [[N, A12], [0, A22]]``."""
+
+    def __init__(self, R_state: np.ndarray, free_velocities: np.ndarray,
+                 weights: np.ndarray):
+        # R_state: N x r rigid positions [R; 0]; free_velocities: N x k (zero where R_state is
+        # not: velocity rows); weights: N, the pivot's choice (kinetic energy per unit entry²)
+        self.size = R_state.shape[0]
+        self.rigid = Deflation(R_state)
+        k = free_velocities.shape[1]
+        pivots = []
+        X = free_velocities.astype(float).copy()
+        for j in range(k):
+            c = int(np.argmax(weights * X[:, j] ** 2))
+            X[:, j] /= X[c, j]
+            pivots.append(c)
+        if k > 1 and np.any(np.abs(X[pivots] - np.eye(k)) > 0):
+            raise ValueError("free modes must not share a pivot coordinate")
+        self.pivots = np.array(pivots, dtype=int)
+        self.shift = X  # x_v (N x k), 1 at its own pivot
+        self.shift[self.pivots, np.arange(k)] -= 1.0  # x_v − e_c
+        r = R_state.shape[1]
+        rest = np.setdiff1d(np.arange(r, self.size), self.pivots)
+        self.order = np.concatenate([np.arange(r), self.pivots, rest]).astype(int)
+        self.rank = r + k
+
+    def _T(self, X: np.ndarray) -> np.ndarray:
+        return X + self.shift @ X[self.pivots] if len(self.pivots) else X
+
+    def _T_inverse(self, X: np.ndarray) -> np.ndarray:
+        return X - self.shift @ X[self.pivots] if len(self.pivots) else X
+
+    def apply(self, Z: np.ndarray) -> np.ndarray:
+        """W Z (Z: N or N x m, rows in the deflated order)."""
+        X = np.empty_like(Z)
+        X[self.order] = Z
+        return self._T(self.rigid.apply(X))
+
+    def to_deflated(self, X: np.ndarray) -> np.ndarray:
+        """W⁻¹ X: a state (or input) in the deflated coordinates."""
+        return self.rigid.apply_transpose(self._T_inverse(X))[self.order]
+
+    def rows(self, C: np.ndarray) -> np.ndarray:
+        """C W: output rows (p x N) on the deflated coordinates."""
+        CT = C.copy()
+        if len(self.pivots):
+            CT[:, self.pivots] += C @ self.shift
+        return self.rigid.apply_transpose(CT.T).T[:, self.order]
+
+    def project(self, A: np.ndarray) -> np.ndarray:
+        """W⁻¹ A W (N x N)."""
+        if len(self.pivots):
+            A = A.copy()
+            A[:, self.pivots] += A @ self.shift  # A T
+            A -= self.shift @ A[self.pivots]  # T⁻¹ (A T)
+        return self.rigid.project(A)[np.ix_(self.order, self.order)]
+
+
 @dataclass
 class LinearSystem:
     """``M q̈ + B q̇ + K q = f u(t)``, rigid modes ``K R = 0`` (R: n x r, r may be 0).
@@ -144,6 +220,7 @@ class LinearSystem:
     f: np.ndarray  # n, generalized force per unit input
     R: np.ndarray  # n x r rigid-body modes
     inverse_mass: np.ndarray | None = None  # M_ii⁻¹ (inertial coordinates) if known
+    free: np.ndarray | None = None  # n x k rigid modes no damping meets (B F = 0), in span R
     _cache: dict = field(default_factory=dict, repr=False)
     _lock: threading.RLock = field(default_factory=threading.RLock, repr=False)
 
@@ -166,6 +243,16 @@ class LinearSystem:
     def N(self) -> int:
         """Number of states: every coordinate and the velocities of the inertial ones."""
         return self.n + len(self.inertial)
+
+    @property
+    def free_modes(self) -> np.ndarray:
+        """F (n x k): the rigid modes whose velocity meets no damping (module docstring)."""
+        return self.free if self.free is not None else np.zeros((self.n, 0))
+
+    @property
+    def rigid_count(self) -> int:
+        """Exact zero eigenvalues deflated: the rigid modes and the free ones' velocities."""
+        return self.R.shape[1] + self.free_modes.shape[1]
 
     def _get(self, key, build):
         with self._lock:  # sessions of the dashboard share systems: build each piece once
@@ -238,19 +325,38 @@ class LinearSystem:
         return self._get("b", lambda: self.input_map(self.f))
 
     @property
-    def deflation(self) -> Deflation:
-        """Q = [Q1 Q2] with Q1 spanning the rigid subspace [R; 0]."""
-        return self._get("deflation", lambda: Deflation(
-            np.vstack([self.R, np.zeros((len(self.inertial), self.R.shape[1]))])))
+    def deflation(self) -> RigidDeflation:
+        """W with the first columns spanning the rigid subspace [R; 0] and the free modes'
+        velocities [0; F_i] (:class:`RigidDeflation`)."""
+        def build():
+            R, F, i, n = self.R, self.free_modes, self.inertial, self.n
+            R_state = np.vstack([R, np.zeros((len(i), R.shape[1]))])
+            free = np.vstack([np.zeros((n, F.shape[1])), F[i]])
+            weights = np.concatenate([np.zeros(n), np.diag(self.M)[i]])
+            return RigidDeflation(R_state, free, weights)
+        return self._get("deflation", build)
 
     @property
     def reduced(self) -> tuple[np.ndarray, np.ndarray]:
-        """(A12, A22) of Qᵀ A Q = [[0, A12], [0, A22]]."""
+        """(A12, A22) of Qᵀ A Q = [[N, A12], [0, A22]] (N: :attr:`rigid_block`)."""
+        return self._projected[1:]
+
+    @property
+    def rigid_block(self) -> np.ndarray:
+        """N (rigid_count x rigid_count) of Qᵀ A Q: zero but for the free modes' velocities,
+        which move their positions (N² = 0)."""
+        return self._projected[0]
+
+    @property
+    def _projected(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         def build():
-            r = self.R.shape[1]
+            r = self.rigid_count
             P = self.deflation.project(self.A)
-            return P[:r, r:], np.ascontiguousarray(P[r:, r:])
-        return self._get("reduced", build)
+            N = P[:r, :r].copy()
+            if not self.free_modes.shape[1]:
+                N[:] = 0.0  # exactly: the rigid subspace is A's null space
+            return N, P[:r, r:], np.ascontiguousarray(P[r:, r:])
+        return self._get("projected", build)
 
     @property
     def eigen(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -311,19 +417,32 @@ class LinearSystem:
             return solve(rhs.real) + 1j * solve(rhs.imag)
         return solve(rhs)
 
-    def step_particular(self, u0: float) -> tuple[np.ndarray, np.ndarray]:
-        """(α, β) with x_p = α + β t solving ẋ = A x + b u0 [state units]."""
-        n, R, i = self.n, self.R, self.inertial
-        r = R.shape[1]
+    def step_particular(self, u0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(α, β, γ) with x_p = α + β t + γ t² solving ẋ = A x + b u0 [state units].
+
+        ``q_p = q0 + v t + a t²/2``: the free modes take a uniform acceleration a = F g, the
+        damped rigid directions a constant velocity v = R_d c, both from the rigid projection
+        ``Rᵀ (M a + B v) = Rᵀ f u0`` (R_d: the part of span R that is not free), and q0 from
+        ``K q0 = f u0 − B v − M a``, ``Rᵀ q0 = 0``."""
+        n, R, F, i = self.n, self.R, self.free_modes, self.inertial
+        r, k = R.shape[1], F.shape[1]
         fu = self.f * u0
+        zero = np.zeros(self.N)
         if r == 0:
             q = np.linalg.solve(self.K, fu)
-            return np.concatenate([q, np.zeros(len(i))]), np.zeros(self.N)
-        c = np.linalg.solve(R.T @ self.B @ R, R.T @ fu)  # rigid-body velocities of the drift
-        v = R @ c
+            return np.concatenate([q, np.zeros(len(i))]), zero, zero
+        if k:
+            S = np.linalg.lstsq(R, F, rcond=None)[0]  # F = R S
+            R_d = R @ sla.null_space(S.T)
+            g = np.linalg.solve(np.hstack([R.T @ (self.M @ F), R.T @ (self.B @ R_d)]), R.T @ fu)
+            acceleration, v = F @ g[:k], R_d @ g[k:]
+        else:
+            acceleration, v = np.zeros(n), R @ np.linalg.solve(R.T @ self.B @ R, R.T @ fu)
         bordered = np.block([[self.K, R], [R.T, np.zeros((r, r))]])
-        q = np.linalg.solve(bordered, np.concatenate([fu - self.B @ v, np.zeros(r)]))[:n]
-        return np.concatenate([q, v[i]]), np.concatenate([v, np.zeros(len(i))])
+        rhs = fu - self.B @ v - self.M @ acceleration
+        q = np.linalg.solve(bordered, np.concatenate([rhs, np.zeros(r)]))[:n]
+        return (np.concatenate([q, v[i]]), np.concatenate([v, acceleration[i]]),
+                np.concatenate([acceleration / 2, np.zeros(len(i))]))
 
     def exponential_particular(self, a: complex, mu: complex) -> np.ndarray:
         """x_μ with x_p = Re(x_μ e^(μt)) solving ẋ = A x + b Re(a e^(μt))."""
@@ -338,12 +457,13 @@ class LinearSystem:
         return sla.eigvals(self.reduced[1], overwrite_a=False, check_finite=False)
 
     def state_vectors(self) -> np.ndarray:
-        """Unit eigenvectors x = Q1 A12 y/λ + Q2 y of A for the eigenvalues of :attr:`eigen`
-        (N x N − r)."""
+        """Unit eigenvectors x = Q1 (λ − N)⁻¹ A12 y + Q2 y of A for the eigenvalues of
+        :attr:`eigen` (N x N − r); (λ − N)⁻¹ = (I + N/λ)/λ since N² = 0."""
         lam, Yb, scale = self.eigen
         Y = Yb * scale[:, None]
-        A12 = self.reduced[0]
-        X = self.deflation.apply(np.vstack([(A12 @ Y) / lam, Y]))
+        rigid = (self.reduced[0] @ Y) / lam
+        rigid = rigid + (self.rigid_block @ rigid) / lam
+        X = self.deflation.apply(np.vstack([rigid, Y]))
         return X / np.linalg.norm(X, axis=0)
 
 

@@ -51,7 +51,7 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
-from model.analysis.eigen import eigen_analysis
+from model.analysis.eigen import eigen_analysis, rigid_zero_count
 from model.analysis.linear_system import first_order_matrix, massless_coordinates
 from model.contact.creep import creep_block
 from model.mechanics.assembly import BogieModel
@@ -363,9 +363,10 @@ def kept_sweep_estimate(model: BogieModel, op: OperatingPoint, first: OperatingP
     reduced = start.reduced
     c = pattern_coefficients(model, op)
     lam, X = reduced.solve(c, op.b_M)
-    # the basis's rigid-body modes give λ = 0 (dropped, as in the sweep); branches inside the
+    # the basis's rigid-body modes and the free rolling velocity give λ = 0 (dropped, as in the
+    # sweep); branches inside the
     # disc where the sweep controls the error
-    keep = np.argsort(np.abs(lam))[model.rigid_body_modes.shape[1]:]
+    keep = np.argsort(np.abs(lam))[rigid_zero_count(model):]
     keep = np.sort(keep[np.abs(lam[keep]) < 1.5 * radius])
     floor = max(float(lambda_floor), 1e-300)
     estimate = reduced.error_estimate(c, lam[keep], X[:, keep],
@@ -525,11 +526,12 @@ def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, redu
     point must be solved densely (ambiguous assignment, too many or unrefinable inaccurate
     branches inside |λ| < controlled)."""
     lam, X = solved
-    # the basis holds the rigid-body modes (K r = 0): the reduced problem has their λ = 0, which
-    # the tracked branches never are (the dense solutions deflate them).  A drivetrain spin whose
+    # the basis holds the rigid-body modes (K r = 0): the reduced problem has their λ = 0 and
+    # the free rolling velocity's, which the tracked branches never are (the dense solutions
+    # deflate them).  A drivetrain spin whose
     # eigenvalue passes through 0 at the creep maximum has the same vector; with a floor on the
     # error measure it could be assigned to the rigid one's exact 0 and stay there
-    keep = np.sort(np.argsort(np.abs(lam))[model.rigid_body_modes.shape[1]:])
+    keep = np.sort(np.argsort(np.abs(lam))[rigid_zero_count(model):])
     lam, X = lam[keep], X[:, keep]
     X_full = reduced.Phi @ X
     chosen, ok = _assign(previous_vectors, previous_values, X_full, lam)

@@ -213,8 +213,8 @@ class NonlinearResult:
     torque_reduction: np.ndarray  # change of ID2's motor torque by the protection [N m]
     contact_velocity: np.ndarray | None = None  # N x contacts: H Δq̇ [m/s] (for checks)
     remainder_force: np.ndarray | None = None  # N x contacts: r(H Δq̇) [N]
-    states: np.ndarray | None = None  # samples x N: [Δq; Δq̇_inertial] without the rigid angles,
-    # if asked
+    states: np.ndarray | None = None  # samples x N: [Δq; Δq̇_inertial] without the rigid-body
+    # positions (the rolling velocity included), if asked
 
     def perturbation(self, name: str) -> np.ndarray:
         """Δy(t) = total − pre-fault value [unit of the output]."""
@@ -251,7 +251,7 @@ def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
         return cached
     lam, Y, _, _, scale = system.modal
     deflation = system.deflation
-    r = system.R.shape[1]
+    r = system.rigid_count
     keep = lam.imag >= 0
     weight = np.where(lam.imag > 0, 2.0, 1.0)[keep]
     G = creep_force_map(model)
@@ -259,7 +259,7 @@ def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
     # inputs: M_C, ΔM_2, the creep remainders, ID2's motor torque again (the channel through
     # which the protection scales the motor's slope torque b_M Δω)
     inputs = system.input_map(np.column_stack([model.short_circuit_force, f_m2, G, f_m2]))
-    rhs = deflation.apply_transpose(inputs)[r:] / scale[:, None]
+    rhs = deflation.to_deflated(inputs)[r:] / scale[:, None]
     beta = system.solve_eigenvectors(rhs)[keep]  # m x (2 + contacts)
     lam_k = lam[keep]
     E = np.exp(lam_k * h)
@@ -525,6 +525,28 @@ def _step(run: _Run, request: _Request, checkpoint: Callable[[], None] | None) -
                       iterations=int(iterations[0]))
 
 
+def _with_free_velocity(model: BogieModel, op: OperatingPoint, states: np.ndarray,
+                        inputs: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The sampled states (samples x N, the modal part the loop forms) with the vehicle's rolling
+    velocity added: no damping meets it, so it is deflated with the rigid-body modes and the loop
+    does not carry it, but it holds kinetic energy.  Its rate is the deflated row of
+    ``A x + b u`` (it depends on the other states and the inputs only), integrated by the
+    trapezoidal rule over the samples [s] (second order in 1/fs).  ``inputs``: M_C, ID2's motor
+    torque change and the contacts' remainder forces (samples x 2 + contacts) [N m, N]."""
+    system = bogie_system(model, op)
+    deflation = system.deflation
+    forces = np.column_stack([model.short_circuit_force, motor2_force(model),
+                              creep_force_map(model)])
+    rates = deflation.to_deflated(system.A @ states.T + system.input_map(forces) @ inputs.T)
+    free = np.arange(system.R.shape[1], system.rigid_count)
+    velocity = np.zeros((len(t), len(free)))
+    velocity[1:] = np.cumsum(0.5 * (rates[free, 1:] + rates[free, :-1]).T * np.diff(t)[:, None],
+                             axis=0)
+    shape = np.zeros((system.N, len(free)))
+    shape[free, np.arange(len(free))] = 1.0
+    return states + velocity @ deflation.apply(shape).T
+
+
 def _limits(p: Parameters, op: OperatingPoint, mu_max: float,
             strength: float | None) -> tuple[dict[str, float], list[tuple[str, str]]]:
     """The limits the totals are checked against ("M_ad", "M_ad/p" [N m], "mu_max N0" [N], and
@@ -579,7 +601,12 @@ def _pack_result(model: BogieModel, op: OperatingPoint, excitation: ShortCircuit
     mu_s0, dmu_s0, step = inputs.mu_s0, inputs.dmu_s0, inputs.M_step
     Y, z_hist, r_hist, u2_hist = histories.Y, histories.z, histories.r, histories.u2
     t = np.arange(request.n_points) / request.fs
-    X_hist = Y[:, len(run.loads):] if request.keep_states else None
+    X_hist = None
+    if request.keep_states:
+        inputs_hist = np.column_stack([excitation.torque(t, inputs.M_step)
+                                       * request.excitation_scale,
+                                       u2_hist + r_hist[:, -1], r_hist[:, :-1]])
+        X_hist = _with_free_velocity(model, op, Y[:, len(run.loads):], inputs_hist, t)
     if not np.all(np.isfinite(Y)) or not np.all(np.isfinite(z_hist)):
         raise NonlinearError("the nonlinear response is not finite")
     slope_torque, slope_cut = z_hist[:, -1], r_hist[:, -1]

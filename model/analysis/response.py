@@ -180,30 +180,49 @@ def _grid_exponentials(lam: np.ndarray, n_points: int, dt: float, block: int):
     return np.exp(np.outer(b, lam)), np.exp(np.outer(a, lam))
 
 
-def _modal_terms(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu: complex):
-    """The modal closed form's pieces for the outputs ``C``: (λ, coef, const_h, α, β, x_μ) with
-    the perturbation outputs ``y(t) = Re Σ_j coef_j e^(λ_j t) + const_h + C (α + β t)
+@dataclass(frozen=True)
+class _ModalTerms:
+    """The modal closed form's pieces for the outputs C: the perturbation outputs are
+    ``y(t) = Re Σ_j coef_j e^(λ_j t) + const_h + lin_h t + C (α + β t + γ t²)
     + Re(C x_μ e^(μt))`` (coef p x m over every eigenvalue of the deflated system)."""
-    deflation, r = system.deflation, system.R.shape[1]
+
+    lam: np.ndarray  # m eigenvalues of the deflated system [1/s]
+    coef: np.ndarray  # p x m
+    const_h: np.ndarray  # p: the rigid coordinates' part of the homogeneous solution, constant
+    lin_h: np.ndarray  # p: … and its ramp (a free mode's velocity moving its position) [1/s]
+    alpha: np.ndarray  # N: the step's particular solution α + β t + γ t²
+    beta: np.ndarray
+    gamma: np.ndarray
+    x_mu: np.ndarray  # N: the exponential input's particular solution
+
+
+def _modal_terms(system: LinearSystem, C: np.ndarray, u0: float, a: complex,
+                 mu: complex) -> _ModalTerms:
+    """The modal closed form's pieces for the outputs ``C`` (:class:`_ModalTerms`)."""
+    deflation, r = system.deflation, system.rigid_count
     lam, Y, _, _, scale = system.modal  # A22 = (T Y) Λ (T Y)⁻¹, T = diag(scale)
-    alpha, beta = system.step_particular(u0)
+    alpha, beta, gamma = system.step_particular(u0)
     x_mu = system.exponential_particular(a, mu)
     xh0 = -(alpha + x_mu.real)
-    z0 = deflation.apply_transpose(xh0)  # [Q1ᵀ; Q2ᵀ] x_h(0)
+    z0 = deflation.to_deflated(xh0)  # W⁻¹ x_h(0)
     a0, c0 = z0[:r], z0[r:]
     d = system.solve_eigenvectors(c0 / scale)
-    CQ = deflation.apply_transpose(C.T).T  # C [Q1 Q2]
+    CQ = deflation.rows(C)  # C W
     CQ1 = CQ[:, :r]
     W = (CQ[:, r:] * scale) @ Y  # p x m
+    const_h = np.zeros(C.shape[0], dtype=complex)
+    lin_h = np.zeros(C.shape[0], dtype=complex)
     if CQ1.size and np.abs(CQ1).max() > 0.0:
-        # rigid coordinates: ȧ = A12 c  ->  a(t) = a0 + A12 Y diag((e^(λt) − 1)/λ) d
-        A12 = system.reduced[0]
-        G = CQ1 @ ((A12 * scale) @ Y)
-        W = W + G / lam
-        const_h = CQ1 @ a0 - (G / lam) @ d
-    else:
-        const_h = np.zeros(C.shape[0], dtype=complex)
-    return lam, W * d, const_h, alpha, beta, x_mu
+        # rigid coordinates: ȧ = N a + A12 c with N² = 0  ->  a(t) = (I + N t) a0
+        #   + A12 Y diag((e^(λt) − 1)/λ) d + N A12 Y diag((e^(λt) − 1 − λt)/λ²) d
+        A12Y = (system.reduced[0] * scale) @ Y
+        N = system.rigid_block
+        G1, G2 = CQ1 @ A12Y, (CQ1 @ N) @ A12Y
+        G = G1 / lam + G2 / lam**2
+        W = W + G
+        const_h = CQ1 @ a0 - G @ d
+        lin_h = (CQ1 @ N) @ a0 - (G2 / lam) @ d
+    return _ModalTerms(lam, W * d, const_h, lin_h, alpha, beta, gamma, x_mu)
 
 
 def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu: complex,
@@ -216,7 +235,9 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
     than :data:`QUASI_STATIC_HZ` and the forced oscillation if μ is that slow); "fast", the rest
     ("slow" + "fast" = "all")."""
     cond = system.modal[3]
-    lam, coef, const_h, alpha, beta, x_mu = _modal_terms(system, C, u0, a, mu)
+    terms = _modal_terms(system, C, u0, a, mu)
+    lam, coef, const_h, lin_h = terms.lam, terms.coef, terms.const_h, terms.lin_h
+    alpha, beta, gamma, x_mu = terms.alpha, terms.beta, terms.gamma, terms.x_mu
     slow_cut = 2 * math.pi * QUASI_STATIC_HZ  # [rad/s]
     keep = lam.imag >= 0  # conjugate pairs: keep Im λ ≥ 0, double the strictly complex ones
     if part == "slow":
@@ -225,8 +246,8 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
             x_mu = np.zeros_like(x_mu)
     elif part == "fast":
         keep &= lam.imag >= slow_cut
-        const_h = np.zeros(C.shape[0], dtype=complex)
-        alpha, beta = np.zeros_like(alpha), np.zeros_like(beta)
+        const_h, lin_h = np.zeros_like(const_h), np.zeros_like(lin_h)
+        alpha, beta, gamma = np.zeros_like(alpha), np.zeros_like(beta), np.zeros_like(gamma)
         if abs(mu.imag) < slow_cut:
             x_mu = np.zeros_like(x_mu)
     elif part != "all":
@@ -276,13 +297,14 @@ def _modal_outputs(system: LinearSystem, C: np.ndarray, u0: float, a: complex, m
     Yh = Yh.reshape(p, -1)[:, :valid]  # p x valid
     t = np.arange(valid) * dt
     Yh += (const_h.real + C @ alpha)[:, None]
-    Yh += np.outer(C @ beta, t)
+    Yh += np.outer(lin_h.real + C @ beta, t)
+    Yh += np.outer(C @ gamma, t * t)
     Yh += ((C @ x_mu)[:, None] * np.exp(mu * t)[None, :]).real
     y = Yh.T  # valid x p (a view: each output's column is contiguous)
     # rounding-error estimate: size of the cancelling terms × eigenvector condition
     terms = (np.abs(coef_k) @ np.exp(np.outer(lam_k.real, [0.0, t[-1]]))).max(axis=1)
-    terms = terms + np.abs(C @ alpha) + np.abs(C @ beta) * t[-1] + np.abs(C @ x_mu) \
-        + np.abs(const_h)
+    terms = terms + np.abs(C @ alpha) + (np.abs(C @ beta) + np.abs(lin_h)) * t[-1] \
+        + np.abs(C @ gamma) * t[-1] ** 2 + np.abs(C @ x_mu) + np.abs(const_h)
     scale = np.abs(y).max(axis=0)
     estimate = float(np.max((EPS * cond * terms + neglected) / np.maximum(scale, 1e-300))) \
         if p else 0.0
@@ -388,12 +410,14 @@ def quasi_static_response(system: LinearSystem, C: np.ndarray, u0: float, a: com
         raise QuasiStaticUnavailable(
             f"the quasi-static part cannot be separated here (modal form ill-conditioned: "
             f"error estimate {estimate:.2g})")
-    lam, _, const_h, alpha, beta, _ = _modal_terms(system, C, u0, a, mu)
-    final = const_h.real + C @ alpha
-    slow = lam[lam.imag < 2 * math.pi * QUASI_STATIC_HZ]
-    # an output that drifts (a rigid coordinate's ramp) more than 1e-9 of its size per second
+    terms = _modal_terms(system, C, u0, a, mu)
+    final = terms.const_h.real + C @ terms.alpha
+    slow = terms.lam[terms.lam.imag < 2 * math.pi * QUASI_STATIC_HZ]
+    # an output that drifts (a rigid coordinate's ramp or a free one's uniform acceleration)
+    # more than 1e-9 of its size per second
     size = np.maximum(np.abs(final), np.abs(y[:valid]).max(axis=0, initial=0.0))
-    drift = np.abs(C @ beta) > 1e-9 * np.maximum(size, 1e-300)
+    rate = np.abs(C @ terms.beta + terms.lin_h.real) + np.abs(C @ terms.gamma)
+    drift = rate > 1e-9 * np.maximum(size, 1e-300)
     if len(slow) and slow.real.max() > GROWTH_RATE:
         drift[:] = True  # a slow mode grows: no final value
     return QuasiStatic(y[:valid], np.where(drift, np.nan, final))

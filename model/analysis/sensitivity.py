@@ -65,7 +65,13 @@ from model.analysis.eigen import EigenResult, eigen_analysis
 from model.analysis.modes import characterize
 from model.analysis.stability import stability_limit
 from model.contact.creep import PolachLaw, creep_block, kalker_creep_coefficients
-from model.mechanics.assembly import BogieModel, assembled_matrices, build_model
+from model.mechanics.assembly import (
+    CONVERTER_FILTER,
+    BogieModel,
+    assembled_matrices,
+    build_model,
+    motor_speed_row,
+)
 from model.mechanics.operating_point import OperatingPoint, damping_matrix
 from model.mechanics.parameters import SCHEMA, Parameters
 
@@ -83,9 +89,12 @@ OPERATING_PARAMETERS: dict[str, str] = {"s0": "1", "v": "m/s", "N0": "N", "b_M":
 # the operating quantity's when the caller says they are linked
 LINKED = {"wheel_force": "N0", "motor_slope": "b_M"}
 # parameters that do not enter the constant assembly (contact and motor only; checked by a test)
-NOT_IN_ASSEMBLY = frozenset({"wheel_radius", "rail_head_radius", "wheel_force", "polach_mu0",
+NOT_IN_ASSEMBLY = frozenset({"rail_head_radius", "wheel_force", "polach_mu0",
                              "polach_A", "polach_B", "polach_kA", "polach_kS", "creep_slope",
                              "motor_slope"})
+# parameters of the vehicle's rolling that eq. 6 measures the healthy motor's speed against
+# (B_M's entry p/r0 on CB.x; with a converter it is in the filter's row of the constant B)
+MOTOR_SPEED_INPUTS = ("gear_ratio", "wheel_radius")
 KALKER_INPUTS = ("wheel_radius", "rail_head_radius", "young_modulus", "poisson_ratio")
 CREEP_LAW_INPUTS = ("polach_mu0", "polach_A", "polach_B", "polach_kA", "polach_kS",
                     "creep_slope", "wheel_force")
@@ -239,11 +248,26 @@ def creep_coefficient_derivatives(parameters: Parameters, op: OperatingPoint,
     return out
 
 
+def motor_pattern_derivative(model: BogieModel, op: OperatingPoint,
+                             name: str) -> MatrixDerivative | None:
+    """b_M ∂B_M/∂p for a parameter of the rolling reference of eq. 6 (:data:`MOTOR_SPEED_INPUTS`;
+    None otherwise, at b_M = 0, or with a converter, whose filter row is in the constant B)."""
+    if name not in MOTOR_SPEED_INPUTS or op.b_M == 0.0 or CONVERTER_FILTER in model.dofs.names:
+        return None
+    h = _step(model.parameters[name])
+    stepped = complex_step_parameters(model.parameters, name, h)
+    d_speed = motor_speed_row(stepped, model.dofs).imag / h
+    force = model.motor_pattern[:, model.dofs.index("ID2.rotor.ry")]  # B_M = force ⊗ speed row
+    zero = np.zeros((model.n, model.n))
+    return _restrict(zero, op.b_M * np.outer(force, d_speed), zero)
+
+
 def operating_derivative(model: BogieModel, op: OperatingPoint, name: str) -> MatrixDerivative | None:
     """∂B/∂p of the operating-point damping ``b_M B_M + B_ad`` (None if p does not enter)."""
     if name == "b_M":
-        index = np.flatnonzero(np.any(model.motor_pattern != 0, axis=0))
-        return MatrixDerivative(index, None, model.motor_pattern[np.ix_(index, index)].copy(), None)
+        pattern = model.motor_pattern
+        index = np.flatnonzero(np.any(pattern != 0, axis=0) | np.any(pattern != 0, axis=1))
+        return MatrixDerivative(index, None, pattern[np.ix_(index, index)].copy(), None)
     d = creep_coefficient_derivatives(model.parameters, op, name)
     if not np.any(d):
         return None
@@ -340,12 +364,15 @@ def _lu_for_inverse_iteration(matrix: np.ndarray):
 
 def null_vectors(model: BogieModel, B_total: np.ndarray, lam: complex,
                  guess: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Right and left null vectors (x, y) of ``λ²M + λB + K`` by one step of inverse iteration
-    (unit 2-norm).  ``guess``: the eigen-analysis' displacement vector (start for x)."""
+    """Right and left null vectors (x, y) of ``λ²M + λB + K`` by inverse iteration (unit
+    2-norm).  ``guess``: the eigen-analysis' displacement vector (start for x; its conjugate
+    starts y).  x takes one step; y two, since B is not symmetric (the creep blocks, the motor
+    slope measured against the vehicle's speed) and the left vector differs from x̄."""
     lu, piv = _lu_for_inverse_iteration(lam * lam * model.M + lam * B_total + model.K)
     x = sla.lu_solve((lu, piv), model.M @ guess, check_finite=False)
-    start = model.M @ guess.conj()
-    y = sla.lu_solve((lu, piv), start, trans=2, check_finite=False)
+    y = model.M @ guess.conj()
+    for _ in range(2):
+        y = sla.lu_solve((lu, piv), y / np.linalg.norm(y), trans=2, check_finite=False)
     return x / np.linalg.norm(x), y / np.linalg.norm(y)
 
 
@@ -460,6 +487,8 @@ def eigen_sensitivities(model: BogieModel, op: OperatingPoint, indices: Iterable
         row = sensitivity(structural.get(name))
         if name in CREEP_LAW_INPUTS or name in KALKER_INPUTS:
             row = row + sensitivity(operating_derivative(model, op, name))
+        if name in MOTOR_SPEED_INPUTS:
+            row = row + sensitivity(motor_pattern_derivative(model, op, name))
         if name in linked:
             row = row + operating_rows[LINKED[name]]
         rows.append(row)

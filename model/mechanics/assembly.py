@@ -18,10 +18,17 @@ DOF layout (197 coordinates; the study had 189 without stating its breakdown):
   by the rest of the locomotive); ``secondary.yaw_damper_{left,right}.stroke`` the massless inner
   coordinates of the two yaw dampers (Maxwell elements: damper in series with its end bushes).
 
+With a converter torque control on ID2 (``motor_bandwidth`` f_c > 0) one massless coordinate
+follows, ``ID2.converter.filtered_angle`` [rad]: the rotor's angle relative to the stator and to
+the vehicle's rolling, high-passed at f_c (:func:`converter_rows`).
+
 Rigid-body modes (``K r = 0``, from the kinematics): the spin of each drivetrain (rotor at −p times
 the wheel) and, since nothing in this model holds the vehicle to the track longitudinally or in
 yaw but the creep (a damping), the longitudinal translation and the yaw about the bogie centre of
-the whole vehicle (car body, frame, drives) — four in all.
+the whole vehicle (car body, frame, drives) — four in all.  One combination of them, the vehicle
+rolling without slip (:attr:`BogieModel.rolling_mode`), meets no damping either: no creep, no
+motor slope (eq. 6 measures the rotor's speed against the rolling the vehicle's speed implies), no
+damper; with no running resistance in the model its velocity is a fifth neutral motion.
 """
 
 from __future__ import annotations
@@ -53,10 +60,12 @@ DRIVES = ("ID1", "ID2")
 CENTRAL_SYMMETRY = np.diag([-1.0, -1.0, 1.0])  # drive 2 = drive 1 turned 180° about z
 CAR_BODY_AXES = ("x", "z", "rz")  # the half car body's coordinates
 YAW_DAMPERS = ("secondary.yaw_damper_left", "secondary.yaw_damper_right")  # +y, −y side
+CONVERTER_FILTER = "ID2.converter.filtered_angle"  # massless coordinate of ID2's torque control
 
 
-def dof_names() -> tuple[str, ...]:
-    """All coordinate names in the order of q = [q_ID1, q_BFCB, q_ID2]."""
+def dof_names(converter: bool = False) -> tuple[str, ...]:
+    """All coordinate names in the order of q = [q_ID1, q_BFCB, q_ID2], then with ``converter``
+    (a torque control on ID2, ``motor_bandwidth`` > 0) its filter's coordinate."""
 
     def drive(prefix: str) -> list[str]:
         names = [f"{prefix}.rotor.ry", f"{prefix}.pinion.ry", f"{prefix}.gear.ry"]
@@ -70,7 +79,8 @@ def dof_names() -> tuple[str, ...]:
         return names
 
     return tuple(drive("ID1") + [f"BF.{a}" for a in AXES6] + [f"CB.{a}" for a in CAR_BODY_AXES]
-                 + [f"{damper}.stroke" for damper in YAW_DAMPERS] + drive("ID2"))
+                 + [f"{damper}.stroke" for damper in YAW_DAMPERS] + drive("ID2")
+                 + ([CONVERTER_FILTER] if converter else []))
 
 
 @dataclass(frozen=True)
@@ -94,10 +104,11 @@ class BogieModel:
     stiffness_parts: dict[str, Part]  # element group -> its share of K (strain energy)
     connections: list[SpringDamper | MaxwellDamper]  # every connection, for output quantities
     rims: dict[str, np.ndarray]  # "ID1.rim12" -> indices of [x, y, z, rx, ry, rz]
-    motor_pattern: np.ndarray  # n x n: B_M for b_M = 1 (ID2 rotor–stator, relative form)
+    motor_pattern: np.ndarray  # n x n: B_M for b_M = 1 (ID2's slope, :func:`motor_slope_rows`)
     short_circuit_force: np.ndarray  # generalized force per unit M_C on ID1 (rotor, stator)
     rigid_body_modes: np.ndarray  # n x 4: rigid spin of each whole drivetrain, longitudinal
     # translation and yaw of the whole vehicle (K r = 0)
+    rolling_mode: np.ndarray  # n: the vehicle rolling without slip at 1 m/s (K r = 0, B r = 0)
     positions: dict[str, np.ndarray] = field(default_factory=dict)  # part -> reference point [m]
 
     @property
@@ -429,11 +440,7 @@ def build_model(parameters: Parameters) -> BogieModel:
     asm, dofs, positions = _assemble(p)
     n = len(dofs)
     dtype = asm.K.dtype
-
-    # healthy motor (ID2): torque depends on the rotor's speed relative to the stator
-    motor = np.zeros((n, n))
-    rotor2, stator2 = dofs.index("ID2.rotor.ry"), dofs.index("ID2.stator.ry")
-    motor[np.ix_([rotor2, stator2], [rotor2, stator2])] = [[1.0, -1.0], [-1.0, 1.0]]
+    motor = motor_slope_rows(p, dofs, asm)
 
     # short circuit torque on ID1: M_C in the driving sense.  Forward running spins the wheels
     # +ry and, through one external gear mesh, the rotor −ry: a driving torque is −ry on the rotor
@@ -452,18 +459,67 @@ def build_model(parameters: Parameters) -> BogieModel:
     # the whole vehicle: longitudinal translation, yaw about the vertical through the bogie centre
     rigid[:, 2] = _rigid_motion(asm.bodies, dofs, np.array([1.0, 0.0, 0.0]), np.zeros(3))
     rigid[:, 3] = _rigid_motion(asm.bodies, dofs, np.zeros(3), np.array([0.0, 0.0, 1.0]))
+    # rolling without slip at 1 m/s: the translation, every wheel spinning at 1/r0
+    rolling = rigid[:, 2] + (rigid[:, 0] + rigid[:, 1]) / p["wheel_radius"]
 
     rims = {f"{prefix}.rim{k}": dofs.indices([f"{prefix}.rim{k}.{a}" for a in AXES6])
             for prefix in DRIVES for k in RIM_NODES}
     return BogieModel(p, dofs, asm.M, asm.K, asm.B, _parts(asm.mass_parts),
                       _parts(asm.stiffness_parts), asm.connections, rims, motor, short_circuit,
-                      rigid, positions)
+                      rigid, rolling, positions)
+
+
+def motor_speed_row(parameters: Parameters, dofs: DofMap) -> np.ndarray:
+    """g (n): ``Δφ̇ = g · q̇``, the speed of ID2's rotor relative to its stator less the rotation
+    that the vehicle's current speed implies (eq. 6: "with respect to rotation corresponding to
+    vehicle forward velocity v").  Rolling without slip at ẋ spins the wheels at ẋ/r0 and, through
+    one external gear mesh, the rotor at −p ẋ/r0; the vehicle's speed is its half car body's
+    ``CB.x``.  A vehicle rolling faster without slip changes no Δφ̇ [1, rad/m]."""
+    ratio = parameters["gear_ratio"] / parameters["wheel_radius"]
+    g = np.zeros(len(dofs), dtype=np.result_type(ratio, float))  # complex in a complex step
+    g[dofs.index("ID2.rotor.ry")] = 1.0
+    g[dofs.index("ID2.stator.ry")] = -1.0
+    g[dofs.index("CB.x")] = ratio
+    return g
+
+
+def motor_slope_rows(parameters: Parameters, dofs: DofMap, asm: _Assembler) -> np.ndarray:
+    """B_M (n x n) for b_M = 1: ID2's slope torque ``−b_M Δφ̇`` on the rotor, its reaction on the
+    stator (eq. 6).  Without torque control (``motor_bandwidth`` = 0) ``Δφ̇ = g · q̇``
+    (:func:`motor_speed_row`); with it the slope acts on Δφ̇ high-passed at f_c, the velocity of
+    the filter's coordinate (:func:`converter_rows`, which adds that coordinate's own row to B and
+    K of ``asm``).  Not symmetric: the vehicle's speed enters the measure, not the torque."""
+    n = len(dofs)
+    force = np.zeros(n)  # a unit slope torque: −1 on the rotor, +1 on the stator (as M_C's sense)
+    force[dofs.index("ID2.rotor.ry")] = 1.0
+    force[dofs.index("ID2.stator.ry")] = -1.0
+    speed = motor_speed_row(parameters, dofs)
+    if parameters["motor_bandwidth"].real > 0.0:
+        speed = converter_rows(parameters, dofs, asm, speed)
+    return np.outer(force, speed)
+
+
+def converter_rows(parameters: Parameters, dofs: DofMap, asm: _Assembler,
+                   speed: np.ndarray) -> np.ndarray:
+    """The torque control of ID2's converter, a first-order high-pass at f_c on the motor's
+    relative speed Δφ̇ = ``speed`` · q̇: the massless coordinate z (:data:`CONVERTER_FILTER`, rad)
+    obeys ``ż + ω_c z = Δφ̇`` (ω_c = 2π f_c), so that ż = Δφ̇ s/(s + ω_c): below f_c the
+    converter restores the set-point torque (ż → 0 for a slow change of speed), above it the
+    slope acts as without control.  Its row goes into the constant B (``ż − speed · q̇``) and K
+    (``ω_c z``) of ``asm``; returns the row e_z on which the slope then acts."""
+    z = dofs.index(CONVERTER_FILTER)
+    asm.B[z, :] -= speed
+    asm.B[z, z] += 1.0
+    asm.K[z, z] += 2 * np.pi * parameters["motor_bandwidth"]
+    row = np.zeros(len(dofs))
+    row[z] = 1.0
+    return row
 
 
 def _assemble(parameters: Parameters) -> tuple[_Assembler, DofMap, dict[str, np.ndarray]]:
     """Every body and element of the bogie added: (assembler, DOF map, drawn positions)."""
     p = parameters
-    dofs = DofMap(dof_names())
+    dofs = DofMap(dof_names(converter=p["motor_bandwidth"].real > 0.0))
     # complex values (a complex-step perturbation, model.analysis.sensitivity) give complex matrices
     dtype = complex if any(isinstance(value, complex) for value in p.values.values()) else float
     asm = _Assembler(dofs, dtype)

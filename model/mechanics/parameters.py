@@ -6,9 +6,10 @@ value comes from (public fact, estimate and why, or calibration output).  Two sc
 :data:`SCHEMA`, what the dynamics need, and :data:`ASSESSMENT_SCHEMA`, the strength data of the
 checks (:mod:`model.analysis.assessment`: press fits, shaft sections, coupling ratings, required
 safety factors), which do not enter the dynamics.  Unknown names are errors, and so are missing
-names of :data:`SCHEMA`, with two exceptions for files written before they existed: a missing
-``train_mass`` is 0 (the locomotive alone, as in the study), and missing strength data take the
-default set's values (each note says so).
+names of :data:`SCHEMA`, with exceptions for files written before they existed: a missing
+``train_mass`` is 0 (the locomotive alone, as in the study), a missing ``motor_bandwidth`` is 0
+(no torque control: the study's motor slope at every frequency), and missing strength data take
+the default set's values (each note says so).
 """
 
 from __future__ import annotations
@@ -139,6 +140,9 @@ SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "shaft_loss_time": ("s", "stiffness-proportional damping of steel parts", (0.0, 1.0, True)),
     "rubber_loss_time": ("s", "stiffness-proportional damping of rubber parts", (0.0, 1.0, True)),
     "motor_slope": ("N m s/rad", "b_M: falling slope of the healthy motor's torque-speed characteristic", _NONNEG),
+    "motor_bandwidth": ("Hz", "f_c: torque-control bandwidth of the healthy motor's converter; below it the "
+                        "converter holds the set-point torque, above it the slope b_M acts (0: no torque "
+                        "control, the slope at every frequency)", (0.0, 1e3, True)),
 }
 
 # Strength data of the checks (model.analysis.assessment); they do not enter the dynamics.  The
@@ -165,6 +169,9 @@ ASSESSMENT_SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "axle_shear_stress_allowable": ("Pa", "permissible torsional shear stress of the axle", _POS),
     "hollow_shaft_shear_stress_allowable": ("Pa", "permissible torsional shear stress of the hollow shaft", _POS),
     "driving_shaft_shear_stress_allowable": ("Pa", "permissible torsional shear stress of the driving shaft", _POS),
+    "starting_traction_force": ("N", "the locomotive's starting traction force at the rails, all its "
+                                "driven wheelsets together (what its converters and motors can give)", _POS),
+    "driven_wheelsets": ("1", "number of driven wheelsets of the locomotive", (1.0, 64.0, True)),
     "disc_clutch_rated_torque": ("N m", "largest torque the disc clutch is rated for", _POS),
     "claw_clutch_rated_torque": ("N m", "largest torque the claw clutch is rated for", _POS),
     "required_factor_slip": ("1", "required safety factor of a press fit against slip", _POS),
@@ -172,9 +179,11 @@ ASSESSMENT_SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "required_factor_coupling": ("1", "required safety factor of a coupling against its rating", _POS),
 }
 ALL_SCHEMA = {**SCHEMA, **ASSESSMENT_SCHEMA}  # every name a parameter file may hold
-# names a file may leave out (written before they existed): train_mass -> 0, strength data -> the
-# default set's values
-OPTIONAL_DEFAULTS = {"train_mass": 0.0}
+# names a file may leave out (written before they existed): train_mass -> 0, motor_bandwidth -> 0,
+# strength data -> the default set's values
+OPTIONAL_DEFAULTS = {"train_mass": 0.0, "motor_bandwidth": 0.0}
+_OPTIONAL_MEANING = {"train_mass": "the locomotive alone as in the study",
+                     "motor_bandwidth": "no torque control, the study's slope at every frequency"}
 
 
 @dataclass(frozen=True)
@@ -252,7 +261,7 @@ def parse_parameters(table: Mapping[str, object], source: str = "<memory>") -> P
     for name, default in OPTIONAL_DEFAULTS.items():
         if name not in values:
             values[name] = default
-            notes[name] = f"not in {source}: {default:g}, the locomotive alone as in the study"
+            notes[name] = f"not in {source}: {default:g}, {_OPTIONAL_MEANING[name]}"
     missing_strength = [name for name in ASSESSMENT_SCHEMA if name not in values]
     if missing_strength:
         defaults, default_notes = _default_strength_data()

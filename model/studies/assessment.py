@@ -9,18 +9,22 @@ coupling of both drives (:func:`model.analysis.assessment.drive_components`) in 
 
 * ``short_circuit`` — ID1's motor short-circuits: the worst case over *every* fault instant in
   closed form (exactly ``bogie envelope --phase all``) over a grid of speeds and stable creepages
-  (default s0 = 0.002, 0.005 at 80, 120, 200 km/h), linear creep.  After the fault ID2 takes over
-  ID1's lost torque slowly, as the vehicle's speed falls (the quasi-static take-over; its time
-  constant grows with the longitudinal mass, ``car_body_mass + train_mass``): the horizon is the
-  time after which the quasi-static part of every checked output stays within 1 % of its final
-  change (:func:`take_over_horizon`), at least 2 s.  With linear creep ID2 takes over the whole
-  loss, even beyond the adhesion limit M_ad, where a real wheelset would slip: conservative.
+  (default s0 = 0.002, 0.005 at 80, 120, 200 km/h), linear creep.  After the fault the vehicle
+  decelerates under the lost torque while ID2 keeps its own (its slope measures the rotor against
+  the vehicle's speed, eq. 6): the loads settle to the static response of that uniform
+  deceleration.  The horizon is the time after which the quasi-static part of every checked
+  output stays within 1 % of that final value (:func:`settling_horizon`), at least 2 s.  Where
+  the linear creep force at a wheel leaves the adhesion range (|T| > μ_max N0) anywhere on the
+  grid, each check of the case says so beside its load: a real wheelset would slip there, and
+  the linear load is an upper estimate.
 * ``unstable_adhesion`` — the same short circuit at a creepage beyond the adhesion maximum
   (default s0 = 0.014, 120 km/h: the study's unstable case), with the creep forces of the
   nonlinear law and the anti-slip protection of ID2 at its default reaction time
   (:class:`model.analysis.nonlinear.AntiSlip`); the history's extremes over 2 s.
-* ``starting`` — steady traction at the adhesion limit: both motors' torque 2 μ_max N0 r0 / p at
-  a starting speed (default 5 km/h), the static loads (no horizon).
+* ``starting`` — steady traction at a starting speed (default 5 km/h) with what the drive can
+  deliver: the smaller of the motors' torque at the locomotive's starting traction force
+  (``starting_traction_force`` shared by its ``driven_wheelsets``) and the adhesion limit
+  2 μ_max N0 r0 / p; the static loads (no horizon), and the check says which bound governs.
 
 **Checks**: the load of a component in a case is the largest |value| of its output over the
 case's histories; safety factor = capacity / load (:mod:`model.analysis.assessment`).
@@ -61,7 +65,7 @@ class AssessmentOptions:
     N0: float | None = None  # wheel force [N] (None: the set's)
     b_M: float | None = None  # motor slope [N m s/rad] (None: the set's)
     excitation: ShortCircuit = field(default_factory=ShortCircuit)  # M0, f, D (Δt: all)
-    t_end: float | None = None  # short_circuit horizon [s] (None: take_over_horizon)
+    t_end: float | None = None  # short_circuit horizon [s] (None: settling_horizon)
     fs: float = 10_000.0  # sampling rate of every history [Hz]
     unstable_s0: float = 0.014  # unstable_adhesion: creepage [-]
     unstable_v: float = 120.0 * KMH  # unstable_adhesion: speed [m/s]
@@ -85,6 +89,7 @@ class CaseLoad:
     value: float  # signed [N m]
     time: float  # [s] (nan: steady)
     scenario: dict  # s0, v_kmh, phase_s, …
+    note: str = ""  # what qualifies the load (shown beside it in the check)
 
 
 @dataclass(frozen=True)
@@ -126,12 +131,13 @@ def _operating_point(parameters: Parameters, s0: float, v: float, options: Asses
     return OperatingPoint(s0, v, N0, b_M)
 
 
-def take_over_horizon(model, ops: list[OperatingPoint], outputs: list[str]) -> float:
+def settling_horizon(model, ops: list[OperatingPoint], outputs: list[str]) -> float:
     """The time [s] after which the quasi-static part (:func:`model.analysis.response.
-    quasi_static_step`) of every output at every operating point stays within 1 % of its final
-    change, rounded up to a whole second, at least 2 s and at most 60 s (the response's
-    longest horizon; a take-over slower than that, or one that cannot be separated from the
-    oscillation at a point, is cut there)."""
+    quasi_static_step`: the static response to the lost motor torque, the vehicle decelerating
+    uniformly, and the slow creep-damped modes on their way to it) of every output at every
+    operating point stays within 1 % of its final value, rounded up to a whole second, at least
+    2 s and at most 60 s (the response's longest horizon; a point where it cannot be separated
+    from the oscillation is cut there)."""
     from model.analysis.eigen import bogie_system
     from model.analysis.response import (
         MAX_T_END,
@@ -202,25 +208,53 @@ def short_circuit_case(parameters: Parameters, outputs: list[str], options: Asse
 
     model = cached_model(parameters)
     ops = short_circuit_points(parameters, options)
-    horizon = options.t_end if options.t_end is not None else take_over_horizon(model, ops,
-                                                                                outputs)
-    names, units = resolve_outputs(model, ops[0], outputs)
+    horizon = options.t_end if options.t_end is not None else settling_horizon(model, ops,
+                                                                               outputs)
+    contacts = [f"{rim}.creep_force" for rim in model.rims]
+    names, units = resolve_outputs(model, ops[0], [*outputs, *contacts])
     e = options.excitation
     study = EnvelopeStudy(s0=options.s0, v=options.v, N0=(ops[0].N0,), b_M=(ops[0].b_M,),
                           outputs=names, units=units, M0=(e.M0,), f=(e.f,), D=(e.D,),
                           fault="all", t_end=horizon, fs=options.fs)
     result = run_envelope(study, parameters, map_unordered, progress)
-    loads = {o.name: _largest(o.max, o.min, o.max_at, o.min_at) for o in result.outputs}
+    envelopes = {o.name: o for o in result.outputs}
+    note = beyond_adhesion_note(parameters, ops[0].N0, [envelopes[c] for c in contacts])
+    loads = {}
+    for name in outputs:
+        o = envelopes[name]
+        load = _largest(o.max, o.min, o.max_at, o.min_at)
+        loads[name] = CaseLoad(load.value, load.time, load.scenario, note)
     return LoadCase(
         "short_circuit",
         "short circuit of ID1's motor, worst case over every fault instant (closed form, linear "
         f"creep, as bogie envelope --phase all) over s0 = {', '.join(f'{x:g}' for x in options.s0)}"
-        f" and v = {', '.join(f'{x / KMH:g}' for x in options.v)} km/h; the horizon covers ID2's "
-        "quasi-static take-over of the lost torque",
+        f" and v = {', '.join(f'{x / KMH:g}' for x in options.v)} km/h; the horizon covers the "
+        "settling to the static response of the vehicle's deceleration",
         horizon, loads,
         {"s0": list(options.s0), "v_kmh": [x / KMH for x in options.v], "N0": ops[0].N0,
          "b_M": ops[0].b_M, "M0": e.M0, "f": e.f, "D": e.D, "fault_instants": "all",
          "creep": "linear", "fs": options.fs})
+
+
+def beyond_adhesion_note(parameters: Parameters, N0: float, contacts) -> str:
+    """What to say beside a linear short-circuit load when a wheel's linear creep force left the
+    adhesion range somewhere on the grid (``contacts``: the creep forces' envelopes, whose
+    extremes carry their speed), "" when none did."""
+    worst = []
+    for envelope in contacts:
+        for value, at in ((envelope.max, envelope.max_at), (envelope.min, envelope.min_at)):
+            v = at["v_kmh"] * KMH
+            limit = creep_law(parameters, N0).maximum(v)[1] * N0
+            if abs(value) > limit:
+                worst.append((abs(value) / limit, envelope.name, value, limit, at))
+    if not worst:
+        return ""
+    ratio, name, value, limit, at = max(worst, key=lambda w: w[0])
+    wheel = name.removesuffix(".creep_force")
+    return (f"linear creep beyond the adhesion limit: {wheel}'s creep force reaches "
+            f"{value / 1e3:.1f} kN, {ratio:.2f} x μ_max N0 = {limit / 1e3:.1f} kN (s0 = "
+            f"{at['s0']:g}, {at['v_kmh']:g} km/h): a real wheelset slips there, the linear load "
+            "is an upper estimate")
 
 
 def unstable_adhesion_case(parameters: Parameters, outputs: list[str],
@@ -259,25 +293,50 @@ def unstable_adhesion_case(parameters: Parameters, outputs: list[str],
 
 def starting_case(parameters: Parameters, outputs: list[str], options: AssessmentOptions
                   ) -> LoadCase:
-    """Steady traction at the adhesion limit: the static loads with the creepage at the creep
-    maximum of the starting speed (so M = 2 μ_max N0 r0 / p)."""
+    """Steady traction at the starting speed with what the drive can deliver: the motors' torque
+    at the starting traction force F (``starting_traction_force`` / ``driven_wheelsets`` per
+    wheelset, F r0 / (n p) per motor) or at the adhesion limit 2 μ_max N0 r0 / p, whichever is
+    smaller; the static loads at the creepage where μ(s0) gives that torque (on the rising
+    branch of the creep law)."""
+    from scipy.optimize import brentq
+
     from model.mechanics.outputs import output_matrices, static_deflection
     from model.studies.maps import cached_model
 
     model = cached_model(parameters)
     N0 = parameters["wheel_force"] if options.N0 is None else options.N0
-    s_max, mu_max = creep_law(parameters, N0).maximum(options.starting_v)
-    op = _operating_point(parameters, s_max, options.starting_v, options)
+    v = options.starting_v
+    law = creep_law(parameters, N0)
+    s_max, mu_max = law.maximum(v)
+    r0, n = parameters["wheel_radius"], parameters["driven_wheelsets"]
+    force = parameters["starting_traction_force"]
+    mu_motors = force / (n * 2 * N0)  # per wheel: F / (2 n N0)
+    if mu_motors < mu_max:
+        s0 = brentq(lambda s: float(law.mu(s, v)) - mu_motors, s_max * 1e-9, s_max, xtol=1e-15,
+                    rtol=1e-14)
+        bound = "motors"
+        words = (f"the motors' torque at the starting traction force {force / 1e3:g} kN over "
+                 f"{n:g} driven wheelsets ({force * r0 / n / 1e3:.1f} kN m per wheelset, below "
+                 f"the adhesion limit {2 * mu_max * N0 * r0 / 1e3:.1f} kN m)")
+    else:
+        s0, bound = s_max, "adhesion"
+        words = (f"the adhesion limit 2 μ_max N0 r0 (μ_max = {mu_max:.3g}, "
+                 f"{2 * mu_max * N0 * r0 / 1e3:.1f} kN m per wheelset, below the motors' "
+                 f"{force * r0 / n / 1e3:.1f} kN m at the starting traction force)")
+    op = _operating_point(parameters, s0, v, options)
+    mu = float(law.mu(s0, v))
     matrices = output_matrices(model, op)
     values = matrices.C_q @ static_deflection(model, op)
-    where = {"s0": s_max, "v_kmh": op.v_kmh, "mu_max": mu_max}
-    loads = {name: CaseLoad(float(values[matrices.index(name)]), math.nan, dict(where))
+    where = {"s0": s0, "v_kmh": op.v_kmh, "mu": mu, "mu_max": mu_max, "bound": bound}
+    note = f"starting torque bounded by {'the motors' if bound == 'motors' else 'adhesion'}"
+    loads = {name: CaseLoad(float(values[matrices.index(name)]), math.nan, dict(where), note)
              for name in outputs}
     return LoadCase(
         "starting",
-        f"steady traction at the adhesion limit at {op.v_kmh:g} km/h: both motors at "
-        f"2 μ_max N0 r0 / p (μ_max = {mu_max:.3g} at s0 = {s_max:.3g}); steady, no horizon",
-        None, loads, {"s0": s_max, "v_kmh": op.v_kmh, "N0": N0, "mu_max": mu_max})
+        f"steady traction at {op.v_kmh:g} km/h with {words}; steady, no horizon",
+        None, loads, {"s0": s0, "v_kmh": op.v_kmh, "N0": N0, "mu": mu, "mu_max": mu_max,
+                      "bound": bound, "starting_traction_force": force,
+                      "driven_wheelsets": n})
 
 
 def assess(parameters: Parameters, options: AssessmentOptions | None = None,
@@ -308,5 +367,5 @@ def assessment_of(parameters: Parameters, cases: list[LoadCase]) -> Assessment:
         for component in components:
             load = case.loads[component.output]
             checks.append(verify(component, case.name, load.value, load.value, load.time,
-                                 load.scenario))
+                                 load.scenario, load.note))
     return Assessment(cases, components, checks, governing(checks))

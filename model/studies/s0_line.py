@@ -349,11 +349,14 @@ class _LineModel:
         # model (K_r y_R = 0) whatever C: that invariant subspace is deflated once per line as in
         # the full model (model.analysis.linear_system.Deflation), and each point solves the eigenvalues of
         # the rest, A22(c) = base + Σ c_k D_k (2r − n_rigid unknowns), only.
-        rigid = sla.solve_triangular(red.Linv.T, red.Phi.T @ model.rigid_body_modes,
-                                     lower=False, check_finite=False)
+        # (and the free rolling velocity's exact zero, [0; y_roll], as in the full model)
+        rigid, rolling = (sla.solve_triangular(red.Linv.T, red.Phi.T @ vectors, lower=False,
+                                               check_finite=False)
+                          for vectors in (model.rigid_body_modes, model.rolling_mode[:, None]))
         r_i = len(red.inertial)  # the reduced state: r coordinates, r_i velocities
-        deflation = Deflation(np.vstack([rigid, np.zeros((r_i, rigid.shape[1]))]))
-        n_rigid = rigid.shape[1]
+        deflation = Deflation(np.block([[rigid, np.zeros((r, 1))],
+                                        [np.zeros((r_i, rigid.shape[1])), rolling[red.inertial]]]))
+        n_rigid = rigid.shape[1] + 1
 
         def first_order(K, C):
             if K is None:  # a creep pattern (inertial coordinates only): its part of A

@@ -24,7 +24,12 @@ from model.analysis.eigen import state_space
 from model.analysis.linear_system import massless_coordinates
 from model.mechanics.assembly import DRIVES, YAW_DAMPERS, dof_names
 from model.mechanics.dofs import AXES6, DofMap
-from model.mechanics.operating_point import creep_coefficients, creep_damping
+from model.mechanics.operating_point import (
+    OperatingPoint,
+    creep_coefficients,
+    creep_damping,
+    damping_matrix,
+)
 from model.mechanics.outputs import static_load
 from model.mechanics.parameters import CALIBRATED_FILE, ESTIMATE_FILE
 
@@ -277,17 +282,68 @@ def test_creep_damping_changes_sign_of_b11_across_the_creep_maximum(calibrated):
 
 
 def test_motor_pattern_only_on_id2_rotor_and_stator(model):
+    """B_M (b_M = 1): the slope torque acts on ID2's rotor and, as reaction, on its stator (rows);
+    it measures the rotor's speed relative to the stator less the rolling that the vehicle's
+    speed CB.x implies through the gear ratio and the wheel radius (columns, eq. 6)."""
     Bm = model.motor_pattern
-    touched = sorted({model.dofs.names[i] for i in np.flatnonzero(np.any(Bm != 0, axis=0))})
-    assert touched == ["ID2.rotor.ry", "ID2.stator.ry"]
-    assert np.array_equal(Bm, Bm.T)
-    assert np.linalg.eigvalsh(Bm).min() > -1e-14
+    names = model.dofs.names
+    rows = sorted({names[i] for i in np.flatnonzero(np.any(Bm != 0, axis=1))})
+    columns = sorted({names[i] for i in np.flatnonzero(np.any(Bm != 0, axis=0))})
+    assert rows == ["ID2.rotor.ry", "ID2.stator.ry"]
+    assert columns == ["CB.x", "ID2.rotor.ry", "ID2.stator.ry"]
+    rotor, stator, car_body = (model.dofs.index(n) for n in ("ID2.rotor.ry", "ID2.stator.ry", "CB.x"))
+    p = model.parameters
+    assert Bm[rotor, rotor] == 1.0 and Bm[rotor, stator] == -1.0
+    assert Bm[rotor, car_body] == pytest.approx(p["gear_ratio"] / p["wheel_radius"], rel=1e-15)
+    assert np.array_equal(Bm[stator], -Bm[rotor])  # the reaction: no net torque on the bogie
     # relative form: a rotation of rotor and stator together does not change the motor torque
     together = np.zeros(model.n)
-    together[[model.dofs.index("ID2.rotor.ry"), model.dofs.index("ID2.stator.ry")]] = 1.0
+    together[[rotor, stator]] = 1.0
     assert not np.any(Bm @ together)
 
 
+def test_rolling_mode_is_the_vehicle_rolling_without_slip(model):
+    """Every .x coordinate of a body 1, every rolling part's .ry 1/r0, rotors and pinions −p/r0,
+    nothing else (the stators, frame and car body do not pitch): K r = 0."""
+    r = model.rolling_mode
+    p = model.parameters
+    r0, ratio = p["wheel_radius"], p["gear_ratio"]
+    for i, name in enumerate(model.dofs.names):
+        part, axis = name.rsplit(".", 1)
+        if axis == "x":
+            assert r[i] == pytest.approx(1.0, rel=1e-15), name
+        elif axis == "ry" and part.split(".")[-1] in ("rotor", "pinion"):
+            assert r[i] == pytest.approx(-ratio / r0, rel=1e-15), name
+        elif axis == "ry" and part.startswith(("ID1.", "ID2.")) and ".stator" not in part:
+            assert r[i] == pytest.approx(1.0 / r0, rel=1e-15), name
+        else:
+            assert r[i] == 0.0, name
+    K = model.K
+    assert np.linalg.norm(K @ r) <= 1e3 * EPS * np.linalg.norm(K, 2) * np.linalg.norm(r)
+
+
+@pytest.mark.parametrize("bandwidth", [0.0, 2.0, 40.0])
+@pytest.mark.parametrize(("s0", "v_kmh", "b_M"), [(0.005, 120.0, None), (0.014, 120.0, 3000.0),
+                                                  (0.002, 40.0, 20_000.0), (0.03, 250.0, 0.0)])
+def test_a_vehicle_rolling_faster_without_slip_meets_no_damping(model, bandwidth, s0, v_kmh, b_M):
+    """The check of eq. 6 against the vehicle's speed: the velocity of the vehicle rolling 1 m/s
+    faster without slip meets no damping force — no creep (no slip), no motor slope (the rotor
+    turns exactly as the vehicle's speed implies), no damper (nothing moves relative to anything)
+    — at every operating point, with and without the converter's torque control: ‖B r‖ at the
+    rounding of B's entries (B's largest entry ≈ 1e6 N s/m, the rolling's entries ≤ p/r0)."""
+    parameters = model.parameters.replace(motor_bandwidth=bandwidth)
+    bogie = build_model(parameters)
+    b_M = parameters["motor_slope"] if b_M is None else b_M
+    B = damping_matrix(bogie, OperatingPoint.from_kmh(s0, v_kmh, parameters["wheel_force"], b_M))
+    r = bogie.rolling_mode
+    force = B @ r
+    assert np.abs(force).max() <= 100 * EPS * np.abs(B).max() * np.abs(r).max()
+    # against the constant reference of the initial speed the slope would brake ID2's rotor:
+    # b_M p/r0 [N m per m/s] on its rotor (and the reaction on its stator)
+    rotor = bogie.dofs.index("ID2.rotor.ry")
+    constant_reference = b_M * (r[rotor] - r[bogie.dofs.index("ID2.stator.ry")])
+    assert abs(constant_reference) == pytest.approx(
+        b_M * parameters["gear_ratio"] / parameters["wheel_radius"], rel=1e-14)
 def test_short_circuit_force_is_internal_and_drives_drivetrain_1(model):
     """M_C acts on ID1's rotor and, as reaction, on ID1's stator: the net torque on the bogie is
     zero (rotating rotor and stator together, i.e. the whole motor as one body, absorbs no work),
@@ -321,12 +377,15 @@ def test_static_traction_load_is_self_equilibrated(model):
             assert abs(f0 @ r) <= 1e-12 * np.linalg.norm(f0) * np.linalg.norm(r)
 
 
-def test_eigen_analysis_identifies_the_four_rigid_body_modes(calibrated):
+def test_eigen_analysis_identifies_the_rigid_body_zeros(calibrated):
+    """Four rigid-body modes (K r = 0) and the velocity of the vehicle rolling without slip, which
+    no damping meets: five exact zeros, deflated, none of them left among the eigenvalues."""
     op = default_operating_point(calibrated.parameters)
     result = eigen_analysis(calibrated, op, vectors=False)
-    assert result.n_rigid == N_RIGID
+    assert result.n_rigid == N_RIGID + 1
     # states: every coordinate and the velocities of the inertial ones (not of the 2 strokes)
-    assert result.eigenvalues.size == 2 * calibrated.n - 2 - N_RIGID
+    assert result.eigenvalues.size == 2 * calibrated.n - 2 - N_RIGID - 1
+    assert np.abs(result.eigenvalues).min() > 1e-3  # the slowest mode: the frame's drift, 0.06 1/s
 
 
 # ------------------------------------------------------------------------------------------------
