@@ -36,14 +36,13 @@ from model.analysis.load_spectrum import LoadSpectrum, history_spectra, load_spe
 from model.analysis.locus import RootLocus, root_locus
 from model.analysis.modes import ModeCharacter, characterize, mode_character
 from model.analysis.nonlinear import AntiSlip, NonlinearResult, nonlinear_response
+from model.analysis.peak_sensitivity import PeakLoadSensitivity, peak_load_sensitivities
 from model.analysis.response import ResponseResult, ShortCircuit, short_circuit_response
 from model.analysis.sensitivity import (
     EigenSensitivities,
     LimitSensitivity,
-    PeakLoadSensitivity,
     eigen_sensitivities,
     limit_sensitivity,
-    peak_load_sensitivities,
 )
 from model.analysis.stability import NoStabilityLimit, StabilityLimit, stability_limit
 from model.mechanics.assembly import BogieModel, build_model

@@ -37,10 +37,10 @@ import numpy as np
 
 from model import build_model, load_parameters
 from model.analysis.eigen import eigen_analysis, forget_systems
+from model.analysis.peak_sensitivity import peak_load_sensitivities
 from model.analysis.sensitivity import (
     eigen_sensitivities,
     limit_sensitivity,
-    peak_load_sensitivities,
     structural_derivatives,
 )
 from model.analysis.stability import stability_limit

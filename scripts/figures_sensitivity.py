@@ -34,11 +34,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from model import build_model, load_parameters
-from model.analysis.sensitivity import (
-    eigen_sensitivities,
-    limit_sensitivity,
-    peak_load_sensitivities,
-)
+from model.analysis.peak_sensitivity import peak_load_sensitivities
+from model.analysis.sensitivity import eigen_sensitivities, limit_sensitivity
 from model.mechanics.operating_point import KMH, OperatingPoint, creep_law
 from model.mechanics.parameters import Parameters
 

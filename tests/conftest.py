@@ -377,3 +377,35 @@ def golden_parameters(golden: dict, path: Path, regenerate: str):
         return parse_parameters(table, source=str(path))
     except ParameterError as error:
         pytest.fail(f"the golden parameters no longer fit the schema ({error}); {regenerate}")
+
+
+def _uniform_acceleration_loads(model, op, force) -> dict[str, float]:
+    """The loads [per unit input] under a constant generalized force ``f`` in the steady state:
+    the whole vehicle accelerates uniformly along its free rolling at a (nothing in the model
+    resists a vehicle rolling faster without slip), the other rigid-body motions drift at
+    constant velocities v = R c (a wheelset slipping at a constant rate against the creep
+    damping), the structure deflects by q0: one linear solve of
+    ``K q0 + B R c + M r a = f``, ``Rᵀ q0 = 0``, ``rᵀ R c = 0`` (the rolling part of v is free:
+    no load sees it); the loads C_q q0 + C_v R c.  Independent of the modal form."""
+    import numpy as np
+
+    from model.mechanics.operating_point import damping_matrix
+    from model.mechanics.outputs import output_matrices
+
+    r, R, n = model.rolling_mode, model.rigid_body_modes, model.n
+    k = R.shape[1]
+    B = damping_matrix(model, op)
+    system = np.zeros((n + k + 1, n + k + 1))
+    system[:n, :n], system[:n, n:n + k], system[:n, -1] = model.K, B @ R, model.M @ r
+    system[n:n + k, :n] = R.T
+    system[-1, n:n + k] = r @ R
+    solution = np.linalg.solve(system, np.concatenate([force, np.zeros(k + 1)]))
+    matrices = output_matrices(model, op)
+    loads = matrices.C_q @ solution[:n] + matrices.C_v @ (R @ solution[n:n + k])
+    return dict(zip(matrices.names, loads, strict=True))
+
+
+@pytest.fixture(scope="session")
+def uniform_acceleration_loads():
+    """:func:`_uniform_acceleration_loads` (model, op, generalized force) -> load per output."""
+    return _uniform_acceleration_loads

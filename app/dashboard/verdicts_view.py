@@ -5,8 +5,8 @@ the safety factors per load case — and a strength-data file that replaces the 
 refused with a notice; the previous data are kept).
 
 The assessment (:func:`app.results.verdicts.assessment_result`) runs on a worker thread for each
-operating point shown; it takes seconds (the short-circuit case's horizon covers ID2's slow
-take-over), so the indicator says "computing" meanwhile.
+operating point shown; it takes a few seconds (the short-circuit case's grid over every fault
+instant), so the indicator says "computing" meanwhile.
 """
 
 from __future__ import annotations

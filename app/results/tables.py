@@ -142,7 +142,7 @@ def peaks_html(response: compute.ResponseView, companion: compute.ResponseView |
     if split:
         explain = ("swing = total − pre-fault value of largest magnitude = its quasi-static part "
                    "(the static response to the lost motor torque and the modes slower than "
-                   f"{QUASI_STATIC_HZ:g} Hz: ID2 taking over ID1's torque as the vehicle slows) "
+                   f"{QUASI_STATIC_HZ:g} Hz: the vehicle decelerating under the lost torque) "
                    "+ its dynamic part (the oscillation about it), both at the swing's time")
     else:
         explain = f"swings not split into quasi-static and dynamic parts: {peaks.split_note}"

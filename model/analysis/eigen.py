@@ -183,7 +183,7 @@ def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) 
         >>> model = build_model(parameters)
         >>> result = eigen_analysis(model, default_operating_point(parameters, s0=0.014))
         >>> result.stable, result.flutter > 0, result.divergence
-        (False, True, 2)
+        (False, True, 1)
         >>> bool(result.real_eigenvalues[0] > 0)        # the largest real eigenvalue [1/s]
         True
     """

@@ -8,8 +8,8 @@ peaks describes whichever history is on screen by the same rules.
 
 **Peaks a reviewer can read** (:class:`LoadPeaks`, :func:`load_peaks`): the largest magnitude of
 a total is often the value before the fault (ID1's disc clutch carries its motor's torque until
-the short circuit) and the value at the end of a window is often a slow take-over still rising
-(ID2 taking over ID1's lost torque as the vehicle slows).  So per output: the maximum, the minimum
+the short circuit) and the value at the end of a window is often a slow drift still settling to
+the static response of the vehicle's deceleration.  So per output: the maximum, the minimum
 and the swing from the pre-fault value, each with its time, and the swing split into its
 quasi-static part (the static response to the lost torque and the slow modes,
 :func:`model.analysis.response.quasi_static_response`) and its dynamic part (the oscillation

@@ -89,9 +89,8 @@ MAX_POINTS = 2_000_001  # time points per response
 MAX_T_END = 60.0  # [s]
 # The quasi-static part of a response: the static response and the modes that do not oscillate
 # or oscillate slower than this (|Im λ| / 2π), not completing a cycle in the study's 2 s window.
-# The bogie's slow modes (the vehicle's speed, a drive taking over a lost torque, creep-damped
-# drifts; a slow pair where the motor slope b_M makes one) lie well below its lowest structural
-# mode (the car body's bounce): no mode between 0.6 and 2 times this at stable points
+# The bogie's slow modes (creep-damped drifts of the wheelsets and the frame) lie well below its
+# lowest structural mode (the car body's bounce): no mode between 0.6 and 2 times this at stable points
 # (tests/model/analysis/test_response_model.py::test_no_mode_near_the_quasi_static_cutoff).
 QUASI_STATIC_HZ = 0.5
 # the split is given when the modal form's rounding-error estimate of the quasi-static part stays
@@ -380,7 +379,7 @@ def solve_linear(system: LinearSystem, C: np.ndarray, u0: float, a: complex, mu:
 
 class QuasiStaticUnavailable(ResponseError):
     """The quasi-static part cannot be separated reliably at this operating point (the modal
-    form is ill-conditioned there, e.g. at b_M = 0, where the vehicle's speed is neutral)."""
+    form is ill-conditioned there)."""
 
 
 @dataclass(frozen=True)
@@ -397,8 +396,9 @@ def quasi_static_response(system: LinearSystem, C: np.ndarray, u0: float, a: com
     """The quasi-static part of the response to ``u(t) = u0 + Re(a e^(μt))`` [N m] (the
     excitation's terms, :meth:`ShortCircuit.terms`) of the outputs ``C``, on the grid
     ``t_k = k dt`` [s]: the static response to the step and the terms of the modes that do not
-    oscillate or oscillate slower than :data:`QUASI_STATIC_HZ` — the take-over of a lost motor
-    torque as the vehicle's speed changes, the creep-damped drifts.  The rest (the faster modes'
+    oscillate or oscillate slower than :data:`QUASI_STATIC_HZ` — the static response to a lost
+    motor torque (the vehicle decelerating uniformly) and the creep-damped drifts on the way to
+    it.  The rest (the faster modes'
     terms, the forced oscillation at f) is the dynamic part: the oscillation about the
     quasi-static value.  Raises :class:`QuasiStaticUnavailable` where the modal form is not
     reliable (rounding-error estimate above :data:`QUASI_STATIC_TOLERANCE`)."""

@@ -12,7 +12,9 @@ matrices are exact, never finite differences of eigenvalues:
   (``p → p + i h``, ``X′ = Im X(p + i h)/h``, ``h = 10⁻²⁰ max(|p|, 1)``; exact to rounding, no
   subtractive cancellation).  They depend only on the parameter set and are cached per model
   (:func:`structural_derivatives`); only the coordinates a parameter touches are kept.
-* ``B′`` of the operating-point blocks: ``∂(b_M B_M)/∂b_M = B_M``; ``B_ad`` is linear in its four
+* ``B′`` of the operating-point blocks: ``∂(b_M B_M)/∂b_M = B_M``, and ``b_M ∂B_M/∂p`` for the
+  gear ratio and the wheel radius (eq. 6 measures the rotor against the rolling p/r0 · ẋ of the
+  vehicle); ``B_ad`` is linear in its four
   coefficients ``b11 = N0 μ′(s0, v)/v``, ``b22, b23, b33 = f_ij/v`` and quadratic in ``r0``:
   ``b11`` by the complex step through Polach's law (s0, v, N0 and the law's parameters), the
   Kalker coefficients ``f_ij`` by central differences with a relative step of 10⁻⁴ (they come from
@@ -20,13 +22,16 @@ matrices are exact, never finite differences of eigenvalues:
   step cannot pass; truncation ≈ 10⁻⁸ relative, see the tests).
 
 Eigenvectors: the right and left null vectors of ``λ²M + λB + K`` at each eigenvalue of the
-eigen-analysis, by one step of inverse iteration with one complex LU per mode (the eigenvalue is
-exact to rounding, so one step gives the null vectors to working accuracy).
+eigen-analysis, by inverse iteration with one complex LU per mode (the eigenvalue is exact to
+rounding: one step gives the right vector to working accuracy, two the left one, which differs
+more from x̄ since B is not symmetric).
 
 What is *not* returned as a number (and said instead):
 
-* the rigid-body zero eigenvalues (the spins of the two drivetrains, ``K r = 0`` for every
-  parameter value): they stay exactly zero, their sensitivity is zero by construction;
+* the rigid-body zero eigenvalues (the spins of the two drivetrains, the vehicle's translation
+  and yaw, ``K r = 0`` for every parameter value, and the velocity of the vehicle rolling
+  without slip, which no damping meets): they stay exactly zero, their sensitivity is zero by
+  construction;
 * near-repeated eigenvalues (the ID1/ID2 twins: nearly equal pairs of the two drives): where the
   relative gap to the nearest other eigenvalue is below :data:`NEAR_REPEATED` the derivative of a
   single member is not meaningful (the pair splits non-smoothly under a perturbation that breaks
@@ -44,7 +49,7 @@ creep on the yaw), so ``s0*`` is the creep maximum ``∂μ/∂s = 0`` and the fo
 and is exactly zero for every structural parameter — reported as such, with the numbers.
 
 Peak drive loads: central differences of the closed-form response at the peak's sample
-(:func:`peak_load_sensitivities`; envelope theorem: the peak is stationary in time).
+(:mod:`model.analysis.peak_sensitivity`; envelope theorem: the peak is stationary in time).
 
 Normalized sensitivities for ranking: ``p/λ · dλ/dp`` (complex), ``p · ∂Re λ/∂p`` [1/s] (the
 change of the growth rate per relative change of p) and ``p/s0* · ds0*/dp``.
@@ -69,7 +74,6 @@ from model.mechanics.assembly import (
     CONVERTER_FILTER,
     BogieModel,
     assembled_matrices,
-    build_model,
     motor_speed_row,
 )
 from model.mechanics.operating_point import OperatingPoint, damping_matrix
@@ -458,8 +462,9 @@ def eigen_sensitivities(model: BogieModel, op: OperatingPoint, indices: Iterable
                       + np.abs(model.K).max() for v in lam])
     condition = scale / (np.abs(lam) * np.abs(denominator))
     reliable = gap >= NEAR_REPEATED
-    notes = [f"{result.n_rigid} rigid-body zero eigenvalues (the spins of the drivetrains, K r = 0 "
-             "for every parameter value): not computed, their sensitivity is zero by construction"]
+    notes = [f"{result.n_rigid} rigid-body zero eigenvalues (the spins of the drivetrains, the "
+             "vehicle's translation and yaw, K r = 0 for every parameter value, and the rolling "
+             "velocity no damping meets): not computed, their sensitivity is zero by construction"]
     for k in np.flatnonzero(~reliable):
         j = int(np.argmin(np.abs(np.delete(others, indices[k]) - lam[k])))
         partner = np.delete(others, indices[k])[j]
@@ -643,87 +648,3 @@ def limit_sensitivity(model: BogieModel, v: float, N0: float, b_M: float,
             "ds0*/dp = −Re(∂λc/∂p)/Re(∂λc/∂s0)")
     return LimitSensitivity(v, N0, b_M, s0_limit, mechanism, lam_c, s_max, dmu, names, units,
                             values, derivatives, note)
-
-
-# --- peak drive loads ------------------------------------------------------------------------------
-
-PEAK_LOADS = ("ID1.disc_clutch.torque", "ID2.disc_clutch.torque",
-              "ID1.driving_shaft.torque", "ID2.driving_shaft.torque")
-PEAK_STEP = 1e-3  # relative central-difference step of the peak-load sensitivities
-
-
-@dataclass(frozen=True)
-class PeakLoadSensitivity:
-    """d(peak total load)/dp after the short circuit (plain data)."""
-
-    operating_point: OperatingPoint
-    outputs: tuple[str, ...]  # load names
-    peaks: np.ndarray  # signed peak totals [N m]
-    peak_times: np.ndarray  # [s]
-    names: tuple[str, ...]  # parameters
-    values: np.ndarray  # their values
-    derivatives: np.ndarray  # len(names) x len(outputs) [N m per unit]
-    seconds: float  # wall time of the whole computation [s]
-
-    @property
-    def normalized(self) -> np.ndarray:
-        """p/peak · d peak/dp [-]."""
-        return self.values[:, None] * self.derivatives / self.peaks[None, :]
-
-
-def peak_load_sensitivities(parameters: Parameters, op: OperatingPoint,
-                            names: Iterable[str] | None = None, step: float = PEAK_STEP,
-                            t_end: float = 0.5, fs: float = 10_000.0, progress=None) -> PeakLoadSensitivity:
-    """Sensitivities of the peak ID1/ID2 disc-clutch and driving-shaft torques (totals) to each
-    parameter by central differences of the closed-form response, evaluated **at the nominal
-    peak's sample** (envelope theorem: the peak is stationary in time, so moving its time changes
-    it only at second order, while the maximum over a grid would jump from sample to sample).
-
-    Step ``step`` relative (10⁻³): the truncation error is O(step²) ≈ 10⁻⁶ relative, the closed
-    form's own error (≈ 10⁻⁷ of the response, docs/response.md) divided by the step ≈ 10⁻⁴.
-    Cost: two model assemblies, eigendecompositions and responses per parameter.
-
-    Example (parameters x outputs):
-        >>> from model import default_operating_point, load_parameters, peak_load_sensitivities
-        >>> p = load_parameters(); peaks = peak_load_sensitivities(p, default_operating_point(p), names=["gear_ratio"])
-        >>> peaks.normalized.shape
-        (1, 4)
-    """
-    import time
-
-    from model.analysis.response import short_circuit_response
-
-    start = time.perf_counter()
-    wanted = list(SCHEMA) if names is None else list(names)
-    for name in wanted:
-        if name not in SCHEMA:
-            raise SensitivityError(f"unknown parameter '{name}'")
-    nominal = short_circuit_response(build_model(parameters), op, t_end=t_end, fs=fs,
-                                     outputs=list(PEAK_LOADS))
-    samples = [round(nominal.peak_times[name] * fs) for name in PEAK_LOADS]
-    peaks = np.array([nominal.peaks[name] for name in PEAK_LOADS])
-    rows = []
-    for done, name in enumerate(wanted):
-        value = parameters[name]
-        h = step * abs(value) if value != 0 else step
-        side = []
-        for sign in (1.0, -1.0):
-            values = dict(parameters.values)
-            values[name] = value + sign * h
-            moved = Parameters(values, parameters.notes, parameters.source)
-            moved_op = op
-            if name == "wheel_force" and op.N0 == value:
-                moved_op = OperatingPoint(op.s0, op.v, value + sign * h, op.b_M)
-            if name == "motor_slope" and op.b_M == value:
-                moved_op = OperatingPoint(op.s0, op.v, op.N0, value + sign * h)
-            response = short_circuit_response(build_model(moved), moved_op, t_end=t_end, fs=fs,
-                                              outputs=list(PEAK_LOADS))
-            side.append([response.outputs[load][k] for load, k in zip(PEAK_LOADS, samples,
-                                                                       strict=True)])
-        rows.append((np.array(side[0]) - np.array(side[1])) / (2 * h))
-        if progress is not None:
-            progress(done + 1, len(wanted))
-    return PeakLoadSensitivity(op, PEAK_LOADS, peaks,
-                               np.array([nominal.peak_times[n] for n in PEAK_LOADS]), tuple(wanted),
-                               np.array([parameters[n] for n in wanted]), np.array(rows),
-                               time.perf_counter() - start)

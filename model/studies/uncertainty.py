@@ -77,31 +77,30 @@ class UncertaintyError(ValueError):
 
 
 UNCERTAIN_PARAMETERS: tuple[ParameterRange, ...] = (
-    ParameterRange("creep_slope", 445.0, 890.0, "the calibrated creep shape (kA 0.89, kS "
-                   "0.23) needs ~670 (docs/validation.md); Hertz+Kalker would give ~130, "
+    ParameterRange("creep_slope", 530.0, 1060.0, "the calibrated creep shape (kA 0.35, kS "
+                   "0.29) needs ~800 (docs/validation.md); Hertz+Kalker would give ~130, "
                    "so ±1/3 around the fit"),
     # over this box (a grid of 7 values each of slope, A and B, geometric) the creep law has a
-    # maximum below s = 1 everywhere at 40–160 km/h (the response at 120 km/h needs it for M_ad);
-    # at 200 and 250 km/h not at 6 and 31 of the 343 points (small slope, large A and B): there
-    # s0* takes the full search
-    ParameterRange("polach_A", 0.4, 0.6, "Polach's presets 0.4; calibrated 0.53"),
-    ParameterRange("polach_B", 2.0, 3.0, "Polach's presets 0.2–0.6 s/m; calibrated 3.0, on the "
-                   "calibration's upper bound: ÷ 1.5 … that bound"),
+    # maximum below s = 1 everywhere at 40–250 km/h (the response at 120 km/h needs it for M_ad)
+    ParameterRange("polach_A", 0.2, 0.3, "Polach's presets 0.4; calibrated 0.20, on the "
+                   "calibration's lower bound: that bound … × 1.5"),
+    ParameterRange("polach_B", 0.1, 0.24, "Polach's presets 0.2–0.6 s/m; calibrated 0.157: "
+                   "÷ 1.5 … × 1.5"),
     ParameterRange("motor_slope", 1000.0, 12000.0, "torque falls 12.8 kN m over 0.5–6 % of "
-                   "213 rad/s (converter control unknown); calibrated 1 140"),
+                   "213 rad/s (converter control unknown); calibrated 2 460"),
     ParameterRange("rubber_loss_time", 1e-4, 4e-4, "rubber loss factor 0.05–0.2 at ~80 Hz",
                    log=False),
     ParameterRange("disc_clutch_torsional_stiffness", 3.5e4, 1e5, "rubber disc clutch; "
-                   "calibrated 5.7e4 from the 2.7 Hz mode"),
-    ParameterRange("driving_shaft_stiffness", 6e6, 1.2e7, "quill shaft; calibrated 8.5e6 "
+                   "calibrated 5.2e4 from the 2.7 Hz mode"),
+    ParameterRange("driving_shaft_stiffness", 6e6, 1.2e7, "quill shaft; calibrated 8.1e6 "
                    "from the 298 Hz mode"),
     ParameterRange("rotor_inertia", 8.0, 18.0, "550 kg rotor, radius of gyration 0.12–0.18 m"),
-    ParameterRange("silent_block_stiffness_x", 1.03e7, 2.4e7, "rubber-metal block, "
-                   "calibrated 2.06e7 (÷ 2; up to the calibration's bound 2.4e7)"),
-    ParameterRange("primary_stiffness_x", 1.8e6, 7.3e6, "longitudinal guide, calibrated "
-                   "3.6e6 (×/÷ 2)"),
-    ParameterRange("yaw_damping", 4.3e5, 1e6, "yaw damper, calibrated 8.6e5: ÷ 2 … the "
-                   "calibration's bound 1 MN s/m"),
+    ParameterRange("silent_block_stiffness_x", 5.9e6, 2.4e7, "rubber-metal block, "
+                   "calibrated 1.18e7 (×/÷ 2; up to the calibration's bound 2.4e7)"),
+    ParameterRange("primary_stiffness_x", 1.7e6, 6.6e6, "longitudinal guide, calibrated "
+                   "3.3e6 (×/÷ 2)"),
+    ParameterRange("yaw_damping", 5e5, 1e6, "yaw damper, calibrated 1e6, on the calibration's "
+                   "bound 1 MN s/m: ÷ 2 … that bound"),
     ParameterRange("yaw_damper_series_stiffness", 9.4e6, 3e7, "the yaw dampers' end bushes, "
                    "calibrated 1.87e7: ÷ 2 … the calibration's bound 3e7"),
     ParameterRange("gear_mesh_stiffness", 7.5e8, 3e9, "~7–30 N/(µm mm) × 100 mm face width"),

@@ -69,26 +69,35 @@ def test_id1_torques_are_dominated_by_90_hz_and_the_two_drive_modes(stable, mode
     assert abs(dc[0] - mode_hz["ID1.disc_clutch"]) <= 0.25, dc
 
 
-# documented miss of the calibrated set (docs/response.md): with the car body free to move
-# longitudinally the half vehicle (28 t + the bogie) decelerates once ID1's traction is gone, and
-# ID2's healthy motor takes up load along its slope b_M over the whole record: ID2's peak |Δy|
-# is at the end of the 2 s (ID1/ID2 = 2.6 on every quantity; 13.6 within the first 0.4 s, the
-# previous set 12.8 over 2 s)
-ID2_SMALLER_MISS = ("ID1/ID2 = 2.6 over 0…2 s (13.6 over the first 0.4 s): the free half vehicle "
-                    "decelerates after the fault and ID2's motor takes up load (docs/response.md)")
-
-
-@pytest.mark.xfail(bool(ID2_SMALLER_MISS), strict=True,
-                   reason="documented miss: " + ID2_SMALLER_MISS)
 @pytest.mark.parametrize("quantity", ["driving_shaft.torque", "disc_clutch.torque",
                                       "claw_clutch.torque", "gear_mesh.force"])
 def test_id2_loads_are_several_times_smaller(stable, quantity):
     """Published: 'the same quantities of ID2 are several times smaller'.  'Several' read as at
-    least 3× (peak |Δy| over 0…2 s)."""
+    least 3× (peak |Δy| over the whole record, 0…2 s, the slow settling to the vehicle's
+    deceleration included: ID2's slope measures its rotor against the vehicle's speed, so ID2
+    does not take over ID1's lost torque)."""
     id1 = abs(stable.perturbation_peaks[f"ID1.{quantity}"])
     id2 = abs(stable.perturbation_peaks[f"ID2.{quantity}"])
     print(f"{quantity}: ID1/ID2 = {id1 / id2:.1f}")
     assert id1 >= 3.0 * id2
+
+
+def test_id2_takes_over_nothing_after_the_published_window(bogie):
+    """Beyond the published 2 s: over 20 s, as the half vehicle decelerates under the lost
+    torque, ID2's disc clutch stays within the 2 s window's swing (no slow take-over of ID1's
+    torque) and ID1's swing is still at least 3x ID2's.  Tolerance: 1.1x the 2 s swing, room
+    for the slow creep-damped drift settling to the deceleration's static response (the
+    steady change is the inertia of ID2's side, a few per cent of the lost torque)."""
+    parameters, model = bogie
+    op = default_operating_point(parameters, 0.005, 120.0)
+    names = ["ID1.disc_clutch.torque", "ID2.disc_clutch.torque"]
+    short = short_circuit_response(model, op, ShortCircuit(), T_END, 1000.0, outputs=names)
+    long = short_circuit_response(model, op, ShortCircuit(), 20.0, 1000.0, outputs=names)
+    id2_short = np.abs(short.perturbation(names[1])).max()
+    id2_long = np.abs(long.perturbation(names[1])).max()
+    print(f"ID2 disc clutch swing: {id2_short:.4g} N m over 2 s, {id2_long:.4g} N m over 20 s")
+    assert id2_long <= 1.1 * id2_short
+    assert np.abs(long.perturbation(names[0])).max() >= 3.0 * id2_long
 
 
 def test_disc_clutch_torque_swing_exceeds_the_adhesion_moment_half_a_period_after_the_fault(

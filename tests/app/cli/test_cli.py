@@ -223,7 +223,8 @@ def test_eigen_json_contract(capsys, model):
     assert code == 0, err
     data = json.loads(out)
     assert set(data) >= EIGEN_KEYS
-    assert data["rigid_body"] == 4  # drivetrain spins, vehicle translation and yaw
+    # drivetrain spins, vehicle translation and yaw, and the rolling velocity nothing damps
+    assert data["rigid_body"] == 5
     assert isinstance(data["stable"], bool)
     assert len(data["complex"]) == 6
     assert len(data["real"]) == 6

@@ -23,7 +23,6 @@ from model.analysis.frequency_response import (
     transfer,
 )
 from model.mechanics.beam import TubeSection
-from model.mechanics.operating_point import damping_matrix
 from model.mechanics.outputs import output_matrices
 
 
@@ -82,7 +81,11 @@ def test_frf_equals_the_steady_state_of_a_long_time_response(setup, f_hz, t_long
     a unit cosine motor torque on ID1 (exact propagation, no eigendecomposition), at two
     frequencies off resonance and at the peaks of the disc clutch (2.7 Hz) and driving shaft
     (298 Hz) modes.  Measured: 1e-9 for ID1's torques, 6e-6 for ID2's (an order of magnitude
-    smaller, the slow modes' drift is a larger part of them)."""
+    smaller, the slow modes' drift is a larger part of them).  The reference's own error is
+    absolute, about 1e-11 of the largest output (the fitted drift of the slow modes): at the
+    driving shaft's resonance ID2's disc clutch answers ID1's torque with 2e-6 N m per N m,
+    seven orders below ID1's torques, so its magnitude is compared to within 1e-4 of itself or
+    1e-10 of the largest output, whichever is larger."""
     model, op, frf = setup
     if f_hz is None:  # the peak the FRF found
         name = ("ID1.disc_clutch.torque" if "disc" in request.node.callspec.id
@@ -96,9 +99,11 @@ def test_frf_equals_the_steady_state_of_a_long_time_response(setup, f_hz, t_long
                                                                 matrices.C_v[rows]), f_hz, t_long)
     modal, _, _ = transfer(model, op, outputs=names)
     H = modal(np.array([f_hz]))[:, 0]
-    np.testing.assert_allclose(np.abs(H), np.abs(reference), rtol=1e-4)
+    floor = 1e-10 * np.abs(reference).max()
+    np.testing.assert_allclose(np.abs(H), np.abs(reference), rtol=1e-4, atol=floor)
     phase_error = np.degrees(np.angle(H / reference))
-    assert np.all(np.abs(phase_error) < 0.01), phase_error
+    resolved = np.abs(reference) > 1e4 * floor  # the phase of what is above the floor
+    assert np.all(np.abs(phase_error[resolved]) < 0.01), phase_error
 
 
 def test_grid_values_equal_direct_solves(setup):
@@ -116,28 +121,7 @@ def test_grid_values_equal_direct_solves(setup):
     assert np.all(np.abs(frf.H[:, columns[on_grid]] - direct[:, on_grid]) <= 1e-7 * scale)
 
 
-def _uniform_acceleration_loads(model, op, force: np.ndarray) -> dict[str, float]:
-    """The loads [per unit input] under a constant generalized force ``f`` in the steady state:
-    the whole vehicle accelerates uniformly along its free rolling at a (nothing in the model
-    resists a vehicle rolling faster without slip), the other rigid-body motions drift at
-    constant velocities v = R c (a wheelset slipping at a constant rate against the creep
-    damping), the structure deflects by q0: one linear solve of
-    ``K q0 + B R c + M r a = f``, ``Rᵀ q0 = 0``, ``rᵀ R c = 0`` (the rolling part of v is free:
-    no load sees it); the loads C_q q0 + C_v R c.  Independent of the modal form."""
-    r, R, n = model.rolling_mode, model.rigid_body_modes, model.n
-    k = R.shape[1]
-    B = damping_matrix(model, op)
-    system = np.zeros((n + k + 1, n + k + 1))
-    system[:n, :n], system[:n, n:n + k], system[:n, -1] = model.K, B @ R, model.M @ r
-    system[n:n + k, :n] = R.T
-    system[-1, n:n + k] = r @ R
-    solution = np.linalg.solve(system, np.concatenate([force, np.zeros(k + 1)]))
-    matrices = output_matrices(model, op)
-    loads = matrices.C_q @ solution[:n] + matrices.C_v @ (R @ solution[n:n + k])
-    return dict(zip(matrices.names, loads, strict=True))
-
-
-def test_static_gain_is_the_torque_balance(setup):
+def test_static_gain_is_the_torque_balance(setup, uniform_acceleration_loads):
     """At 0 Hz a motor torque on ID1 accelerates the whole vehicle (no running resistance, and
     ID2's slope measures its rotor against the vehicle's own speed, so it does not take the
     torque back): every load is the torque balance of that uniform acceleration.  ID1's driving
@@ -146,7 +130,7 @@ def test_static_gain_is_the_torque_balance(setup):
     model, op, frf = setup
     assert frf.f_hz[0] == 0.0
     gain = dict(zip(frf.names, frf.H[:, 0], strict=True))
-    expected = _uniform_acceleration_loads(model, op, input_force(model, "ID1.motor.torque")[0])
+    expected = uniform_acceleration_loads(model, op, input_force(model, "ID1.motor.torque")[0])
     for name in ("ID1.driving_shaft.torque", "ID1.disc_clutch.torque", "ID2.disc_clutch.torque",
                  "ID2.driving_shaft.torque"):
         assert gain[name].real == pytest.approx(expected[name], rel=1e-8, abs=1e-10), name
@@ -202,18 +186,23 @@ def test_outputs_follow_the_output_matrices(setup):
     assert frf.H.shape == (len(frf.names), len(frf.f_hz))
 
 
-def test_other_inputs(setup):
+def test_other_inputs(setup, uniform_acceleration_loads):
     """ID2's motor torque: its steady part accelerates the vehicle as ID1's does (its own slope
     measures against the vehicle's speed and does not take it back), while its 298 Hz mode
-    amplifies; a creep-force disturbance at a wheel is an input in N."""
+    amplifies, less than ID1's (ID2's slope b_M damps it; ID1's motor has none); a creep-force
+    disturbance at a wheel is an input in N."""
     model, op, _ = setup
     names = input_names(model)
     assert names[:2] == ("ID1.motor.torque", "ID2.motor.torque")
     other = frequency_response(model, op, input="ID2.motor.torque", points=200)
     row = other.output("ID2.driving_shaft.torque")
-    expected = _uniform_acceleration_loads(model, op, input_force(model, "ID2.motor.torque")[0])
+    expected = uniform_acceleration_loads(model, op, input_force(model, "ID2.motor.torque")[0])
     assert other.H[row, 0].real == pytest.approx(expected["ID2.driving_shaft.torque"], rel=1e-8)
-    assert max(peak.abs for peak in other.peaks[row] if peak.f_hz > 290) > 10
+    amplification = max(peak.abs for peak in other.peaks[row] if peak.f_hz > 290)
+    own = frequency_response(model, op, input="ID1.motor.torque", points=200)
+    id1 = max(peak.abs for peak in own.peaks[own.output("ID1.driving_shaft.torque")]
+              if peak.f_hz > 290)
+    assert 3 < amplification < id1
     creep = frequency_response(model, op, input="ID1.rim12.creep_disturbance", points=200)
     assert creep.input_unit == "N"
     force, unit = input_force(model, "ID1.rim12.creep_disturbance")

