@@ -28,7 +28,16 @@ Method — a reduced model whose error is estimated at every point and bounded b
    them and solves only its new points (same basis, so bitwise the same values where both have
    a point).
 4. Branches are continued from point to point by an optimal assignment on ``1 − MAC`` plus the
-   normalized eigenvalue distance, so branches do not swap at near-crossings.
+   normalized eigenvalue distance, so branches do not swap at near-crossings.  An assignment is
+   ambiguous where a branch continues into a value neither of similar shape (MAC > 0.5) nor
+   close (5 % of |λ|), or where the two branches of a conjugate pair continue into values that
+   are not a conjugate pair (nor both real).  An ambiguous reduced point is solved densely; an
+   ambiguous dense point halves the step: the branches are carried through densely solved
+   intermediate points (not recorded) until every assignment is unambiguous, at most
+   :data:`BRIDGE_HALVINGS` times (:func:`_bridge`).  Without it, where branches move far
+   within one step (near s0 = 0.0025 at 120 km/h two well damped ≈ 17 Hz pairs move by a fifth
+   of their size per step of 0.0005 while two reals run out of the disc and merge), a coarse
+   sweep took a branch into another mode's pair and split a conjugate pair.
 5. ``select`` (optional) narrows step 2 and the tracking to some of the modes inside the disc
    (say, those a motor's torque excites: :mod:`model.analysis.campbell`): the basis holds only
    their vectors, so a sweep of a few modes spread over a wide band costs what a sweep of a
@@ -302,7 +311,7 @@ def root_locus(model: BogieModel, op: OperatingPoint, parameter: str, values,
     key = _sweep_start_key(model, points[0], points[-1], radius, select)
     start = _sweep_start(model, op, parameter, points, radius, workers, key, select)
     inner = _InnerSolutions(start, coefficients[1:-1], workers)
-    tracks = _track(model, points, coefficients, start, inner, radius, rtol,
+    tracks = _track(model, parameter, points, coefficients, start, inner, radius, rtol,
                     max(lambda_floor, 1e-300))
     _keep_sweep_start(key, model, start, inner)
     return RootLocus(parameter, values, tracks.eigenvalues, tracks.errors, tracks.dense, op,
@@ -484,12 +493,14 @@ class _Tracks:
     refined: int  # branch-points refined by Newton's method on the full model
 
 
-def _track(model: BogieModel, points: list[OperatingPoint], coefficients: np.ndarray,
-           start: _SweepStart, solution: _InnerSolutions, radius: float, rtol: float,
-           floor: float) -> _Tracks:
+def _track(model: BogieModel, parameter: str, points: list[OperatingPoint],
+           coefficients: np.ndarray, start: _SweepStart, solution: _InnerSolutions,
+           radius: float, rtol: float, floor: float) -> _Tracks:
     """Continue the tracked branches (those with |λ| < ``radius`` [1/s] at the first point that
     the sweep's selection keeps) from point to point: the reduced solution where it is accurate to
-    ``rtol`` (after Newton on a few branches), the dense one otherwise and at the last point."""
+    ``rtol`` (after Newton on a few branches) and unambiguously assigned, the dense one otherwise
+    and at the last point (assigned through intermediate dense points where the step is too
+    long to assign: :func:`_bridge`; ``parameter``: the swept quantity, "s0" or "v")."""
     first, last, reduced = start.first, start.last, start.reduced
     controlled = 1.5 * radius  # accuracy is enforced for branches inside this disc
     n_points = len(points)
@@ -511,7 +522,8 @@ def _track(model: BogieModel, points: list[OperatingPoint], coefficients: np.nda
                 previous_values, previous_vectors = values_i, vectors_i
                 continue
         lam, Q = last if i == n_points - 1 else _exact(model, points[i])  # dense: exact here
-        chosen, _ = _assign(previous_vectors, previous_values, Q, lam)
+        chosen = _bridge(model, parameter, points[i - 1], points[i], previous_values,
+                         previous_vectors, lam, Q)
         eigenvalues[i], dense[i] = lam[chosen], True
         previous_values, previous_vectors = lam[chosen], Q[:, chosen]
     return _Tracks(eigenvalues, errors, dense, refined)
@@ -606,8 +618,48 @@ def nonlinear_inverse_iteration(matrix, derivative, lam: complex, x: np.ndarray,
     return lam, x / np.linalg.norm(x), step
 
 
+BRIDGE_HALVINGS = 4  # an ambiguous dense step is halved at most this often (≤ 15 dense points)
+CONJUGATE_RTOL = 1e-12  # two values are a conjugate pair within this relative distance
+
+
+def _bridge(model: BogieModel, parameter: str, start: OperatingPoint, end: OperatingPoint,
+            values: np.ndarray, vectors: np.ndarray, end_values: np.ndarray,
+            end_vectors: np.ndarray, halvings: int = BRIDGE_HALVINGS) -> np.ndarray:
+    """Columns of the dense solution at ``end`` (``end_values`` [1/s], unit displacement
+    ``end_vectors``) continuing the branches (``values``, ``vectors``) at ``start``.  Where the
+    assignment is ambiguous (:func:`_assign`) the step in ``parameter`` is halved: the branches
+    are assigned to a dense solution at the middle first, and from there to ``end`` (each half
+    again, at most ``halvings`` times in all; the last assignment is taken as it is)."""
+    chosen, ok = _assign(vectors, values, end_vectors, end_values)
+    if ok or halvings == 0:
+        return chosen
+    halfway = 0.5 * (getattr(start, parameter) + getattr(end, parameter))
+    middle = replace(start, **{parameter: halfway})
+    middle_values, middle_vectors = _exact(model, middle)
+    kept = _bridge(model, parameter, start, middle, values, vectors, middle_values,
+                   middle_vectors, halvings - 1)
+    return _bridge(model, parameter, middle, end, middle_values[kept], middle_vectors[:, kept],
+                   end_values, end_vectors, halvings - 1)
+
+
+def _conjugate_pairs(values: np.ndarray) -> list[tuple[int, int]]:
+    """(b, p): the branches whose complex values are a conjugate pair (Im > 0 at b; each branch
+    in one pair at most; a complex branch whose conjugate is not tracked is in none)."""
+    lower = list(np.flatnonzero(values.imag < 0))
+    pairs = []
+    for b in np.flatnonzero(values.imag > 0):
+        if not lower:
+            break
+        gaps = np.abs(values[lower] - values[b].conjugate())
+        k = int(np.argmin(gaps))
+        if gaps[k] <= CONJUGATE_RTOL * abs(values[b]):
+            pairs.append((int(b), int(lower.pop(k))))
+    return pairs
+
+
 def _assign(previous_vectors, previous_values, vectors, values):
-    """Columns of ``vectors`` continuing each previous branch (MAC + eigenvalue distance)."""
+    """Columns of ``vectors`` continuing each previous branch (MAC + eigenvalue distance), and
+    whether that assignment is unambiguous (module docstring, step 4)."""
     mac = np.abs(previous_vectors.conj().T @ vectors) ** 2  # unit vectors: MAC in [0, 1]
     scale = np.maximum(np.abs(previous_values), 1.0)[:, None]
     distance = np.abs(previous_values[:, None] - values[None, :]) / scale
@@ -616,7 +668,15 @@ def _assign(previous_vectors, previous_values, vectors, values):
     chosen[rows] = columns
     # unambiguous: similar mode shape, or (for near-repeated twins of ID1/ID2, whose eigenvectors
     # mix freely) an eigenvalue that moved by less than 5 % of its size
-    return chosen, bool(np.all((mac[rows, columns] > 0.5) | (distance[rows, columns] < 0.05)))
+    ok = bool(np.all((mac[rows, columns] > 0.5) | (distance[rows, columns] < 0.05)))
+    # and a conjugate pair stays a pair (or splits into two reals): the cost is the same for an
+    # assignment and its conjugate, so a pair torn apart means no step-continuous choice exists
+    for b, p in _conjugate_pairs(previous_values):
+        w_b, w_p = values[chosen[b]], values[chosen[p]]
+        if not ((w_b.imag == 0 and w_p.imag == 0)
+                or abs(w_p - w_b.conjugate()) <= CONJUGATE_RTOL * abs(w_b)):
+            ok = False
+    return chosen, ok
 
 
 def dense_generalized_eigenvalues(model: BogieModel, op: OperatingPoint) -> np.ndarray:

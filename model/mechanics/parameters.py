@@ -148,6 +148,8 @@ SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
 # Strength data of the checks (model.analysis.assessment); they do not enter the dynamics.  The
 # shafts' own elastic constants are young_modulus and poisson_ratio; the axle is solid and the
 # hollow shaft's bore is 2 hollow_shaft_inner_radius, as in the dynamics.
+_AMPLITUDE = (0.0, 1e7, True)  # a ripple amplitude [N m]: 0 (none) up to 10 MN m
+_STRENGTH = (0.0, 3e9, False)  # a steel's tensile strength [Pa]: > 0, at most 3 GPa
 ASSESSMENT_SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "wheel_seat_diameter": ("m", "wheel seat: diameter d of the axle's seat", _POS),
     "wheel_seat_length": ("m", "wheel seat: length L of the fit", _POS),
@@ -177,6 +179,33 @@ ASSESSMENT_SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "required_factor_slip": ("1", "required safety factor of a press fit against slip", _POS),
     "required_factor_shear": ("1", "required safety factor of a shaft against its permissible shear stress", _POS),
     "required_factor_coupling": ("1", "required safety factor of a coupling against its rating", _POS),
+    # --- under alternating load: the converters' torque ripple (the ripple load case) ------------
+    "ripple_el6_amplitude": ("N m", "each converter's air-gap torque ripple at 6 times the motor's "
+                             "electrical frequency (amplitude per motor)", _AMPLITUDE),
+    "ripple_el12_amplitude": ("N m", "each converter's air-gap torque ripple at 12 times the motor's "
+                              "electrical frequency (amplitude per motor)", _AMPLITUDE),
+    **{name: entry for shaft, words in (("axle", "the axle (its centre section)"),
+                                        ("hollow_shaft", "the hollow shaft (its middle section)"),
+                                        ("driving_shaft", "the driving shaft"))
+       for name, entry in (
+           (f"{shaft}_tensile_strength", ("Pa", f"tensile strength R_m of the steel of {words} at "
+                                          f"the diameter {shaft}_strength_diameter (DIN 743 "
+                                          "fatigue check)", _STRENGTH)),
+           (f"{shaft}_strength_diameter", ("m", f"diameter for which {shaft}_tensile_strength is "
+                                           "given: DIN 743-3's reference diameter d_B of a "
+                                           "material table, or the part's own size", _POS)),
+           (f"{shaft}_torsional_notch_factor", ("1", f"fatigue notch factor beta_tau of {words} in "
+                                                "torsion (DIN 743-2)", (1.0, 10.0, True))),
+           (f"{shaft}_surface_roughness", ("m", f"mean roughness depth R_z of {words} at its notch",
+                                           (0.0, 1e-3, False))))},
+    "disc_clutch_vibratory_torque": ("N m", "permissible vibratory torque T_KW of the disc clutch "
+                                     "(DIN 740-2: the amplitude it bears indefinitely)", _POS),
+    "claw_clutch_vibratory_torque": ("N m", "permissible vibratory torque T_KW of the claw clutch "
+                                     "(DIN 740-2: the amplitude it bears indefinitely)", _POS),
+    "required_factor_fatigue": ("1", "required safety factor of a shaft section against its fatigue "
+                                "limit (DIN 743's S_min)", _POS),
+    "required_factor_vibratory": ("1", "required safety factor of a coupling against its permissible "
+                                  "vibratory torque", _POS),
 }
 ALL_SCHEMA = {**SCHEMA, **ASSESSMENT_SCHEMA}  # every name a parameter file may hold
 # names a file may leave out (written before they existed): train_mass -> 0, motor_bandwidth -> 0,
