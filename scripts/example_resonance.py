@@ -37,9 +37,10 @@ MODE_KEYS = (  # the modes the page discusses: a key each, found by the words of
     ("driving_shaft_1", ("twisting of driving shaft 1",)),
     ("driving_shaft_2", ("twisting of driving shaft 2",)),
     ("rotor_disc_clutch_1", ("torsion of rotor 1", "twisting of disc clutch 1")),
-    ("frame_pitch", ("pitch of bogie frame",)),
-    ("wheelsets_longitudinal_pitch", ("longitudinal–pitch of wheelset",)),
-    ("motors_vertical_pitch", ("vertical–pitch of TM",)),
+    ("frame_pitch", ("pitch of bogie frame with combined",)),
+    ("frame_pitch_motors", ("pitch of bogie frame with TM",)),
+    ("wheelsets_longitudinal", ("longitudinal of wheelset",)),
+    ("motors_longitudinal_pitch", ("longitudinal–pitch of TM",)),
 )
 
 

@@ -86,6 +86,8 @@ STEPS = (
          "docs/results/design_loads.json (the worked example of docs/design-loads.md)"),
     Step("resonance", (_python("example_resonance.py"),),
          "docs/results/resonance_example.json (the worked example of docs/resonance.md)"),
+    Step("assessment", (_python("example_assessment.py"),),
+         "docs/results/assessment.json (the worked example of docs/assessment.md)"),
     Step("screenshots", (_python("bench_app.py", "--only-screenshots"),
                          _python("screenshot_design_loads.py"), _python("screenshot_resonances.py")),
          "assets/screenshots/*.png (Chromium)", needs_browser=True),

@@ -24,7 +24,22 @@ what EN 13103-1 adds for an axle, and are not checked here.
 **Coupling**: the torque against the coupling's rating.
 
 A check's safety factor is capacity / load (load = the largest |torque| of the load case); it
-passes when that is at least the required factor (a parameter with its source).  SI units.
+passes when that is at least the required factor (a parameter with its source).
+
+**Under alternating load** (a steady mean torque T_m with a steady oscillation of amplitude T_a
+about it, over a range of speeds: :class:`AlternatingLoad`, :func:`verify_alternating`; the
+components of :func:`alternating_components`):
+
+* press-fit slip: the same capacity T_slip against the largest torque ``|T_m| + T_a``;
+* torsional fatigue of the axle, the hollow shaft and the driving shaft (DIN 743, simplified:
+  :mod:`model.analysis.fatigue`): the permissible amplitude ``T_ADK = τ_ADK(τ_m) W_t`` against
+  ``T_a`` (``W_t = π (D⁴ − d_i⁴)/(16 D)``, ``τ_m = T_m / W_t``); the capacity depends on the mean;
+* coupling vibratory torque: ``T_a`` against the coupling's permissible vibratory torque T_KW
+  (DIN 740-2).
+
+Each is taken at the speed where its utilisation (required / safety factor) is largest; the check
+states that speed, the mean and the amplitude there, and each order's share of the amplitude.
+SI units.
 """
 
 from __future__ import annotations
@@ -32,12 +47,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
+from model.analysis.fatigue import TorsionalFatigue, permissible_amplitude, torsional_fatigue
 from model.mechanics.assembly import DRIVES, RIM_NODES
+from model.mechanics.excitation import Order
+from model.mechanics.operating_point import KMH
 from model.mechanics.parameters import Parameters
 
-KINDS = ("press_fit_slip", "torsional_shear", "coupling")
+KINDS = ("press_fit_slip", "torsional_shear", "coupling", "torsional_fatigue",
+         "coupling_vibratory")
 KIND_NAMES = {"press_fit_slip": "press-fit slip", "torsional_shear": "torsional shear",
-              "coupling": "coupling rating"}  # each kind in words (tables, reports)
+              "coupling": "coupling rating", "torsional_fatigue": "torsional fatigue",
+              "coupling_vibratory": "coupling vibratory torque"}  # each kind in words (tables, reports)
 # each verdict colour (:func:`verdict_colour`) in words
 VERDICT_WORDS = {"green": "margin met", "amber": "margin short", "red": "overloaded"}
 
@@ -139,6 +161,62 @@ def drive_components(parameters: Parameters) -> list[Component]:
     return components
 
 
+def fatigue_shaft(name: str, output: str, p: Parameters, shaft: str, D: float, d_i: float
+                  ) -> Component:
+    """A shaft section's torsional fatigue component (:mod:`model.analysis.fatigue`): its
+    capacity is the permissible amplitude without a mean, T_WK = τ_WK W_t [N m]; a check takes the
+    one at its mean (:func:`fatigue_capacity`).  ``shaft`` names its data in the set
+    (``{shaft}_tensile_strength``, …; its yield limit ``{shaft}_shear_stress_allowable``)."""
+    data = torsional_fatigue(p[f"{shaft}_tensile_strength"], p[f"{shaft}_strength_diameter"], D,
+                             d_i, p[f"{shaft}_torsional_notch_factor"],
+                             p[f"{shaft}_surface_roughness"], p[f"{shaft}_shear_stress_allowable"])
+    return Component(name, "torsional_fatigue", output, data.tau_WK * data.section_modulus,
+                     p["required_factor_fatigue"], data.as_dict())
+
+
+def fatigue_capacity(component: Component, mean: float) -> float:
+    """The permissible torque amplitude T_ADK = τ_ADK(τ_m) W_t [N m] of a torsional fatigue
+    component about the mean torque ``mean`` [N m]."""
+    data = _fatigue_data(component)
+    W_t = data.section_modulus
+    return permissible_amplitude(data, mean / W_t) * W_t
+
+
+def _fatigue_data(component: Component) -> TorsionalFatigue:
+    fields = {name: component.inputs[name] for name in TorsionalFatigue.__dataclass_fields__}
+    return TorsionalFatigue(**fields)
+
+
+def vibratory_coupling(name: str, output: str, p: Parameters, vibratory: str) -> Component:
+    return Component(name, "coupling_vibratory", output, p[vibratory],
+                     p["required_factor_vibratory"], {"vibratory_torque": p[vibratory]})
+
+
+def alternating_components(parameters: Parameters) -> list[Component]:
+    """What a steady alternating load is checked against (8 per drive, in drive order, the
+    sections of :func:`drive_components`): the press fits against slip under mean + amplitude,
+    the axle, hollow shaft and driving shaft against torsional fatigue, the disc and claw
+    clutches against their permissible vibratory torque."""
+    p = parameters
+    hollow_bore = 2 * p["hollow_shaft_inner_radius"]
+    components = []
+    for drive in DRIVES:
+        components += [c for c in drive_components(p)
+                       if c.kind == "press_fit_slip" and c.name.startswith(f"{drive} ")]
+        components.append(fatigue_shaft(f"{drive} axle", f"{drive}.axle.centre.torque", p,
+                                        "axle", 2 * p["axle_radius"], 0.0))
+        components.append(fatigue_shaft(f"{drive} hollow shaft", f"{drive}.hollow_shaft.torque", p,
+                                        "hollow_shaft", 2 * p["hollow_shaft_outer_radius"],
+                                        hollow_bore))
+        components.append(fatigue_shaft(f"{drive} driving shaft", f"{drive}.driving_shaft.torque",
+                                        p, "driving_shaft", p["driving_shaft_diameter"], 0.0))
+        components.append(vibratory_coupling(f"{drive} disc clutch", f"{drive}.disc_clutch.torque",
+                                             p, "disc_clutch_vibratory_torque"))
+        components.append(vibratory_coupling(f"{drive} claw clutch", f"{drive}.claw_clutch.torque",
+                                             p, "claw_clutch_vibratory_torque"))
+    return components
+
+
 @dataclass(frozen=True)
 class Check:
     """One component under one load case."""
@@ -157,6 +235,12 @@ class Check:
     time: float = math.nan  # when it occurs [s] (nan: a steady case)
     scenario: dict = field(default_factory=dict)  # where: s0, v_kmh, phase_s, …
     note: str = ""  # what qualifies the load (e.g. linear creep beyond the adhesion limit)
+    # under alternating load (nan / empty otherwise), at the check's worst speed:
+    mean: float = math.nan  # the steady mean torque [N m]
+    alternating: float = math.nan  # the amplitude of the oscillation about it [N m]
+    v_kmh: float = math.nan  # the speed [km/h]
+    orders: tuple = ()  # per order: {"order", "f_hz", "amplitude" (its share of the amplitude,
+    #                     N m), "ripple_amplitude" (the excitation's amplitude, N m)}
 
     @property
     def utilisation(self) -> float:
@@ -169,7 +253,13 @@ class Check:
                 "safety_factor": self.safety_factor, "required": self.required,
                 "ok": self.ok, "inputs": dict(self.inputs), "signed_load": self.signed_load,
                 "time_s": None if math.isnan(self.time) else self.time,
-                "scenario": dict(self.scenario), "note": self.note}
+                "scenario": dict(self.scenario), "note": self.note,
+                "mean": _number_or_none(self.mean), "alternating": _number_or_none(self.alternating),
+                "v_kmh": _number_or_none(self.v_kmh), "orders": [dict(o) for o in self.orders]}
+
+
+def _number_or_none(value: float) -> float | None:
+    return None if math.isnan(value) else value
 
 
 def verify(component: Component, load_case: str, load: float, signed_load: float = math.nan,
@@ -181,6 +271,61 @@ def verify(component: Component, load_case: str, load: float, signed_load: float
     return Check(component.name, component.kind, component.output, load_case, load,
                  component.capacity, factor, component.required, factor >= component.required,
                  component.inputs, float(signed_load), float(time), dict(scenario or {}), note)
+
+
+@dataclass(frozen=True)
+class AlternatingLoad:
+    """The steady torque of one output over a speed grid: a mean and the amplitude of the
+    oscillation about it, with each excitation order's share."""
+
+    v: np.ndarray  # (V,) speeds [m/s]
+    mean: np.ndarray  # (V,) signed mean torque [N m]
+    alternating: np.ndarray  # (V,) amplitude [N m]: the sum of by_order over the orders
+    orders: tuple[Order, ...]
+    ripple: np.ndarray  # (orders,) the excitation's amplitude of each order [N m]
+    frequencies_hz: np.ndarray  # (orders, V) each order's frequency [Hz] (nan: not excited)
+    by_order: np.ndarray  # (orders, V) each order's share of the amplitude [N m]
+    scenarios: tuple[dict, ...] = ()  # (V,) what else defines each speed's values (s0, …)
+
+
+def verify_alternating(component: Component, load_case: str, load: AlternatingLoad,
+                       note: str = "") -> Check:
+    """The check of ``component`` under the alternating ``load``, at the speed where its
+    utilisation is largest (module docstring): a press fit (or any peak check) against
+    ``|T_m| + T_a``, a fatigue section's amplitude against T_ADK(T_m), a coupling's amplitude
+    against T_KW."""
+    mean = np.asarray(load.mean, dtype=float)
+    amplitude = np.asarray(load.alternating, dtype=float)
+    if component.kind == "torsional_fatigue":
+        loads = amplitude
+        capacities = np.array([fatigue_capacity(component, m) for m in mean])
+    elif component.kind == "coupling_vibratory":
+        loads, capacities = amplitude, np.full(len(mean), component.capacity)
+    else:  # a largest-torque check: the peak of the oscillation
+        loads, capacities = np.abs(mean) + amplitude, np.full(len(mean), component.capacity)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(loads > 0, loads / capacities, 0.0)
+    i = int(np.argmax(np.where(np.isnan(ratio), np.inf, ratio)))
+    if component.kind in ("torsional_fatigue", "coupling_vibratory"):
+        signed = float(amplitude[i])
+    else:
+        signed = float(mean[i] + math.copysign(amplitude[i], mean[i]))
+    capacity, value = float(capacities[i]), float(loads[i])
+    factor = capacity / value if value > 0 else math.inf
+    inputs = dict(component.inputs)
+    if component.kind == "torsional_fatigue":
+        W_t = _fatigue_data(component).section_modulus
+        inputs.update(tau_m=float(mean[i]) / W_t, tau_a=float(amplitude[i]) / W_t,
+                      tau_ADK=capacity / W_t)
+    v_kmh = float(load.v[i]) / KMH
+    scenario = {**(dict(load.scenarios[i]) if load.scenarios else {}), "v_kmh": v_kmh}
+    orders = tuple({"order": order.name, "f_hz": _number_or_none(float(load.frequencies_hz[k, i])),
+                    "amplitude": float(load.by_order[k, i]),
+                    "ripple_amplitude": float(load.ripple[k])}
+                   for k, order in enumerate(load.orders))
+    return Check(component.name, component.kind, component.output, load_case, value, capacity,
+                 factor, component.required, factor >= component.required, inputs, signed,
+                 math.nan, scenario, note, float(mean[i]), float(amplitude[i]), v_kmh, orders)
 
 
 def governing(checks: list[Check]) -> Check:

@@ -60,8 +60,8 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
-from model.analysis.eigen import eigen_analysis, rigid_zero_count
-from model.analysis.linear_system import first_order_matrix, massless_coordinates
+from model.analysis.eigen import eigen_analysis
+from model.analysis.linear_system import Deflation, first_order_matrix, massless_coordinates
 from model.contact.creep import creep_block
 from model.mechanics.assembly import BogieModel
 from model.mechanics.operating_point import OperatingPoint, creep_coefficients, damping_matrix
@@ -160,6 +160,21 @@ class Reduced:
         self.C0_r = project(self.C0_Phi)
         self.motor_r = project(self.motor_Phi)
         self.P_r = [project(P) for P in self.P_Phi]
+        # The reduced model's exact zeros, deflated as in the full model
+        # (model.analysis.linear_system): the basis holds the rigid-body modes, whose reduced
+        # coordinates y_R = Lᵀ Φᵀ R give the eigenpairs (0, [y_R; 0]) whatever the damping, and
+        # the free rolling velocity [0; y_roll] maps onto them (a Jordan chain).  Left in, the
+        # chain's double zero comes out as a pair ≈ ±1e-5 1/s (the square root of the rounding):
+        # a drivetrain spin passing through λ = 0 at the creep maximum met it there, was assigned
+        # to it and sent the point to the dense solve.  (Mass-normalized coordinates put every
+        # velocity on one footing: the orthogonal Deflation loses no digits here.)
+        rigid, rolling = (sla.solve_triangular(self.Linv.T, Phi.T @ vectors, lower=False,
+                                               check_finite=False)
+                          for vectors in (model.rigid_body_modes, model.rolling_mode[:, None]))
+        self.deflation = Deflation(np.block([
+            [rigid, np.zeros((Phi.shape[1], 1))],
+            [np.zeros((r_i, rigid.shape[1])), rolling[self.inertial]]]))
+        self.zero_count = rigid.shape[1] + 1  # deflated zeros: rigid_zero_count(model)
 
     @property
     def size(self) -> int:
@@ -178,15 +193,23 @@ class Reduced:
         return first_order_matrix(np.eye(len(self.inertial)), C, K, self.inertial, self.massless)
 
     def solve(self, c: np.ndarray, b_M: float | None = None):
-        """Ritz values and displacement vectors (Φ coordinates, unit norm) at coefficients c
-        (``b_M`` [N m s/rad]: another motor slope than the sweep's)."""
-        r = self.size
+        """The non-rigid Ritz values and their displacement vectors (Φ coordinates, unit norm)
+        at coefficients c (``b_M`` [N m s/rad]: another motor slope than the sweep's); the exact
+        zeros are deflated (:attr:`zero_count` of them).
+
+        With ``Qᵀ A Q = [[N, A12], [0, A22]]`` (N nilpotent, N² = 0) an eigenvector y of A22 gives
+        the eigenvector ``Q [(λ − N)⁻¹ A12 y; y]`` of A, ``(λ − N)⁻¹ = (λ + N)/λ²``: scaled by
+        λ², ``Q [(λ + N) A12 y; λ² y]``, which stays finite for a λ at zero (a spin at the creep
+        maximum: its vector is a rigid one's)."""
+        r, k = self.size, self.zero_count
         C = self.C0_r + sum(ck * Pk for ck, Pk in zip(c, self.P_r, strict=True))
         if b_M is not None and b_M != self.b_M:
             C = C + (b_M - self.b_M) * self.motor_r
-        A = self.first_order(self.K_r, C)
-        lam, V = np.linalg.eig(A)  # numpy releases the GIL: the points run on several threads
-        X = self.Linv.T @ V[:r]  # back from mass-normalized to Φ coordinates
+        P = self.deflation.project(self.first_order(self.K_r, C))
+        lam, Y = np.linalg.eig(P[k:, k:])  # numpy releases the GIL: points run on several threads
+        W = P[:k, k:] @ Y
+        Z = self.deflation.apply(np.vstack([W * lam + P[:k, :k] @ W, Y * lam**2]))
+        X = self.Linv.T @ Z[:r]  # back from mass-normalized to Φ coordinates
         X /= np.linalg.norm(X, axis=0)
         return lam, X
 
@@ -371,12 +394,8 @@ def kept_sweep_estimate(model: BogieModel, op: OperatingPoint, first: OperatingP
         return None
     reduced = start.reduced
     c = pattern_coefficients(model, op)
-    lam, X = reduced.solve(c, op.b_M)
-    # the basis's rigid-body modes and the free rolling velocity give λ = 0 (dropped, as in the
-    # sweep); branches inside the
-    # disc where the sweep controls the error
-    keep = np.argsort(np.abs(lam))[rigid_zero_count(model):]
-    keep = np.sort(keep[np.abs(lam[keep]) < 1.5 * radius])
+    lam, X = reduced.solve(c, op.b_M)  # non-rigid only (the zeros are deflated)
+    keep = np.flatnonzero(np.abs(lam) < 1.5 * radius)  # where the sweep controls the error
     floor = max(float(lambda_floor), 1e-300)
     estimate = reduced.error_estimate(c, lam[keep], X[:, keep],
                                       C_Phi=reduced.damping_Phi(c, op.b_M), floor=floor)
@@ -537,14 +556,7 @@ def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, redu
     errors relative to max(|λ|, ``floor`` [1/s]), branches refined by Newton), or None where the
     point must be solved densely (ambiguous assignment, too many or unrefinable inaccurate
     branches inside |λ| < controlled)."""
-    lam, X = solved
-    # the basis holds the rigid-body modes (K r = 0): the reduced problem has their λ = 0 and
-    # the free rolling velocity's, which the tracked branches never are (the dense solutions
-    # deflate them).  A drivetrain spin whose
-    # eigenvalue passes through 0 at the creep maximum has the same vector; with a floor on the
-    # error measure it could be assigned to the rigid one's exact 0 and stay there
-    keep = np.sort(np.argsort(np.abs(lam))[rigid_zero_count(model):])
-    lam, X = lam[keep], X[:, keep]
+    lam, X = solved  # non-rigid only: the reduced model deflates its zeros as the dense one
     X_full = reduced.Phi @ X
     chosen, ok = _assign(previous_vectors, previous_values, X_full, lam)
     estimate = reduced.error_estimate(c, lam[chosen], X[:, chosen], floor=floor)

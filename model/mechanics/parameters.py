@@ -150,6 +150,8 @@ SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
 # hollow shaft's bore is 2 hollow_shaft_inner_radius, as in the dynamics.
 _AMPLITUDE = (0.0, 1e7, True)  # a ripple amplitude [N m]: 0 (none) up to 10 MN m
 _STRENGTH = (0.0, 3e9, False)  # a steel's tensile strength [Pa]: > 0, at most 3 GPa
+_NOTCH = (1.0, 10.0, True)  # a fatigue notch factor [-]: 1 (no notch) … 10
+_ROUGHNESS = (0.0, 1e-3, False)  # a mean roughness depth R_z [m]: > 0, at most 1 mm
 ASSESSMENT_SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
     "wheel_seat_diameter": ("m", "wheel seat: diameter d of the axle's seat", _POS),
     "wheel_seat_length": ("m", "wheel seat: length L of the fit", _POS),
@@ -184,20 +186,34 @@ ASSESSMENT_SCHEMA: dict[str, tuple[str, str, tuple[float, float, bool]]] = {
                              "electrical frequency (amplitude per motor)", _AMPLITUDE),
     "ripple_el12_amplitude": ("N m", "each converter's air-gap torque ripple at 12 times the motor's "
                               "electrical frequency (amplitude per motor)", _AMPLITUDE),
-    **{name: entry for shaft, words in (("axle", "the axle (its centre section)"),
-                                        ("hollow_shaft", "the hollow shaft (its middle section)"),
-                                        ("driving_shaft", "the driving shaft"))
-       for name, entry in (
-           (f"{shaft}_tensile_strength", ("Pa", f"tensile strength R_m of the steel of {words} at "
-                                          f"the diameter {shaft}_strength_diameter (DIN 743 "
-                                          "fatigue check)", _STRENGTH)),
-           (f"{shaft}_strength_diameter", ("m", f"diameter for which {shaft}_tensile_strength is "
-                                           "given: DIN 743-3's reference diameter d_B of a "
-                                           "material table, or the part's own size", _POS)),
-           (f"{shaft}_torsional_notch_factor", ("1", f"fatigue notch factor beta_tau of {words} in "
-                                                "torsion (DIN 743-2)", (1.0, 10.0, True))),
-           (f"{shaft}_surface_roughness", ("m", f"mean roughness depth R_z of {words} at its notch",
-                                           (0.0, 1e-3, False))))},
+    "axle_tensile_strength": ("Pa", "tensile strength R_m of the axle steel at axle_strength_diameter "
+                              "(fatigue check, DIN 743)", _STRENGTH),
+    "axle_strength_diameter": ("m", "diameter for which axle_tensile_strength is given: DIN 743-3's "
+                               "reference diameter d_B of its table, or the part's own size", _POS),
+    "axle_torsional_notch_factor": ("1", "fatigue notch factor beta_tau of the axle's centre section in "
+                                    "torsion (DIN 743-2)", _NOTCH),
+    "axle_surface_roughness": ("m", "mean roughness depth R_z of the axle's centre section",
+                               _ROUGHNESS),
+    "hollow_shaft_tensile_strength": ("Pa", "tensile strength R_m of the hollow shaft's steel at "
+                                      "hollow_shaft_strength_diameter (fatigue check, DIN 743)",
+                                      _STRENGTH),
+    "hollow_shaft_strength_diameter": ("m", "diameter for which hollow_shaft_tensile_strength is "
+                                       "given: DIN 743-3's reference diameter d_B of its table, or "
+                                       "the part's own size", _POS),
+    "hollow_shaft_torsional_notch_factor": ("1", "fatigue notch factor beta_tau of the hollow shaft's "
+                                            "middle section in torsion (DIN 743-2)", _NOTCH),
+    "hollow_shaft_surface_roughness": ("m", "mean roughness depth R_z of the hollow shaft's middle "
+                                       "section", _ROUGHNESS),
+    "driving_shaft_tensile_strength": ("Pa", "tensile strength R_m of the driving shaft's steel at "
+                                       "driving_shaft_strength_diameter (fatigue check, DIN 743)",
+                                       _STRENGTH),
+    "driving_shaft_strength_diameter": ("m", "diameter for which driving_shaft_tensile_strength is "
+                                        "given: DIN 743-3's reference diameter d_B of its table, "
+                                        "or the part's own size", _POS),
+    "driving_shaft_torsional_notch_factor": ("1", "fatigue notch factor beta_tau of the driving shaft "
+                                             "in torsion (DIN 743-2)", _NOTCH),
+    "driving_shaft_surface_roughness": ("m", "mean roughness depth R_z of the driving shaft at its "
+                                        "notch", _ROUGHNESS),
     "disc_clutch_vibratory_torque": ("N m", "permissible vibratory torque T_KW of the disc clutch "
                                      "(DIN 740-2: the amplitude it bears indefinitely)", _POS),
     "claw_clutch_vibratory_torque": ("N m", "permissible vibratory torque T_KW of the claw clutch "
@@ -320,7 +336,8 @@ def check_strength_data(values: Mapping[str, float]) -> None:
     """Refuse strength data whose geometry or tolerances are not physical, naming the parameter
     (:class:`ParameterError`): a hub not wider than its seat (d ≥ D), a bore not narrower than
     the seat (d_i ≥ d), a tolerance range upside down.  Non-positive interferences and friction
-    coefficients are refused by the schema's bounds."""
+    coefficients, negative ripple amplitudes, tensile strengths (whence the fatigue limits) and
+    roughnesses ≤ 0, and notch factors below 1 are refused by the schema's bounds."""
     pairs = (("wheel_hub_outer_diameter", "wheel_seat_diameter",
               "must exceed the seat's diameter wheel_seat_diameter"),
              ("gear_hub_outer_diameter", "gear_seat_diameter",

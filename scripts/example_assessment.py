@@ -1,0 +1,56 @@
+"""The worked example of docs/assessment.md: `bogie assess` at the default set, every load case,
+the governing check and what qualifies the loads (the short circuit's horizon, the adhesion note,
+the starting case's bound).
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/example_assessment.py
+
+Writes ``docs/results/assessment.json`` (every number the page quotes; the same as
+``bogie assess --serial --json``) in a few seconds.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+
+from model import load_parameters
+from model.studies.assessment import assess
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from docs_numbers import write_results  # noqa: E402
+
+NOTE = re.compile(r"(?P<wheel>ID\d\.rim\d+)'s creep force reaches (?P<force>[-\d.]+) kN, "
+                  r"(?P<ratio>[\d.]+) x μ_max N0 = (?P<limit>[\d.]+) kN \(s0 = (?P<s0>[\d.]+), "
+                  r"(?P<v>[\d.]+) km/h\)")
+
+
+def main() -> None:
+    parameters = load_parameters()
+    result = assess(parameters)
+    data = result.as_dict()
+    cases = {case.name: case for case in result.cases}
+    data["horizon_s"] = {name: case.horizon for name, case in cases.items()}
+    starting = cases["starting"].scenario
+    r0, n = parameters["wheel_radius"], parameters["driven_wheelsets"]
+    data["starting"] = {"bound": starting["bound"],
+                        "motors_wheelset_torque": parameters["starting_traction_force"] * r0 / n,
+                        "adhesion_wheelset_torque": 2 * starting["mu_max"] * starting["N0"] * r0,
+                        "s0": starting["s0"]}
+    notes = {c.note for c in result.checks if c.load_case == "short_circuit" and c.note}
+    match = NOTE.search(next(iter(notes))) if notes else None
+    data["short_circuit_beyond_adhesion"] = None if match is None else {
+        "wheel": match["wheel"], "ratio": float(match["ratio"]), "s0": float(match["s0"]),
+        "v_kmh": float(match["v"])}
+    g = result.governing
+    data["governing_summary"] = {"component": g.component, "load_case": g.load_case,
+                                 "safety_factor": g.safety_factor, "required": g.required}
+    print(f"governing: {g.component} in {g.load_case}: {g.safety_factor:.3g} (required "
+          f"{g.required:.3g}); horizons {data['horizon_s']}")
+    print(f"wrote {write_results('assessment', data, 'scripts/example_assessment.py')}")
+
+
+if __name__ == "__main__":
+    main()
