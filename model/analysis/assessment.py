@@ -161,15 +161,17 @@ def drive_components(parameters: Parameters) -> list[Component]:
     return components
 
 
-def fatigue_shaft(name: str, output: str, p: Parameters, shaft: str, D: float, d_i: float
+def fatigue_shaft(name: str, output: str, p: Parameters, part: str, D: float, d_i: float
                   ) -> Component:
-    """A shaft section's torsional fatigue component (:mod:`model.analysis.fatigue`): its
-    capacity is the permissible amplitude without a mean, T_WK = τ_WK W_t [N m]; a check takes the
-    one at its mean (:func:`fatigue_capacity`).  ``shaft`` names its data in the set
-    (``{shaft}_tensile_strength``, …; its yield limit ``{shaft}_shear_stress_allowable``)."""
-    data = torsional_fatigue(p[f"{shaft}_tensile_strength"], p[f"{shaft}_strength_diameter"], D,
-                             d_i, p[f"{shaft}_torsional_notch_factor"],
-                             p[f"{shaft}_surface_roughness"], p[f"{shaft}_shear_stress_allowable"])
+    """A shaft section's torsional fatigue component (:mod:`model.analysis.fatigue`; outer
+    diameter ``D``, bore ``d_i`` [m]): its capacity is the permissible amplitude without a mean,
+    T_WK = τ_WK W_t [N m]; a check takes the one at its mean (:func:`fatigue_capacity`).  ``part``
+    names its data in the set (``{part}_tensile_strength``, ``{part}_strength_diameter``,
+    ``{part}_torsional_notch_factor``, ``{part}_surface_roughness``; its yield limit
+    ``{part}_shear_stress_allowable``)."""
+    data = torsional_fatigue(p[f"{part}_tensile_strength"], p[f"{part}_strength_diameter"], D,
+                             d_i, p[f"{part}_torsional_notch_factor"],
+                             p[f"{part}_surface_roughness"], p[f"{part}_shear_stress_allowable"])
     return Component(name, "torsional_fatigue", output, data.tau_WK * data.section_modulus,
                      p["required_factor_fatigue"], data.as_dict())
 
@@ -188,6 +190,7 @@ def _fatigue_data(component: Component) -> TorsionalFatigue:
 
 
 def vibratory_coupling(name: str, output: str, p: Parameters, vibratory: str) -> Component:
+    """A coupling against its permissible vibratory torque T_KW [N m], the set's ``vibratory``."""
     return Component(name, "coupling_vibratory", output, p[vibratory],
                      p["required_factor_vibratory"], {"vibratory_torque": p[vibratory]})
 
@@ -199,10 +202,10 @@ def alternating_components(parameters: Parameters) -> list[Component]:
     clutches against their permissible vibratory torque."""
     p = parameters
     hollow_bore = 2 * p["hollow_shaft_inner_radius"]
+    press_fits = [c for c in drive_components(p) if c.kind == "press_fit_slip"]
     components = []
     for drive in DRIVES:
-        components += [c for c in drive_components(p)
-                       if c.kind == "press_fit_slip" and c.name.startswith(f"{drive} ")]
+        components += [c for c in press_fits if c.name.startswith(f"{drive} ")]
         components.append(fatigue_shaft(f"{drive} axle", f"{drive}.axle.centre.torque", p,
                                         "axle", 2 * p["axle_radius"], 0.0))
         components.append(fatigue_shaft(f"{drive} hollow shaft", f"{drive}.hollow_shaft.torque", p,

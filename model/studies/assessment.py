@@ -1,5 +1,7 @@
 """The load cases of the assessment and the checks under them: every press fit, shaft section and
-coupling of both drives (:func:`model.analysis.assessment.drive_components`) in three cases.
+coupling of both drives (:func:`model.analysis.assessment.drive_components`) in three rare events,
+and under the converters' steady torque ripple (:func:`model.analysis.assessment.
+alternating_components`) in normal running.
 
     result = assess(parameters)                   # AssessmentOptions() by default
     result.governing.component, result.governing.safety_factor
@@ -26,8 +28,17 @@ coupling of both drives (:func:`model.analysis.assessment.drive_components`) in 
   (``starting_traction_force`` shared by its ``driven_wheelsets``) and the adhesion limit
   2 μ_max N0 r0 / p; the static loads (no horizon), and the check says which bound governs.
 
+* ``ripple`` — both converters' torque ripple at the orders and amplitudes of the parameter set
+  (``ripple_el6_amplitude``, ``ripple_el12_amplitude``) or of ``AssessmentOptions.ripple``, in
+  steady running over 10…200 km/h on a grid refined at every resonance, at the short-circuit
+  case's creepages: each section's mean (the steady traction) and alternating amplitude (the two
+  motors' responses added as magnitudes — the worst relative phase — and summed over the orders);
+  steady, no horizon (:mod:`model.studies.ripple_case`).
+
 **Checks**: the load of a component in a case is the largest |value| of its output over the
-case's histories; safety factor = capacity / load (:mod:`model.analysis.assessment`).
+case's histories; safety factor = capacity / load (:mod:`model.analysis.assessment`).  Under the
+ripple: press-fit slip under mean + amplitude, torsional fatigue (DIN 743, simplified) and the
+couplings' permissible vibratory torque, each at its worst speed.
 """
 
 from __future__ import annotations
@@ -37,19 +48,40 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from model.analysis.assessment import Check, Component, drive_components, governing, verify
+from model.analysis.assessment import (
+    AlternatingLoad,
+    Check,
+    Component,
+    alternating_components,
+    drive_components,
+    governing,
+    verify,
+    verify_alternating,
+)
 from model.analysis.load_peaks import GROWTH_RATE
 from model.analysis.nonlinear import AntiSlip
 from model.analysis.response import ResponseError, ShortCircuit
+from model.mechanics.excitation import DriveExcitation, Order
 from model.mechanics.operating_point import KMH, OperatingPoint, creep_law
 from model.mechanics.parameters import Parameters
+from model.studies.ripple_case import (
+    RippleCaseError,
+    RippleSweep,
+    envelope_loads,
+    ripple_amplitudes,
+    ripple_sweep,
+)
 
-LOAD_CASES = ("short_circuit", "unstable_adhesion", "starting")
+LOAD_CASES = ("short_circuit", "unstable_adhesion", "starting", "ripple")
 DEFAULT_S0 = (0.002, 0.005)  # stable creepages of the short-circuit grid [-]
 DEFAULT_V_KMH = (80.0, 120.0, 200.0)  # speeds of the short-circuit grid [km/h]
 MIN_HORIZON = 2.0  # [s]: the study's window
 SETTLED = 0.01  # the quasi-static part within 1 % of its final change
 MAX_GRID = 60  # (s0, v) points of the short-circuit grid
+# ripple: the speed grid before its refinement at the resonances, 10…200 km/h (the locomotive's
+# top speed) every 10 km/h [m/s]
+DEFAULT_RIPPLE_V = tuple(float(x) * KMH for x in np.linspace(10.0, 200.0, 20))
+MAX_RIPPLE_SPEEDS = 200  # speeds of that grid
 
 
 class AssessmentError(ResponseError):
@@ -72,6 +104,11 @@ class AssessmentOptions:
     unstable_t_end: float = 2.0  # unstable_adhesion: horizon [s]
     anti_slip: AntiSlip | None = None  # unstable_adhesion: ID2's protection (None: defaults)
     starting_v: float = 5.0 * KMH  # starting: speed [m/s]
+    ripple: dict[Order, float] | None = None  # ripple: each converter's {order: amplitude [N m]}
+    #                                           (None: the set's, ripple_case.ripple_amplitudes)
+    ripple_v: tuple[float, ...] = DEFAULT_RIPPLE_V  # ripple: speeds before refinement [m/s]
+    ripple_drive: DriveExcitation | None = None  # ripple: pole pairs, pinion teeth (None: the file's)
+    cases: tuple[str, ...] = LOAD_CASES  # the load cases assess() computes, in this order
 
     def __post_init__(self) -> None:
         for label, values in (("--s0", self.s0), ("--v", self.v)):
@@ -80,6 +117,36 @@ class AssessmentOptions:
         if len(self.s0) * len(self.v) > MAX_GRID:
             raise AssessmentError(f"--s0 × --v = {len(self.s0) * len(self.v)} points, at most "
                                   f"{MAX_GRID}")
+        if self.ripple is not None:
+            check_ripple(self.ripple)
+        speeds = np.asarray(self.ripple_v, dtype=float)
+        if not (speeds.ndim == 1 and 2 <= len(speeds) <= MAX_RIPPLE_SPEEDS
+                and np.all(np.isfinite(speeds)) and speeds[0] > 0 and np.all(np.diff(speeds) > 0)):
+            raise AssessmentError(f"ripple speeds: give 2 to {MAX_RIPPLE_SPEEDS} increasing speeds "
+                                  "above 0")
+        unknown = [name for name in self.cases if name not in LOAD_CASES]
+        if not self.cases or unknown or len(set(self.cases)) != len(self.cases):
+            raise AssessmentError(f"load cases: give distinct names of {', '.join(LOAD_CASES)}"
+                                  + (f" (not {', '.join(map(str, unknown))})" if unknown else ""))
+
+
+def check_ripple(ripple: dict) -> None:
+    """Refuse a ripple that is not {Order: amplitude [N m] in [0, 1e7]} with at least one order,
+    or a fixed frequency beyond the model's range (:class:`AssessmentError`, one line)."""
+    from model.analysis.frequency_response import MODEL_FREQUENCY_LIMIT_HZ
+
+    if not ripple:
+        raise AssessmentError("ripple: give at least one order=amplitude (e.g. el:6=256)")
+    for order, amplitude in ripple.items():
+        if not isinstance(order, Order):
+            raise AssessmentError(f"ripple: {order!r} is not an excitation order (e.g. el:6)")
+        if isinstance(amplitude, bool) or not isinstance(amplitude, int | float) or not (
+                math.isfinite(amplitude) and 0 <= amplitude <= 1e7):
+            raise AssessmentError(f"ripple: the amplitude of {order.name} must be a number in "
+                                  f"[0, 1e7] N m, got {amplitude!r}")
+        if order.family == "fixed" and order.order > MODEL_FREQUENCY_LIMIT_HZ:
+            raise AssessmentError(f"ripple: fixed frequency {order.order:g} Hz is beyond the "
+                                  f"model's range of {MODEL_FREQUENCY_LIMIT_HZ:g} Hz")
 
 
 @dataclass(frozen=True)
@@ -99,8 +166,10 @@ class LoadCase:
     name: str
     description: str
     horizon: float | None  # [s] (None: steady)
-    loads: dict[str, CaseLoad]
+    loads: dict[str, CaseLoad] | dict[str, AlternatingLoad]
     scenario: dict  # what defines it (operating points, creep, protection)
+    alternating: bool = False  # True: the loads are AlternatingLoad, checked by
+    #                            alternating_components (press fits, fatigue, vibratory torque)
 
 
 @dataclass(frozen=True)
@@ -124,8 +193,10 @@ class Assessment:
                 "all_ok": all(c.ok for c in self.checks)}
 
 
-def _operating_point(parameters: Parameters, s0: float, v: float, options: AssessmentOptions
-                     ) -> OperatingPoint:
+def operating_point(parameters: Parameters, s0: float, v: float, options: AssessmentOptions
+                    ) -> OperatingPoint:
+    """The operating point (s0 [-], v [m/s]) with the options' wheel force and motor slope (the
+    set's where they are None)."""
     N0 = parameters["wheel_force"] if options.N0 is None else options.N0
     b_M = parameters["motor_slope"] if options.b_M is None else options.b_M
     return OperatingPoint(s0, v, N0, b_M)
@@ -186,7 +257,7 @@ def short_circuit_points(parameters: Parameters, options: AssessmentOptions
     from model.studies.maps import cached_model
 
     model = cached_model(parameters)
-    ops = [_operating_point(parameters, s0, v, options) for s0 in options.s0 for v in options.v]
+    ops = [operating_point(parameters, s0, v, options) for s0 in options.s0 for v in options.v]
     for op in ops:
         growth = float(np.max(bogie_system(model, op).eigenvalues().real))
         if growth > GROWTH_RATE:
@@ -266,7 +337,7 @@ def unstable_adhesion_case(parameters: Parameters, outputs: list[str],
     from model.studies.maps import cached_model
 
     model = cached_model(parameters)
-    op = _operating_point(parameters, options.unstable_s0, options.unstable_v, options)
+    op = operating_point(parameters, options.unstable_s0, options.unstable_v, options)
     protection = AntiSlip() if options.anti_slip is None else options.anti_slip
     e = options.excitation
     excitation = ShortCircuit(M0=e.M0, f=e.f, D=e.D)  # the continuity root (physics first)
@@ -323,7 +394,7 @@ def starting_case(parameters: Parameters, outputs: list[str], options: Assessmen
         words = (f"the adhesion limit 2 μ_max N0 r0 (μ_max = {mu_max:.3g}, "
                  f"{2 * mu_max * N0 * r0 / 1e3:.1f} kN m per wheelset, below the motors' "
                  f"{force * r0 / n / 1e3:.1f} kN m at the starting traction force)")
-    op = _operating_point(parameters, s0, v, options)
+    op = operating_point(parameters, s0, v, options)
     mu = float(law.mu(s0, v))
     matrices = output_matrices(model, op)
     values = matrices.C_q @ static_deflection(model, op)
@@ -339,17 +410,76 @@ def starting_case(parameters: Parameters, outputs: list[str], options: Assessmen
                       "driven_wheelsets": n})
 
 
+def ripple_case(parameters: Parameters, outputs: list[str], options: AssessmentOptions
+                ) -> LoadCase:
+    """The ripple case (:mod:`model.studies.ripple_case`): an
+    :class:`~model.analysis.assessment.AlternatingLoad` per output over the options' speeds
+    (``ripple_v``, refined at the resonances) and creepages (``s0``, each checked stable at every
+    speed, else :class:`AssessmentError`), under the options' ripple (``ripple``; None: the set's)
+    of both converters."""
+    from model.mechanics.excitation import load_excitation
+    from model.studies.maps import cached_model
+
+    points = [operating_point(parameters, s0, options.ripple_v[0], options) for s0 in options.s0]
+    drive = options.ripple_drive if options.ripple_drive is not None else load_excitation()
+    ripple = options.ripple if options.ripple is not None else ripple_amplitudes(parameters)
+    try:
+        sweep = ripple_sweep(cached_model(parameters), points, options.ripple_v, ripple, drive,
+                             outputs)
+    except RippleCaseError as error:
+        raise AssessmentError(str(error)) from None
+    return ripple_load_case(sweep, parameters, options)
+
+
+def ripple_load_case(sweep: RippleSweep, parameters: Parameters, options: AssessmentOptions
+                     ) -> LoadCase:
+    """The ripple case of a computed sweep (:func:`model.studies.ripple_case.ripple_sweep` with the
+    options' speeds and creepages): the envelope over the creepages, what defines the case."""
+    from model.analysis.campbell import MOTOR_INPUTS
+    from model.analysis.frequency_response import MODEL_FREQUENCY_LIMIT_HZ
+
+    first = operating_point(parameters, sweep.s0[0], float(sweep.v[0]), options)
+    coarse_kmh = np.asarray(options.ripple_v) / KMH
+    ripple_words = ", ".join(f"{o.name} = {a:g} N m" for o, a in zip(sweep.orders, sweep.ripple,
+                                                                      strict=True))
+    beyond = [o.name for o, row in zip(sweep.orders, sweep.frequencies_hz, strict=True)
+              if np.any(~np.isfinite(row))]
+    description = (
+        f"both converters' torque ripple ({ripple_words} per motor) in steady running over "
+        f"{coarse_kmh[0]:g}…{coarse_kmh[-1]:g} km/h ({len(coarse_kmh)} speeds and "
+        f"{len(sweep.refined)} at the resonances) at s0 = "
+        f"{', '.join(f'{x:g}' for x in sweep.s0)}: each section's mean is the steady traction's "
+        "load (the largest over the creepages), its amplitude the two motors' responses added as "
+        "magnitudes (the worst relative phase) and summed over the orders; ID1's motor a pure "
+        "torque source, ID2's on its slope b_M (as in the model)"
+        + (f"; {', '.join(beyond)} beyond the model's {MODEL_FREQUENCY_LIMIT_HZ:g} Hz at the "
+           "highest speeds, left out there" if beyond else ""))
+    scenario = {"s0": list(sweep.s0), "v_kmh": [float(x) for x in coarse_kmh],
+                "v_kmh_refined": [float(x) for x in sweep.refined / KMH],
+                "orders": [{"order": o.name, "amplitude": float(a)}
+                           for o, a in zip(sweep.orders, sweep.ripple, strict=True)],
+                "motors": list(MOTOR_INPUTS), "phase": "worst (magnitudes added)",
+                "N0": first.N0, "b_M": first.b_M,
+                "motor_bandwidth": parameters["motor_bandwidth"], "creep": "linear"}
+    return LoadCase("ripple", description, None, envelope_loads(sweep), scenario,
+                    alternating=True)
+
+
 def assess(parameters: Parameters, options: AssessmentOptions | None = None,
            map_unordered=None, progress=None) -> Assessment:
-    """The three load cases and every check under them.  The short-circuit case's grid runs on
-    the study engine's ``map_unordered`` (default: in this process) with ``progress(finished,
-    total, elapsed [s])`` after each point; the other two cases are single runs here."""
+    """The load cases of ``options.cases`` (default all four) and every check under them.  The
+    short-circuit case's grid runs on the study engine's ``map_unordered`` (default: in this
+    process) with ``progress(finished, total, elapsed [s])`` after each point; the other cases
+    are runs here (the ripple case: :mod:`model.studies.ripple_case`)."""
     options = AssessmentOptions() if options is None else options
     outputs = assessed_outputs(parameters)
-    return assessment_of(parameters, [
-        short_circuit_case(parameters, outputs, options, map_unordered, progress),
-        unstable_adhesion_case(parameters, outputs, options),
-        starting_case(parameters, outputs, options)])
+    builders = {
+        "short_circuit": lambda: short_circuit_case(parameters, outputs, options, map_unordered,
+                                                    progress),
+        "unstable_adhesion": lambda: unstable_adhesion_case(parameters, outputs, options),
+        "starting": lambda: starting_case(parameters, outputs, options),
+        "ripple": lambda: ripple_case(parameters, outputs, options)}
+    return assessment_of(parameters, [builders[name]() for name in options.cases])
 
 
 def assessed_outputs(parameters: Parameters) -> list[str]:
@@ -360,12 +490,21 @@ def assessed_outputs(parameters: Parameters) -> list[str]:
 def assessment_of(parameters: Parameters, cases: list[LoadCase]) -> Assessment:
     """Every check of the set's drive components under ``cases`` (computed by the case functions
     above with :func:`assessed_outputs`; a caller may keep a case that its inputs leave unchanged,
-    as the dashboard keeps the unstable case while only the short circuit's creepage moves)."""
+    as the dashboard keeps the unstable case while only the short circuit's creepage moves).  An
+    alternating case (``ripple``) is checked by the components under alternating load."""
     components = drive_components(parameters)
+    under_alternating = alternating_components(parameters)
     checks = []
     for case in cases:
+        if case.alternating:
+            checks += [verify_alternating(c, case.name, case.loads[c.output])
+                       for c in under_alternating]
+            continue
         for component in components:
             load = case.loads[component.output]
             checks.append(verify(component, case.name, load.value, load.value, load.time,
                                  load.scenario, load.note))
+    if any(case.alternating for case in cases):
+        components = components + [c for c in under_alternating
+                                    if c.kind not in {d.kind for d in components}]
     return Assessment(cases, components, checks, governing(checks))

@@ -218,6 +218,14 @@ def test_hash_ignores_strength_data_and_a_zero_train_mass(estimate):
     ({"wheel_seat_interference_min": 4e-4}, r"'wheel_seat_interference_min' = 0.0004 m must "
                                             r"not exceed 'wheel_seat_interference_max'"),
     ({"wheel_seat_friction_max": 0.1}, r"'wheel_seat_friction_min' = 0.12 must not exceed"),
+    ({"ripple_el6_amplitude": -256.0}, r"'ripple_el6_amplitude' = -256.0 N m is outside \[0.0, "),
+    ({"axle_tensile_strength": 0.0}, r"'axle_tensile_strength' = 0.0 Pa is outside \(0.0, "),
+    ({"driving_shaft_tensile_strength": -1e9}, r"'driving_shaft_tensile_strength' = -1000000000.0 "
+                                               r"Pa is outside"),
+    ({"hollow_shaft_torsional_notch_factor": 0.8}, r"'hollow_shaft_torsional_notch_factor' = 0.8 1 "
+                                                   r"is outside \[1.0, 10.0\]"),
+    ({"axle_surface_roughness": 0.0}, r"'axle_surface_roughness' = 0.0 m is outside"),
+    ({"claw_clutch_vibratory_torque": 0.0}, r"'claw_clutch_vibratory_torque' = 0.0 N m is outside"),
 ])
 def test_unphysical_strength_data_are_refused_naming_the_parameter(table, estimate, changes,
                                                                    message):
