@@ -35,9 +35,9 @@ Method — a reduced model whose error is estimated at every point and bounded b
    ambiguous dense point halves the step: the branches are carried through densely solved
    intermediate points (not recorded) until every assignment is unambiguous, at most
    :data:`BRIDGE_HALVINGS` times (:func:`_bridge`).  Without it, where branches move far
-   within one step (near s0 = 0.0025 at 120 km/h two well damped ≈ 17 Hz pairs move by a fifth
-   of their size per step of 0.0005 while two reals run out of the disc and merge), a coarse
-   sweep took a branch into another mode's pair and split a conjugate pair.
+   within one step (near s0 = 0.0025 at 120 km/h two well damped ≈ 18 Hz pairs move by a
+   quarter of their size per step of 0.0005 while two reals run out of the disc and merge), a
+   coarse sweep took a branch into another mode's pair and split a conjugate pair.
 5. ``select`` (optional) narrows step 2 and the tracking to some of the modes inside the disc
    (say, those a motor's torque excites: :mod:`model.analysis.campbell`): the basis holds only
    their vectors, so a sweep of a few modes spread over a wide band costs what a sweep of a
@@ -164,10 +164,11 @@ class Reduced:
         # (model.analysis.linear_system): the basis holds the rigid-body modes, whose reduced
         # coordinates y_R = Lᵀ Φᵀ R give the eigenpairs (0, [y_R; 0]) whatever the damping, and
         # the free rolling velocity [0; y_roll] maps onto them (a Jordan chain).  Left in, the
-        # chain's double zero comes out as a pair ≈ ±1e-5 1/s (the square root of the rounding):
-        # a drivetrain spin passing through λ = 0 at the creep maximum met it there, was assigned
-        # to it and sent the point to the dense solve.  (Mass-normalized coordinates put every
-        # velocity on one footing: the orthogonal Deflation loses no digits here.)
+        # chain's double zero comes out as a pair ≈ ±1e-5 1/s (the square root of the rounding),
+        # and where a drivetrain spin's eigenvalue passes through 0 (the creep maximum) closer
+        # than that, dropping the Ritz values nearest to zero left a spurious one in the spin's
+        # place.  (Mass-normalized coordinates put every velocity on one footing: the
+        # orthogonal Deflation loses no digits here.)
         rigid, rolling = (sla.solve_triangular(self.Linv.T, Phi.T @ vectors, lower=False,
                                                check_finite=False)
                           for vectors in (model.rigid_body_modes, model.rolling_mode[:, None]))

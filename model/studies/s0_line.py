@@ -79,7 +79,6 @@ from scipy.optimize import brentq
 
 from model.analysis.continuation import LineContinuation
 from model.analysis.eigen import eigen_analysis, non_neutral
-from model.analysis.linear_system import Deflation
 from model.analysis.locus import (
     Reduced,
     creep_patterns,
@@ -346,17 +345,12 @@ class _LineModel:
         # The first-order reduced matrix [[0, I], [−K_r, −C]] is affine in the creep
         # coefficients c: C = C0_r + Σ c_k P_k,r.  The basis holds the rigid-body modes, whose
         # reduced coordinates y_R = Lᵀ Φᵀ R give the exact eigenpairs (0, [y_R; 0]) of the reduced
-        # model (K_r y_R = 0) whatever C: that invariant subspace is deflated once per line as in
-        # the full model (model.analysis.linear_system.Deflation), and each point solves the eigenvalues of
-        # the rest, A22(c) = base + Σ c_k D_k (2r − n_rigid unknowns), only.
-        # (and the free rolling velocity's exact zero, [0; y_roll], as in the full model)
-        rigid, rolling = (sla.solve_triangular(red.Linv.T, red.Phi.T @ vectors, lower=False,
-                                               check_finite=False)
-                          for vectors in (model.rigid_body_modes, model.rolling_mode[:, None]))
+        # model (K_r y_R = 0) whatever C, and the free rolling velocity's [0; y_roll] maps onto
+        # them: that invariant subspace (Reduced.deflation, as in the full model) is deflated
+        # once per line, and each point solves the eigenvalues of the rest,
+        # A22(c) = base + Σ c_k D_k (2r − n_rigid unknowns), only.
         r_i = len(red.inertial)  # the reduced state: r coordinates, r_i velocities
-        deflation = Deflation(np.block([[rigid, np.zeros((r, 1))],
-                                        [np.zeros((r_i, rigid.shape[1])), rolling[red.inertial]]]))
-        n_rigid = rigid.shape[1] + 1
+        deflation, n_rigid = red.deflation, red.zero_count
 
         def first_order(K, C):
             if K is None:  # a creep pattern (inertial coordinates only): its part of A

@@ -63,14 +63,20 @@ def test_modes_are_the_ones_the_motor_drives(setup):
 
 
 def test_close_twins_do_not_swap(setup):
-    """The two drives' driving-shaft modes stay within 0.1 % of each other over the whole range
-    (a close approach throughout), but each is a motion of its own drive (MAC between them ≈ 0:
-    unambiguous).  At every fourth speed the branch named for drive k is, in the exact
-    eigenvector nearest to its eigenvalue, more than 90 % kinetic energy of drive k."""
+    """The two drives' driving-shaft modes stay close over the whole range (a close approach
+    throughout: their resonances overlap, the gap between their frequencies is below the
+    half-power width 2|Re λ| of the lighter damped one), but each is a motion of its own drive
+    (MAC between them ≈ 0: unambiguous).  At every fourth speed the branch named for drive k is,
+    in the exact eigenvector nearest to its eigenvalue, more than 90 % kinetic energy of drive k.
+    (How close depends on the parameter set: without the healthy motor's slope the twins
+    coincide; the slope damps drive 2's twin and lowers its frequency, the more the steeper it
+    is, so a fixed bound on the relative gap holds for one set and not the next.  The overlap is
+    the approach that matters to the diagram: one order line meets both within one resonance.)"""
     model, op, _, diagram = setup
     twins = {k: _mode(diagram, f"twisting of driving shaft {k}") for k in (1, 2)}
-    gap = np.abs(twins[1].f_hz - twins[2].f_hz) / twins[1].f_hz
-    assert gap.max() < 1e-3
+    gap = np.abs(twins[1].eigenvalues.imag - twins[2].eigenvalues.imag)
+    width = 2 * np.minimum(np.abs(twins[1].eigenvalues.real), np.abs(twins[2].eigenvalues.real))
+    assert np.all(gap < width)
     for i in range(0, len(diagram.v), 4):
         result = eigen_analysis(model, replace(op, v=float(diagram.v[i])))
         shapes = {}
