@@ -10,7 +10,6 @@ Writes ``docs/results/assessment.json`` (every number the page quotes; the same 
 
 from __future__ import annotations
 
-import re
 import sys
 from pathlib import Path
 
@@ -21,10 +20,6 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "scripts"))
 
 from docs_numbers import write_results  # noqa: E402
-
-NOTE = re.compile(r"(?P<wheel>ID\d\.rim\d+)'s creep force reaches (?P<force>[-\d.]+) kN, "
-                  r"(?P<ratio>[\d.]+) x μ_max N0 = (?P<limit>[\d.]+) kN \(s0 = (?P<s0>[\d.]+), "
-                  r"(?P<v>[\d.]+) km/h\)")
 
 
 def main() -> None:
@@ -39,11 +34,7 @@ def main() -> None:
                         "motors_wheelset_torque": parameters["starting_traction_force"] * r0 / n,
                         "adhesion_wheelset_torque": 2 * starting["mu_max"] * starting["N0"] * r0,
                         "s0": starting["s0"]}
-    notes = {c.note for c in result.checks if c.load_case == "short_circuit" and c.note}
-    match = NOTE.search(next(iter(notes))) if notes else None
-    data["short_circuit_beyond_adhesion"] = None if match is None else {
-        "wheel": match["wheel"], "ratio": float(match["ratio"]), "s0": float(match["s0"]),
-        "v_kmh": float(match["v"])}
+    data["short_circuit_beyond_adhesion"] = cases["short_circuit"].scenario["beyond_adhesion"]
     g = result.governing
     data["governing_summary"] = {"component": g.component, "load_case": g.load_case,
                                  "safety_factor": g.safety_factor, "required": g.required}

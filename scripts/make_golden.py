@@ -37,6 +37,7 @@ from model import (  # noqa: E402
     stability_limit,
 )
 from model.mechanics.operating_point import KMH, OperatingPoint  # noqa: E402
+from model.mechanics.parameters import OPTIONAL_DEFAULTS, SCHEMA  # noqa: E402
 
 GOLDEN_FILE = ROOT / "tests" / "golden" / "calibrated.json"
 SPEED_KMH = 120.0
@@ -69,7 +70,11 @@ def golden_data(parameters) -> dict:
         "generated_with": {"python": platform.python_version(), "numpy": np.__version__,
                            "scipy": scipy.__version__},
         "parameter_source": Path(parameters.source).name,
-        "parameters": dict(parameters.values),
+        # the values the dynamics depend on (a parameter at its optional default and the
+        # strength data left out: a reader takes their defaults)
+        "parameters": {name: value for name, value in parameters.values.items()
+                       if name in SCHEMA and not (name in OPTIONAL_DEFAULTS
+                                                  and value == OPTIONAL_DEFAULTS[name])},
         "operating_points": points,
         "stability_limit": {"v_kmh": SPEED_KMH, "N0": N0, "b_M": b_M,
                             "s0_limit": limit.s0_limit},

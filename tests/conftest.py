@@ -369,9 +369,9 @@ def golden_parameters(golden: dict, path: Path, regenerate: str):
     """The parameter set stored in a golden file (its values, units from the schema); fails if
     they no longer fit the schema."""
     from model import ParameterError
-    from model.mechanics.parameters import SCHEMA, parse_parameters
+    from model.mechanics.parameters import ALL_SCHEMA, parse_parameters
 
-    table = {name: {"value": value, "unit": SCHEMA[name][0] if name in SCHEMA else "?"}
+    table = {name: {"value": value, "unit": ALL_SCHEMA[name][0] if name in ALL_SCHEMA else "?"}
              for name, value in golden["parameters"].items()}
     try:
         return parse_parameters(table, source=str(path))

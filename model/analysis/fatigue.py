@@ -91,7 +91,7 @@ def roughness_factor_torsion(R_z: float, sigma_B: float) -> float:
 
 @dataclass(frozen=True)
 class TorsionalFatigue:
-    """A section's fatigue data (module docstring); every factor kept for the record."""
+    """A section's fatigue data (module docstring); every factor kept, so that a check can be recomputed by hand."""
 
     D: float  # outer diameter [m]
     d_i: float  # bore [m] (0: solid)

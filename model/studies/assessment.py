@@ -289,7 +289,12 @@ def short_circuit_case(parameters: Parameters, outputs: list[str], options: Asse
                           fault="all", t_end=horizon, fs=options.fs)
     result = run_envelope(study, parameters, map_unordered, progress)
     envelopes = {o.name: o for o in result.outputs}
-    note = beyond_adhesion_note(parameters, ops[0].N0, [envelopes[c] for c in contacts])
+    beyond = beyond_adhesion(parameters, ops[0].N0, [envelopes[c] for c in contacts])
+    note = "" if beyond is None else (
+        f"linear creep beyond the adhesion limit: {beyond['wheel']}'s creep force reaches "
+        f"{beyond['force'] / 1e3:.1f} kN, {beyond['ratio']:.2f} x μ_max N0 = "
+        f"{beyond['limit'] / 1e3:.1f} kN (s0 = {beyond['s0']:g}, {beyond['v_kmh']:g} km/h): a "
+        "real wheelset slips there, the linear load is an upper estimate")
     loads = {}
     for name in outputs:
         o = envelopes[name]
@@ -304,13 +309,13 @@ def short_circuit_case(parameters: Parameters, outputs: list[str], options: Asse
         horizon, loads,
         {"s0": list(options.s0), "v_kmh": [x / KMH for x in options.v], "N0": ops[0].N0,
          "b_M": ops[0].b_M, "M0": e.M0, "f": e.f, "D": e.D, "fault_instants": "all",
-         "creep": "linear", "fs": options.fs})
+         "creep": "linear", "fs": options.fs, "beyond_adhesion": beyond})
 
 
-def beyond_adhesion_note(parameters: Parameters, N0: float, contacts) -> str:
-    """What to say beside a linear short-circuit load when a wheel's linear creep force left the
-    adhesion range somewhere on the grid (``contacts``: the creep forces' envelopes, whose
-    extremes carry their speed), "" when none did."""
+def beyond_adhesion(parameters: Parameters, N0: float, contacts) -> dict | None:
+    """Where a wheel's linear creep force left the adhesion range the furthest on the grid
+    (``contacts``: the creep forces' envelopes, whose extremes carry their speed): the wheel, its
+    force and the limit μ_max N0 [N], their ratio, s0 and v_kmh; None when none did."""
     worst = []
     for envelope in contacts:
         for value, at in ((envelope.max, envelope.max_at), (envelope.min, envelope.min_at)):
@@ -319,13 +324,11 @@ def beyond_adhesion_note(parameters: Parameters, N0: float, contacts) -> str:
             if abs(value) > limit:
                 worst.append((abs(value) / limit, envelope.name, value, limit, at))
     if not worst:
-        return ""
+        return None
     ratio, name, value, limit, at = max(worst, key=lambda w: w[0])
-    wheel = name.removesuffix(".creep_force")
-    return (f"linear creep beyond the adhesion limit: {wheel}'s creep force reaches "
-            f"{value / 1e3:.1f} kN, {ratio:.2f} x μ_max N0 = {limit / 1e3:.1f} kN (s0 = "
-            f"{at['s0']:g}, {at['v_kmh']:g} km/h): a real wheelset slips there, the linear load "
-            "is an upper estimate")
+    return {"wheel": name.removesuffix(".creep_force"), "force": float(value),
+            "limit": float(limit), "ratio": float(ratio), "s0": float(at["s0"]),
+            "v_kmh": float(at["v_kmh"])}
 
 
 def unstable_adhesion_case(parameters: Parameters, outputs: list[str],

@@ -79,13 +79,8 @@ from scipy.optimize import brentq
 
 from model.analysis.continuation import LineContinuation
 from model.analysis.eigen import eigen_analysis, non_neutral
-from model.analysis.locus import (
-    Reduced,
-    creep_patterns,
-    newton,
-    nonlinear_inverse_iteration,
-    pattern_coefficients,
-)
+from model.analysis.locus import newton, nonlinear_inverse_iteration
+from model.analysis.reduced_model import Reduced, creep_patterns, pattern_coefficients
 from model.mechanics.assembly import BogieModel
 from model.mechanics.operating_point import (
     OperatingPoint,

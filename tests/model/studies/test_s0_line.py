@@ -106,7 +106,7 @@ def test_basis_check_at_the_most_destabilizing_point(setup):
     last point, itself an end of the basis)."""
     from scipy.optimize import minimize_scalar
 
-    from model.analysis.locus import pattern_coefficients
+    from model.analysis.reduced_model import pattern_coefficients
     from model.mechanics.operating_point import OperatingPoint
     from model.studies.s0_line import _dense_point, _LineModel, _missing_modes
 
@@ -160,7 +160,7 @@ def test_point_at_the_crossing_needs_no_full_analysis(setup):
     refinement divides the rigid rows by λ and converges; the point is not sent to a full
     eigen-analysis, and its largest real part is the dense one within rtol = 1e-6 1/s."""
     from model.analysis.eigen import eigen_analysis
-    from model.analysis.locus import pattern_coefficients
+    from model.analysis.reduced_model import pattern_coefficients
     from model.mechanics.operating_point import OperatingPoint
     from model.studies.s0_line import _dense_point, _LineModel
 
