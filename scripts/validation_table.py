@@ -152,6 +152,55 @@ def mode2_argument(model, parameters) -> tuple[str, list]:
     return "\n".join(rows), numbers
 
 
+def constant_reference_pattern(model) -> np.ndarray:
+    """B_M (b_M = 1) with the slope measured against the initial speed instead of the vehicle's
+    (the car body's column dropped): the form the comparison below contrasts."""
+    pattern = model.motor_pattern.copy()
+    pattern[:, model.dofs.index("CB.x")] = 0.0
+    return pattern
+
+
+def reference_comparison(model, parameters) -> tuple[str, dict]:
+    """The ten lowest pairs and the positive real eigenvalues at s0 = 0.005 and 0.014, and s0* at
+    120 km/h, of the same set with the healthy motor's slope measured against the vehicle's
+    speed (the model) and against the initial speed (a constant reference; its rolling velocity
+    is then damped, so only the four rigid-body modes are deflated)."""
+    from scipy.optimize import brentq
+
+    N0, b_M = parameters["wheel_force"], parameters["motor_slope"]
+    space = state_space(model)
+    constant = constant_reference_pattern(model)
+
+    def constant_system(s0: float) -> LinearSystem:
+        op = OperatingPoint(s0, V_REF, N0, b_M)
+        B = model.B + b_M * constant + creep_damping(model, creep_coefficients(parameters, op))
+        return LinearSystem(model.M, B, model.K, model.short_circuit_force,
+                            model.rigid_body_modes, space.inverse_mass)
+
+    numbers: dict = {}
+    rows = ["| s0 | reference | pairs 1–10: Im [Hz] (Re [1/s]) | positive reals [1/s] |",
+            "|---|---|---|---|"]
+    for s0 in (0.005, 0.014):
+        vehicle = eigen_analysis(model, OperatingPoint(s0, V_REF, N0, b_M), vectors=False)
+        for label, values in (("vehicle's speed", vehicle.eigenvalues),
+                              ("initial speed", constant_system(s0).eigenvalues())):
+            pairs = values[values.imag > 0]
+            pairs = pairs[np.argsort(pairs.imag)][:10]
+            reals = np.sort(values.real[values.imag == 0])[::-1]
+            positive = reals[reals > 1e-9]
+            reference = "vehicle" if label.startswith("vehicle") else "initial"
+            numbers.setdefault(f"{s0:g}", {})[reference] = {
+                "pairs": [_pair(z) for z in pairs], "positive_reals": [float(x) for x in positive]}
+            text = ", ".join(f"{_hz(z):.3f} ({z.real:+.2f})" for z in pairs)
+            rows.append(f"| {s0:g} | {label} | {text} | "
+                        f"{', '.join(f'{x:+.3f}' for x in positive) or 'none'} |")
+    limit_vehicle = stability_limit(model, V_REF, N0, b_M).s0_limit
+    limit_initial = brentq(lambda s: float(np.max(constant_system(s).eigenvalues().real)),
+                           0.005, 0.014, xtol=1e-9)
+    numbers["s0_limit"] = {"vehicle": float(limit_vehicle), "initial": float(limit_initial)}
+    return "\n".join(rows), numbers
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--params", default=None, help="parameter file (default: calibrated)")
@@ -167,6 +216,7 @@ def main(argv: list[str] | None = None) -> int:
         rows = evaluate(parameters)
         blocks["targets"] = "```\n" + format_table(rows, limit) + "\n```"
         blocks["mode2"], numbers["mode2"] = mode2_argument(model, parameters)
+        blocks["reference"], numbers["reference"] = reference_comparison(model, parameters)
     numbers["s0_limit"] = float(limit)
     numbers["targets"] = {_slug(row.name): {
         "published": row.target, "achieved": float(row.achieved), "error": float(row.error),
@@ -177,7 +227,7 @@ def main(argv: list[str] | None = None) -> int:
     numbers["on_bound_count"] = len(numbers["on_bound"])
     nominal = OperatingPoint(0.005, V_REF, parameters["wheel_force"], parameters["motor_slope"])
     numbers["rotor_speed_120"] = float(parameters["gear_ratio"] * nominal.v / parameters["wheel_radius"])
-    for name in ("rank_table", "descriptions", "reals", "targets", "mode2"):
+    for name in ("rank_table", "descriptions", "reals", "targets", "mode2", "reference"):
         print(blocks[name], end="\n\n")
     if args.out or args.params is None:
         out = Path(args.out) if args.out else None
