@@ -420,7 +420,8 @@ def test_peaks_csv_and_report_describe_the_nonlinear_history(dash):
     assert not dash.point.stable
     linear = dash.response
     assert "linear creep" in dash.peaks.object
-    assert abs(linear.peaks["ID1.disc_clutch.torque"]) > 1e12  # the blow-up
+    # the blow-up: orders of magnitude beyond anything the wheelset can pass
+    assert abs(linear.peaks["ID1.disc_clutch.torque"]) > 1e4 * linear.limits["M_ad"]
     assert dash.downloads.widgets[0].filename == "time_histories.csv"
     dash.nonlinear.creep.value = "nonlinear"
     shown = dash.history
