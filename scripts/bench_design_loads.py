@@ -215,15 +215,16 @@ def _collect(study, keys, finished) -> tuple[dict, float]:
 def dashboard_design_loads(repeats: int = 15) -> None:
     """Part 4 (module docstring)."""
     from app.results import compute
+    from app.results.case import Case
 
     print("\n4. the dashboard's design loads (ms, median of "
           f"{repeats}; ratio to the fast stage's response with 14 outputs)")
     for s0 in (0.005, 0.014):
-        point = ("", "calibrated", s0, 120.0, 100.0, 3000.0)
-        excitation = compute.excitation(50.0, 90.0, 0.04, None)
-        model = compute.model("", "calibrated")
-        op = compute.operating_point(*point)
-        compute.point_result(*point)  # the eigendecomposition, as after the first answer
+        case = Case(s0=s0, v=120.0, N0=100.0, b_M=3000.0)
+        excitation = case.short_circuit()
+        model = compute.model_for(case)
+        op = case.operating_point()
+        compute.point_result(case)  # the eigendecomposition, as after the first answer
 
         # the fast stage's response before: 10 outputs, 11 series decimated
         def before(model=model, op=op, excitation=excitation):
@@ -238,17 +239,22 @@ def dashboard_design_loads(repeats: int = 15) -> None:
             return compute.history_view(r, compute.LINEAR_HISTORY, True,
                                         compute.RESPONSE_OUTPUTS)
 
+        def cold(kind: str, function):
+            """``function()`` with its kind of result dropped from the results cache first."""
+            def run():
+                compute.RESULTS.drop(kind)
+                return function()
+            return run
+
         cases = {
             "response, 10 outputs + plot series (before)": before,
             "response, 14 outputs + plot series (now)": now,
             "worst case over every fault instant (8 parts)":
-                lambda point=point: compute.worst_case_result.__wrapped__(*point, 50.0, 90.0, 0.04, None,
-                                                              2.0),
+                cold("worst case", lambda case=case: compute.worst_case_result(case)),
             "load spectra of the linear history (8 parts)":
-                lambda point=point: compute.spectra_result.__wrapped__(*point, 50.0, 90.0, 0.04, None, 2.0,
-                                                           None),
+                cold("spectra", lambda case=case: compute.spectra_result(case, None)),
         }
-        compute.response_result(*point, 50.0, 90.0, 0.04, None, 2.0)  # the spectra's history
+        compute.response_result(case)  # the spectra's history
         times = {name: [] for name in cases}
         for _ in range(repeats):
             for name, function in cases.items():

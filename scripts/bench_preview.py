@@ -27,6 +27,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from app.results import compute, preview
+from app.results.case import Case
 from app.services.thread_pools import limit_blas_threads
 from model import eigen_analysis
 from model.analysis.eigen import forget_systems
@@ -51,25 +52,26 @@ def main() -> None:
     args = parser.parse_args()
     limit_blas_threads()
     p = compute.parameters(SET, RAIL)
-    N0, b_M = round(p["wheel_force"] / 1e3, 3), round(p["motor_slope"], 3)
-    key = (SET, RAIL, "s0", V_KMH, N0, b_M)
+    base = Case(set_key=SET, rail=RAIL, **{**Case.defaults(p), "v": V_KMH})
+    N0, b_M = base.N0, base.b_M
+    key = base.sweep("s0")
     m = compute.model(SET, RAIL)
-    compute.dense_locus_result(*key)
-    s0_limit = compute.limit_result(SET, RAIL, V_KMH, N0, b_M).s0_limit
+    compute.dense_locus_result(key)
+    s0_limit = compute.limit_result(base).s0_limit
 
     def dense(vectors: bool) -> None:
         forget_systems(m)
-        eigen_analysis(m, compute.operating_point(SET, RAIL, 0.0061, V_KMH, N0, b_M), vectors)
+        eigen_analysis(m, base.replace(s0=0.0061).operating_point(), vectors)
 
     with_vectors, values_only = best_of(lambda: dense(True), 5), best_of(lambda: dense(False), 5)
     n = 3 if args.quick else 10
     s0_steps = [round(0.005 + 0.0001 * k, 7) for k in range(0, 71, 7 if args.quick else 1)]
+    start = base.replace(s0=0.005)
     kinds = {
-        "s0 (s0*(v), root locus)": [(SET, RAIL, s0, V_KMH, N0, b_M) for s0 in s0_steps],
-        "v (reduced model)": [(SET, RAIL, 0.005, V_KMH + 1.0 + k, N0, b_M) for k in range(n)],
-        "N0 (reduced model)": [(SET, RAIL, 0.005, V_KMH, N0 + 1.0 + k, b_M) for k in range(n)],
-        "b_M (reduced model)": [(SET, RAIL, 0.005, V_KMH, N0, b_M + 500.0 * (k + 1))
-                                for k in range(n)],
+        "s0 (s0*(v), root locus)": [base.replace(s0=s0) for s0 in s0_steps],
+        "v (reduced model)": [start.replace(v=V_KMH + 1.0 + k) for k in range(n)],
+        "N0 (reduced model)": [start.replace(N0=N0 + 1.0 + k) for k in range(n)],
+        "b_M (reduced model)": [start.replace(b_M=b_M + 500.0 * (k + 1)) for k in range(n)],
     }
     print(f"one eigen-analysis: with vectors {with_vectors * 1e3:.1f} ms, eigenvalues only "
           f"{values_only * 1e3:.1f} ms (best of 5); s0*(120 km/h) = {s0_limit:.5f}")
@@ -87,7 +89,7 @@ def main() -> None:
             previews.append(preview.preview(point, key, dragged))
             times.append(time.perf_counter() - t0)
         solves = dense_decompositions() - before
-        exact = [eigen_analysis(m, compute.operating_point(*point), vectors=False).stable
+        exact = [eigen_analysis(m, point.operating_point(), vectors=False).stable
                  for point in points]
         unlike = sum(r.stable is not None and r.stable != e
                      for r, e in zip(previews, exact, strict=True))

@@ -16,24 +16,26 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
 
-# dashboard parameter -> (command-line option [unit], in files: name [unit])
-ELSEWHERE = {
-    "s0": ("`--s0` [-]", "`s0` [-]"),
-    "v": ("`--v` [km/h]", "`v` [m/s], `v_kmh`"),
-    "N0": ("`--n0` [N]", "`N0` [N], `wheel_force`"),
-    "b_M": ("`--bm` [N m s/rad]", "`b_M` [N m s/rad], `motor_slope`"),
-    "rail": ("`--rail` (`bogie envelope`, `report`, `study map`)", "`rail`"),
-    "M0": ("`--m0` [N m]", "`M0` [N m]"),
-    "f": ("`--f` [Hz]", "`f` [Hz]"),
-    "D": ("`--decay` [-]", "`D` [-]"),
-    "dt": ("`--phase` [s]", "`phase_s` [s]"),
-    "t_end": ("`--t-end` [s]", "`t` [s]"),
+# in the files: name [unit] of each quantity (the case's quantities take their command-line
+# option from their declaration, app.results.case) and of the creep model's controls
+FILES = {"s0": "`s0` [-]", "v": "`v` [m/s], `v_kmh`", "N0": "`N0` [N], `wheel_force`",
+         "b_M": "`b_M` [N m s/rad], `motor_slope`", "rail": "`rail`", "M0": "`M0` [N m]",
+         "f": "`f` [Hz]", "D": "`D` [-]", "dt": "`phase_s` [s]", "t_end": "`t` [s]"}
+# the commands a choice's option belongs to (a number's: every command with the operating point)
+COMMANDS = {"rail": " (`bogie envelope`, `report`, `study map`)"}
+CREEP = {  # the creep model's controls: (command-line option [unit], in files: name [unit])
     "creep": ("`--creep`", "`creep`"),
     "anti_slip": ("`--anti-slip`", "`anti_slip`"),
     "delay": ("`--anti-slip-delay` [s]", "`anti_slip_delay` [s]"),
     "threshold": ("`--anti-slip-threshold` [m/s]", "—"),
     "rate": ("`--anti-slip-rate` [1/s]", "—"),
 }
+
+
+def elsewhere(q) -> tuple[str, str]:
+    """(command-line option [unit], in files) of a quantity."""
+    option = f"`{q.option}`" + (COMMANDS.get(q.name, "") if q.choice else f" [{q.outer_unit}]")
+    return option, FILES[q.name]
 
 
 def _number(x: float) -> str:
@@ -43,37 +45,39 @@ def _number(x: float) -> str:
 def controls_rows(dashboard) -> list[tuple]:
     """(CSS class, label, range, default, link name [unit], CLI option, files) of every control
     of the dashboard's controls column, in its order."""
-    from app.dashboard.url_state import CHOICES, NUMBERS
+    from app.dashboard.url_state import choices, numbers
 
-    link = {target: f"`{name}` [{unit}]" for name, (target, _, unit) in NUMBERS.items()}
-    link |= {target: f"`{name}`" for name, target in CHOICES.items()}
+    quantities = dashboard.case_type.quantities
+    link = {q.name: f"`{name}` [{q.outer_unit}]" for name, q in numbers(quantities).items()}
+    link |= {target: f"`{name}`" for name, target in choices(quantities).items()}
     sliders = dashboard.controls.sliders
     rows = []
     for name, widget in sliders.items():
-        if name == "dt":  # after its switch, as in the column
-            auto = dashboard.param["dt_auto"]
-            rows.append(("ctl-dt_auto", "Δt automatic: the motor torque continuous at the fault",
-                         "on / off", "on" if auto.default else "off", "`phase` absent",
-                         "`--phase` absent", "—"))
-        default = _number(widget.value) + (" (the set's)" if name in ("N0", "b_M") else "")
+        q = dashboard.case_type.quantity(name)
+        if q.automatic:  # after its switch, as in the column
+            auto = dashboard.param[f"{name}_auto"]
+            rows.append((f"ctl-{name}_auto", f"{q.symbol} automatic: the motor torque continuous "
+                         "at the fault", "on / off", "on" if auto.default else "off",
+                         f"`{q.link}` absent", f"`{q.option}` absent", "—"))
+        default = _number(widget.value) + (" (the set's)" if q.from_set else "")
         rows.append((f"ctl-{name}", widget.label, f"{_number(widget.start)} … {_number(widget.end)} "
                      f"(step {_number(widget.step)})", default, link.get(name, "—"),
-                     *ELSEWHERE[name]))
+                     *elsewhere(q)))
         if name == "b_M":
-            rail = dashboard.param["rail"]
-            rows.append(("ctl-rail", "rail condition (creep law)", " / ".join(rail.objects),
-                         rail.default, link["rail"], *ELSEWHERE["rail"]))
+            rail = dashboard.case_type.quantity("rail")
+            rows.append(("ctl-rail", rail.label, " / ".join(rail.choices), rail.default,
+                         link["rail"], *elsewhere(rail)))
     nonlinear = dashboard.nonlinear
     rows.append(("ctl-creep", "creep model", " / ".join(nonlinear.creep.options),
-                 nonlinear.creep.value, "—", *ELSEWHERE["creep"]))
+                 nonlinear.creep.value, "—", *CREEP["creep"]))
     rows.append(("ctl-antislip", nonlinear.anti_slip.label, "on / off",
-                 "on" if nonlinear.anti_slip.value else "off", "—", *ELSEWHERE["anti_slip"]))
+                 "on" if nonlinear.anti_slip.value else "off", "—", *CREEP["anti_slip"]))
     for key, widget in (("delay", nonlinear.delay), ("threshold", nonlinear.threshold),
                         ("rate", nonlinear.rate)):
         css = next(c for c in widget.css_classes if c.startswith("ctl-"))
         bound = "≥ 0" if key == "delay" else "> 0"
         rows.append((css, widget.label, f"{bound} (step {_number(widget.step)})",
-                     _number(widget.value), "—", *ELSEWHERE[key]))
+                     _number(widget.value), "—", *CREEP[key]))
     return rows
 
 

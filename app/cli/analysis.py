@@ -153,8 +153,15 @@ def cmd_locus(args: argparse.Namespace) -> None:
 
 
 def cmd_export(args: argparse.Namespace) -> None:
+    from pathlib import Path
+
     from model.analysis.export import export_system
 
+    out = Path(args.out)  # refused before the model is built
+    if out.suffix != ".npz":
+        raise UsageError(f"export file must end in .npz, got '{out.name}'")
+    if not out.parent.is_dir():
+        raise UsageError(f"directory '{out.parent}' does not exist")
     model, op, _ = load_model(args)
     export_system(model, op, args.out)
     emit(args, {"out": args.out, "n_dof": model.n}, f"wrote {args.out} ({model.n} DOF)")

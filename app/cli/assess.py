@@ -26,7 +26,9 @@ import math
 import sys
 
 from app.cli.options import (
-    EXIT_INTERRUPTED,
+    MAX_SAMPLES,
+    MIN_SAMPLES_PER_PERIOD,
+    UsageError,
     add_anti_slip_arguments,
     add_engine_options,
     add_rail,
@@ -36,11 +38,11 @@ from app.cli.options import (
     anti_slip_from,
     bounded,
     check_samples,
-    parse_values,
+    quantity_values,
     short_circuit_from,
 )
 from app.cli.output import emit
-from app.cli.runs import ProgressBar, start_engine
+from app.cli.runs import ProgressBar, study_engine
 
 
 def register(subparsers) -> None:
@@ -53,7 +55,7 @@ def register(subparsers) -> None:
                    help="short_circuit: speeds [km/h] (default %(default)s)")
     add_wheel_force_and_motor_slope(p)
     add_rail(p)
-    add_short_circuit(p, phase=None)  # every fault instant: no --phase
+    add_short_circuit(p, phase=False)  # every fault instant: no --phase
     add_time_grid(p, "short_circuit horizon (default: until the quasi-static part is within "
                   "1 %% of the static response to the lost torque, at least 2 s, at most 60 s)",
                   "sampling rate of every history", t_end_default=None)
@@ -85,16 +87,16 @@ def options_from_args(args: argparse.Namespace):
     from model.studies.envelope import rail_parameters
 
     parameters = rail_parameters(load_parameters(args.params), args.rail)
-    s0 = parse_values(args.s0, "--s0", 1e-9, 1 - 1e-9, "-", increasing=True)
-    v = [x * KMH for x in parse_values(args.v, "--v", 1, 500, "km/h", increasing=True)]
+    s0 = quantity_values(args.s0, "s0", increasing=True)
+    v = [x * KMH for x in quantity_values(args.v, "v", increasing=True)]
     if args.t_end is not None:
         check_samples(args)
-    elif 60.0 * args.fs > 2_000_000:
-        raise ValueError(f"--fs = {args.fs:g} Hz: the automatic horizon may reach 60 s, at most "
-                         f"{2_000_000 / 60:.0f} Hz (or give --t-end)")
-    if args.fs < 2.5 * args.f:
-        raise ValueError(f"--fs = {args.fs:g} Hz is too low to resolve the excitation at f = "
-                         f"{args.f:g} Hz: must be at least {2.5 * args.f:g} Hz")
+    elif 60.0 * args.fs > MAX_SAMPLES:
+        raise UsageError(f"--fs = {args.fs:g} Hz: the automatic horizon may reach 60 s, at most "
+                         f"{MAX_SAMPLES / 60:.0f} Hz (or give --t-end)")
+    if args.fs < MIN_SAMPLES_PER_PERIOD * args.f:
+        raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the excitation at f = "
+                         f"{args.f:g} Hz: must be at least {MIN_SAMPLES_PER_PERIOD * args.f:g} Hz")
     options = AssessmentOptions(
         s0=tuple(s0), v=tuple(v), N0=args.n0, b_M=args.bm, excitation=short_circuit_from(args),
         t_end=args.t_end, fs=args.fs, unstable_s0=args.unstable_s0,
@@ -143,17 +145,9 @@ def cmd_assess(args: argparse.Namespace) -> None:
 
     parameters, options = options_from_args(args)
     short_circuit_points(parameters, options)  # an unstable grid point: refused before any work
-    engine = None
-    try:
-        engine, mapper, where = start_engine(args)
+    with study_engine(args, "assess") as (mapper, where):
         print(f"assess: short_circuit ({len(options.s0) * len(options.v)} point(s) on {where}), "
               "unstable_adhesion, starting …", file=sys.stderr)
         result = assess(parameters, options, mapper, ProgressBar("assess: short_circuit",
                                                                  unit="points"))
-    except KeyboardInterrupt:
-        print("\nassess: interrupted", file=sys.stderr)
-        raise SystemExit(EXIT_INTERRUPTED) from None
-    finally:
-        if engine is not None:
-            engine.close()
     emit(args, {**result.as_dict(), "rail": args.rail}, assessment_table(result))

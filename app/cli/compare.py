@@ -24,7 +24,7 @@ def register(subparsers) -> None:
     p.add_argument("variant", metavar="VARIANT.toml", help="variant parameter file")
     add_operating_point(p)
     # the comparison samples its response at a fixed 10 kHz (no --fs): f stays below that rate
-    add_short_circuit(p, f="(0, 1e4)", phase=None)
+    add_short_circuit(p, intervals={"f": "(0, 1e4)"}, phase=False)
     add_time_grid(p, "horizon of the response")
     p.set_defaults(func=cmd_compare)
 

@@ -27,7 +27,6 @@ from pathlib import Path
 import numpy as np
 
 from app.cli.options import (
-    EXIT_INTERRUPTED,
     UsageError,
     add_anti_slip_arguments,
     add_engine_options,
@@ -38,9 +37,10 @@ from app.cli.options import (
     check_sampling,
     output_names,
     parse_values,
+    quantity_values,
 )
 from app.cli.output import check_history_file
-from app.cli.runs import ProgressBar, history_from_args, start_engine
+from app.cli.runs import ProgressBar, history_from_args, study_engine
 
 AXIS_LABELS = {"rail": "rail", "s0": "s0", "v": "v [km/h]", "N0": "N0 [N]", "b_M": "b_M",
                "M0": "M0 [N m]", "f": "f [Hz]", "D": "D", "anti_slip": "anti-slip",
@@ -114,22 +114,22 @@ def study_from_args(args: argparse.Namespace):
     from model.studies.envelope import EnvelopeStudy, rail_parameters, resolve_outputs
 
     parameters = load_parameters(args.params)
-    s0 = parse_values(args.s0, "--s0", 1e-9, 1 - 1e-9, "-", increasing=True)
-    v = [x * KMH for x in parse_values(args.v, "--v", 1, 500, "km/h", increasing=True)]
-    n0 = (parse_values(args.n0, "--n0", 1e3, 1e6, "N", increasing=True)
+    s0 = quantity_values(args.s0, "s0", increasing=True)
+    v = [x * KMH for x in quantity_values(args.v, "v", increasing=True)]
+    n0 = (quantity_values(args.n0, "N0", increasing=True)
           if args.n0 is not None else [parameters["wheel_force"]])
-    bm = (parse_values(args.bm, "--bm", 0, 1e9, "N m s/rad", increasing=True)
+    bm = (quantity_values(args.bm, "b_M", increasing=True)
           if args.bm is not None else [parameters["motor_slope"]])
-    m0 = parse_values(args.m0, "--m0", 0, 1e8, "N m", increasing=True)
-    f = parse_values(args.f, "--f", 1e-3, 1e5, "Hz", increasing=True)
-    decay = parse_values(args.decay, "--decay", 0, 10, "-", increasing=True)
+    m0 = quantity_values(args.m0, "M0", increasing=True)
+    f = quantity_values(args.f, "f", increasing=True)
+    decay = quantity_values(args.decay, "D", increasing=True)
     rails = _names(args.rail, "--rail")
     if args.phase is None:
         fault, phase = "roots", ()
     elif args.phase.strip() == "all":
         fault, phase = "all", ()
     else:
-        fault, phase = "grid", parse_values(args.phase, "--phase", -10, 10, "s", increasing=True)
+        fault, phase = "grid", quantity_values(args.phase, "dt", increasing=True)
     if fault == "all" and args.creep != "linear":
         raise UsageError("--phase all needs --creep linear (the closed form over every fault "
                          "instant is a superposition); give a --phase grid with nonlinear creep")
@@ -197,9 +197,14 @@ def cmd_envelope(args: argparse.Namespace) -> None:
         prepare_store(out, study, parameters, resume=True)  # refuses another study's store
     _check_first_point(study, parameters, args)
     progress = ProgressBar("envelope")
-    engine = None
-    try:
-        engine, mapper, where = start_engine(args)
+
+    def interrupted() -> str:
+        if out is None:
+            return ""
+        done = len(finished_chunks(out)) if out.exists() else 0
+        return f"; {done} of {len(study.chunks())} chunks finished in {out}; continue with --resume"
+
+    with study_engine(args, "envelope", interrupted) as (mapper, where):
         print(f"envelope: {study.scenarios} scenario(s) in {len(study.chunks())} chunk(s) on "
               f"{where}; fault instants: {study.fault}", file=sys.stderr)
         if out is None:
@@ -210,16 +215,6 @@ def cmd_envelope(args: argparse.Namespace) -> None:
                                  progress=progress)
             dataset = open_study(out)
             arrays = {name: dataset[name].values for name in store_layout(study).variables}
-    except KeyboardInterrupt:
-        where_to = ""
-        if out is not None:
-            where_to = (f"; {len(finished_chunks(out))} of {len(study.chunks())} chunks finished "
-                        f"in {out}; continue with --resume")
-        print(f"\nenvelope: interrupted{where_to}", file=sys.stderr)
-        raise SystemExit(EXIT_INTERRUPTED) from None
-    finally:
-        if engine is not None:
-            engine.close()
     result = envelope(study, arrays)
     data = result.as_dict()
     data.update({"t_end": study.t_end, "fs": study.fs})

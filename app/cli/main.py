@@ -2,9 +2,11 @@
 groups and runs one command.
 
 Every group module has ``register(subparsers)`` adding its sub-commands; the order of
-:data:`COMMAND_GROUPS` is the order of ``bogie --help``.  Bad input (a :class:`UsageError`, a bad
-parameter file or operating point, a ``KeyError``/``ValueError`` with a message): one line on
-stderr saying what is wrong and what is allowed, exit status 2, no traceback.
+:data:`COMMAND_GROUPS` is the order of ``bogie --help``.  Bad input (one of the project's input
+errors, :func:`app.cli.options.input_errors`: a :class:`UsageError`, a bad parameter file,
+operating point, excitation, store …): one line on stderr saying what is wrong and what is
+allowed, exit status 2, no traceback.  Any other error is a programming error: its traceback
+is shown (exit status 1).  Ctrl-C during a study: exit status 130 (:mod:`app.cli.runs`).
 """
 
 from __future__ import annotations
@@ -26,8 +28,7 @@ from app.cli import (
     serve,
     study,
 )
-from app.cli.options import EXIT_BAD_INPUT, BogieParser, UsageError
-from model.mechanics.parameters import ParameterError
+from app.cli.options import EXIT_BAD_INPUT, BogieParser, input_errors
 
 COMMAND_GROUPS = (analysis.register, calibrate.register, analysis.register_export, serve.register,
                   response.register, sensitivity.register, antislip.register, study.register,
@@ -47,14 +48,12 @@ def build_parser() -> BogieParser:
 def main(argv: list[str] | None = None) -> int:
     from threadpoolctl import threadpool_limits
 
-    from model.mechanics.operating_point import OperatingPointError
-
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
         with threadpool_limits(1):  # dense 200-400 sized problems: one BLAS thread is fastest
             args.func(args)
-    except (UsageError, ParameterError, OperatingPointError, KeyError, ValueError) as error:
+    except input_errors() as error:
         message = error.args[0] if error.args else str(error)
         print(f"bogie {args.command}: error: {message}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -2,13 +2,16 @@
 
 The parser whose errors are one line with exit status 2; argparse types for numbers with
 bounds (:func:`bounded` takes the allowed interval as it is printed, ``"(0, 60]"``, so the check
-and its message cannot drift apart); the operating point (``--s0 --v --n0 --bm --params
---json``) and the model it builds; ranges ``A:B:N`` and value lists ``x1,x2,…``; the time grid
-(``--t-end --fs``) and the short circuit (``--m0 --f --decay --phase``) of the commands that
-compute a response; the nonlinear creep and anti-slip options of ``bogie response`` and
-``bogie antislip``; the uncertainty options of ``bogie uncertainty`` and ``bogie study
-uncertainty``.  A check that fails raises :class:`UsageError`, which :func:`app.cli.main.main`
-prints as one line on stderr with exit status 2.
+and its message cannot drift apart); the options of the case's quantities, each added by one
+loop from its declaration (:data:`app.results.case.QUANTITIES`: option, label, interval, unit,
+default — :func:`add_case_option`): the operating point (``--s0 --v --n0 --bm``, with
+``--params --json``) and the model it builds, the short circuit (``--m0 --f --decay --phase``),
+the simulated time (``--t-end``, with ``--fs``) and the rail (``--rail``), and their value lists
+(:func:`quantity_values`); ranges ``A:B:N`` and value lists ``x1,x2,…``; the nonlinear creep
+and anti-slip options of ``bogie response`` and ``bogie antislip``; the uncertainty options of
+``bogie uncertainty`` and ``bogie study uncertainty``; the study engine's options.  A check that
+fails raises :class:`UsageError`; :data:`INPUT_ERRORS` are the errors of bad input, which
+:func:`app.cli.main.main` prints as one line on stderr with exit status 2.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from app.results.case import Case, Quantity
 from model.mechanics.parameters import load_parameters
 
 EXIT_BAD_INPUT = 2
@@ -28,6 +32,33 @@ EXIT_BAD_INPUT = 2
 
 class UsageError(Exception):
     """Bad input from the command line (reported in one line, exit status 2)."""
+
+
+def input_errors() -> tuple[type[BaseException], ...]:
+    """The errors that mean bad input (a malformed value, parameter file, store, study): the
+    project's own input-error types, each raised with a one-line message.  Any other error —
+    a ``KeyError`` or ``ValueError`` included — is a programming error and shows its
+    traceback."""
+    from app.results.variants import VariantError
+    from app.services.settings import SettingsError
+    from model.analysis.campbell import CampbellError
+    from model.analysis.frequency_response import FrequencyResponseError
+    from model.analysis.load_spectrum import SpectrumError
+    from model.analysis.response import ResponseError
+    from model.analysis.sensitivity import SensitivityError
+    from model.analysis.stability import NoStabilityLimit
+    from model.mechanics.excitation import ExcitationError
+    from model.mechanics.operating_point import OperatingPointError
+    from model.mechanics.parameters import ParameterError
+    from model.studies.posterior import PosteriorError
+    from model.studies.store import StoreMismatch
+    from model.studies.uncertainty import UncertaintyError
+
+    # ResponseError covers the nonlinear solver's, the design loads' and the assessment's
+    return (UsageError, ParameterError, OperatingPointError, NoStabilityLimit, ResponseError,
+            ExcitationError, FrequencyResponseError, CampbellError, SensitivityError,
+            SpectrumError, UncertaintyError, PosteriorError, StoreMismatch, VariantError,
+            SettingsError)
 
 
 class BogieParser(argparse.ArgumentParser):
@@ -60,19 +91,24 @@ def number(label: str, low: float = -math.inf, high: float = math.inf, low_open:
 _INTERVAL = re.compile(r"^([\[(])(\S+), (\S+)([\])])$")
 
 
+def interval_ends(interval: str) -> tuple[float, float, bool, bool]:
+    """(low, high, low open, high open) of an interval written as it is printed (``"(0, 60]"``:
+    0 excluded, 60 included); a malformed one is a programming error (ValueError)."""
+    match = _INTERVAL.match(interval)
+    try:
+        opening, low, high, closing = match.groups()
+        return float(low), float(high), opening == "(", closing == ")"
+    except (AttributeError, ValueError):
+        raise ValueError(f"interval {interval!r} is not written as '(a, b]' or the like") from None
+
+
 def bounded(label: str, interval: str, unit: str = "") -> Callable[[str], float]:
     """argparse type: a finite float in ``interval``, written as it is printed (``"(0, 60]"``:
     0 excluded, 60 included; ``"[1, 500]"``; ``"(0, 1e7)"``) followed by ``unit``.  A value
     outside: ``<label> = <text> is not allowed: must be in <interval> <unit>``."""
-    match = _INTERVAL.match(interval)
-    try:
-        opening, low, high, closing = match.groups()
-        ends = float(low), float(high)
-    except (AttributeError, ValueError):
-        raise ValueError(f"interval {interval!r} is not written as '(a, b]' or the like") from None
+    low, high, low_open, high_open = interval_ends(interval)
     allowed = f"must be in {interval}" + (f" {unit}" if unit else "")
-    return number(label, *ends, low_open=opening == "(", high_open=closing == ")",
-                  allowed=allowed)
+    return number(label, low, high, low_open=low_open, high_open=high_open, allowed=allowed)
 
 
 def non_negative_int(label: str) -> Callable[[str], int]:
@@ -105,40 +141,98 @@ def positive_int(label: str) -> Callable[[str], int]:
     return parse
 
 
-# --- the operating point -------------------------------------------------------------------------
+# --- the case's quantities: one option each, from its declaration --------------------------------
+
+def _unit(q: Quantity) -> str:
+    return "" if q.outer_unit == "-" else q.outer_unit
+
+
+def dest(q: Quantity) -> str:
+    """The namespace attribute of a quantity's option (``--t-end`` -> ``t_end``)."""
+    return q.option.lstrip("-").replace("-", "_")
+
+
+def dashboard_interval(q: Quantity) -> str:
+    """The dashboard's range of ``q`` as a closed interval in the command line's unit (a
+    command that reproduces the dashboard accepts exactly what its sliders allow)."""
+    return f"[{q.to_outer(q.low):g}, {q.to_outer(q.high):g}]"
+
+
+def add_case_option(parser, q: Quantity, *, interval: str | None = None,
+                    default=..., help: str | None = None) -> None:
+    """``q.option`` with the declared type, interval (``interval``: a narrower one; give the
+    reason at the call), unit and default (the declared one in the command line's unit; a
+    quantity whose default is the set's, or automatic, defaults to None); ``help``: what the
+    value means for the command (default: the declaration's doc)."""
+    doc = q.doc if help is None else help
+    if q.choice:
+        parser.add_argument(q.option, choices=q.choices,
+                            default=q.default if default is ... else default,
+                            help=f"{doc} (default %(default)s)")
+        return
+    if default is ...:
+        default = None if q.from_set or q.default is None else q.to_outer(q.default)
+    unit = _unit(q)
+    if default is not None:
+        said = " (default %(default)s)"
+    elif q.from_set:
+        said = " (default: parameter set)"
+    else:
+        said = f" (default: {q.automatic})" if q.automatic else ""
+    parser.add_argument(q.option, type=bounded(q.option_label, interval or q.option_interval,
+                                               unit),
+                        default=default, help=f"{doc} [{q.outer_unit}]{said}")
+
+
+def case_option_values(args: argparse.Namespace) -> dict:
+    """name -> value (the command line's unit; None: not given or not an option of the
+    command) of every quantity of the case."""
+    return {q.name: getattr(args, dest(q), None) for q in Case.quantities}
+
 
 def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.005,
                         speed: bool = True) -> None:
-    """``--s0 --v --n0 --bm --params --json`` (``s0``: the default creepage; None: not given;
-    ``speed`` False: no ``--v``, for a command that sweeps the speed)."""
-    parser.add_argument("--s0", type=bounded("--s0 (creepage)", "(0, 1)"),
-                        default=s0, help="longitudinal creepage s0 [-] (default %(default)s)")
-    if speed:
-        parser.add_argument("--v", type=bounded("--v (speed, km/h)", "[1, 500]", "km/h"),
-                            default=120.0, help="speed [km/h] (default %(default)s)")
-    add_wheel_force_and_motor_slope(parser)
+    """The operating point's options (``--s0 --v --n0 --bm`` and every quantity that changes
+    the parameter set's values), ``--params`` and ``--json`` (``s0``: the default creepage;
+    None: not given; ``speed`` False: no ``--v``, for a command that sweeps the speed)."""
+    for q in Case.of_role("point", "override"):
+        if q.name == "v" and not speed:
+            continue
+        add_case_option(parser, q, default=s0 if q.name == "s0" else ...)
     parser.add_argument("--params", default=None, metavar="FILE",
                         help="parameter file (TOML; default: the calibrated set)")
     parser.add_argument("--json", action="store_true", help="machine-readable JSON output")
 
 
 def add_wheel_force_and_motor_slope(parser: argparse.ArgumentParser) -> None:
-    """``--n0`` [N] and ``--bm`` [N m s/rad], one value each (None: the parameter set's)."""
-    parser.add_argument("--n0", type=bounded("--n0 (wheel force, N)", "[1e3, 1e6]", "N"),
-                        default=None, help="static wheel force N0 [N] (default: parameter set)")
-    parser.add_argument("--bm", type=bounded("--bm (motor slope, N m s/rad)", "[0, 1e9]",
-                                             "N m s/rad"),
-                        default=None, help="motor slope b_M [N m s/rad] (default: parameter set)")
+    """One value each of the quantities whose default is the parameter set's (``--n0`` [N],
+    ``--bm`` [N m s/rad], …; None: the set's)."""
+    for q in Case.of_role("point", "override"):
+        if q.from_set:
+            add_case_option(parser, q)
 
 
-RAILS = ("calibrated", "dry", "wet")  # the creep laws: the set's own, Polach's presets
+RAILS = Case.quantity("rail").choices  # the creep laws: the set's own, Polach's presets
 
 
 def add_rail(parser: argparse.ArgumentParser) -> None:
     """``--rail``: one creep law, the set's own (calibrated) or Polach's dry/wet preset."""
-    parser.add_argument("--rail", choices=RAILS, default="calibrated",
-                        help="creep law: the set's own (calibrated) or Polach's dry/wet preset "
-                             "(default %(default)s)")
+    add_case_option(parser, Case.quantity("rail"))
+
+
+def overrides_from(args: argparse.Namespace) -> dict[str, float]:
+    """The parameter set's values the options replace (quantities of role ``override`` given
+    on the command line), SI."""
+    values = case_option_values(args)
+    return {q.target: q.outer_to_si(values[q.name]) for q in Case.of_role("override")
+            if values[q.name] is not None}
+
+
+def load_parameters_from(args: argparse.Namespace):
+    """The parameter set of ``--params`` with the values the options replace."""
+    parameters = load_parameters(args.params)
+    overrides = overrides_from(args)
+    return parameters.replace(**overrides) if overrides else parameters
 
 
 def load_model(args: argparse.Namespace):
@@ -147,12 +241,27 @@ def load_model(args: argparse.Namespace):
     from model.mechanics.assembly import build_model
     from model.mechanics.operating_point import OperatingPoint
 
-    parameters = load_parameters(args.params)
+    parameters = load_parameters_from(args)
     model = build_model(parameters)
     n0 = parameters["wheel_force"] if args.n0 is None else args.n0
     bm = parameters["motor_slope"] if args.bm is None else args.bm
     op = OperatingPoint.from_kmh(args.s0, args.v, n0, bm) if args.s0 is not None else None
     return model, op, (n0, bm)
+
+
+def case_from_args(args: argparse.Namespace, set_key: str, parameters) -> Case:
+    """The case record of the options (the command line's units), the quantities not given at
+    their defaults (``parameters``: the set's values)."""
+    return Case.from_outer(set_key, case_option_values(args), parameters)
+
+
+def quantity_values(text: str, name: str, increasing: bool = False) -> list[float]:
+    """A value list ``x1,x2,…`` or ``A:B:N`` of the quantity ``name`` in the command line's
+    unit, each within the interval its option accepts."""
+    q = Case.quantity(name)
+    low, high, low_open, high_open = interval_ends(q.option_interval)
+    return parse_values(text, q.option, low, high, q.outer_unit, increasing, low_open,
+                        high_open)
 
 
 # --- ranges and value lists ----------------------------------------------------------------------
@@ -170,8 +279,10 @@ def parse_range(text: str, label: str, scale: float = 1.0) -> np.ndarray:
 
 
 def parse_values(text: str, label: str, low: float, high: float, unit: str,
-                 increasing: bool = False) -> list[float]:
-    """'A:B:N' (N values from A to B) or 'x1,x2,…' -> values within [low, high]."""
+                 increasing: bool = False, low_open: bool = False,
+                 high_open: bool = False) -> list[float]:
+    """'A:B:N' (N values from A to B) or 'x1,x2,…' -> values within [low, high] (an end
+    excluded where ``low_open``/``high_open``)."""
     text = text.strip()
     if ":" in text:
         parts = text.split(":")
@@ -196,9 +307,12 @@ def parse_values(text: str, label: str, low: float, high: float, unit: str,
         if not values:
             raise UsageError(f"{label} is empty")
     for value in values:
-        if not (math.isfinite(value) and low <= value <= high):
-            raise UsageError(f"{label}: {value:g} is not allowed, must be in [{low:g}, {high:g}] "
-                             f"{unit}")
+        inside = ((low < value if low_open else low <= value)
+                  and (value < high if high_open else value <= high))
+        if not (math.isfinite(value) and inside):
+            raise UsageError(f"{label}: {value:g} is not allowed, must be in "
+                             f"{'(' if low_open else '['}{low:g}, {high:g}{')' if high_open else ']'}"
+                             f" {unit}")
     if increasing and any(b <= a for a, b in itertools.pairwise(values)):
         raise UsageError(f"{label} must increase")
     if len(values) > 100_000:
@@ -208,21 +322,22 @@ def parse_values(text: str, label: str, low: float, high: float, unit: str,
 
 # --- the time grid of a response ----------------------------------------------------------------
 
-T_END = "(0, 60]"  # [s]: the horizons model.analysis.response accepts (MAX_T_END)
 FS = "(0, 1e7)"  # [Hz]
 MAX_SAMPLES = 2_000_000  # t_end × fs: the longest history model.analysis.response computes
 
 
 def add_time_grid(p: argparse.ArgumentParser, t_end_help: str, fs_help: str | None = None, *,
-                  t_end: str = T_END, fs: str = FS, t_end_default: float | None = 2.0) -> None:
-    """``--t-end`` [s] (default ``t_end_default``; None: the command chooses, and
-    ``t_end_help`` says how) and, with ``fs_help``, ``--fs`` [Hz] (default 10 000).
-    ``t_end_help``/``fs_help`` say what the values mean for the command ("horizon of each run");
-    ``t_end``/``fs`` are the allowed intervals, narrower where a command needs it (give the
-    reason at the call).  With ``--fs``, call :func:`check_samples` before computing."""
-    default = "" if t_end_default is None else " (default %(default)s)"
-    p.add_argument("--t-end", type=bounded("--t-end (horizon, s)", t_end, "s"),
-                   default=t_end_default, help=f"{t_end_help} [s]{default}")
+                  t_end: str | None = None, fs: str = FS, t_end_default: float | None = ...
+                  ) -> None:
+    """``--t-end`` [s] (the horizon quantity's option; default ``t_end_default``, else the
+    declared one; None: the command chooses, and ``t_end_help`` says how) and, with
+    ``fs_help``, ``--fs`` [Hz] (default 10 000).  ``t_end_help``/``fs_help`` say what the
+    values mean for the command ("horizon of each run"); ``t_end``/``fs`` are the allowed
+    intervals, narrower where a command needs it (give the reason at the call; default the
+    declared one, the horizons model.analysis.response accepts).  With ``--fs``, call
+    :func:`check_samples` before computing."""
+    (horizon,) = Case.of_role("horizon")
+    add_case_option(p, horizon, interval=t_end, default=t_end_default, help=t_end_help)
     if fs_help is not None:
         p.add_argument("--fs", type=bounded("--fs (sampling rate, Hz)", fs, "Hz"),
                        default=10_000.0, help=f"{fs_help} [Hz] (default %(default)s)")
@@ -237,40 +352,32 @@ def check_samples(args: argparse.Namespace) -> None:
 
 # --- the short circuit ---------------------------------------------------------------------------
 
-M0 = "[0, 1e8]"  # [N m]: the amplitudes model.analysis.response.ShortCircuit accepts
-FREQUENCY = "(0, 1e5)"  # [Hz]
-DECAY = "[0, 10]"  # [-]
-PHASE = "[-10, 10]"  # [s]
-
-
-def add_short_circuit(p: argparse.ArgumentParser, *, m0: str = M0, f: str = FREQUENCY,
-                      decay: str = DECAY, phase: str | None = PHASE) -> None:
-    """``--m0`` [N m], ``--f`` [Hz], ``--decay`` [-] and (unless ``phase`` is None) ``--phase``
-    [s] of the short-circuit torque, defaults those of
-    :class:`model.analysis.response.ShortCircuit` (``--phase``: none, the motor torque is
-    continuous).  The arguments are the allowed intervals, narrower where a command needs it
-    (give the reason at the call).  :func:`short_circuit_from` builds the excitation."""
-    from model.analysis.response import ShortCircuit
-
-    defaults = ShortCircuit()
-    p.add_argument("--m0", type=bounded("--m0 (amplitude, N m)", m0, "N m"), default=defaults.M0,
-                   help="short-circuit amplitude M0 (oscillating part) [N m] "
-                        "(default %(default)s)")
-    p.add_argument("--f", type=bounded("--f (frequency, Hz)", f, "Hz"), default=defaults.f,
-                   help="short-circuit frequency f (oscillating part) [Hz] (default %(default)s)")
-    p.add_argument("--decay", type=bounded("--decay (D)", decay), default=defaults.D,
-                   help="short-circuit decay D: envelope e^(-D 2π f t) [-] (default %(default)s)")
-    if phase is not None:
-        p.add_argument("--phase", type=bounded("--phase (Δt, s)", phase, "s"), default=None,
-                       help="time shift Δt [s] (default: continuous motor torque)")
+def add_short_circuit(p: argparse.ArgumentParser, *, dashboard: bool = False,
+                      phase: bool = True, intervals: dict[str, str] | None = None) -> None:
+    """The short circuit's options (``--m0`` [N m], ``--f`` [Hz], ``--decay`` [-] and, unless
+    ``phase`` is False, ``--phase`` [s]), each from its declaration: defaults those of the
+    dashboard and of :class:`model.analysis.response.ShortCircuit` (``--phase``: none, the
+    motor torque is continuous); ``dashboard``: the intervals are the dashboard's sliders' (a
+    command that reproduces the dashboard); ``intervals``: name -> a narrower interval where a
+    command needs it (give the reason at the call).  :func:`short_circuit_from` builds the
+    excitation."""
+    intervals = intervals or {}
+    for q in Case.of_role("short_circuit"):
+        if q.automatic and not phase:
+            continue
+        interval = intervals.get(q.name, dashboard_interval(q) if dashboard else None)
+        add_case_option(p, q, interval=interval)
 
 
 def short_circuit_from(args: argparse.Namespace):
     """The :class:`model.analysis.response.ShortCircuit` of the options of
-    :func:`add_short_circuit`."""
+    :func:`add_short_circuit` (SI)."""
     from model.analysis.response import ShortCircuit
 
-    return ShortCircuit(M0=args.m0, f=args.f, D=args.decay, dt=getattr(args, "phase", None))
+    values = case_option_values(args)
+    return ShortCircuit(**{q.target: None if values[q.name] is None
+                           else q.outer_to_si(values[q.name])
+                           for q in Case.of_role("short_circuit")})
 
 
 # --- nonlinear creep and the anti-slip protection ------------------------------------------------
@@ -370,7 +477,8 @@ def uncertainty_options(args: argparse.Namespace) -> dict:
     if args.posterior and args.no_indices:
         raise UsageError("--posterior and --no-indices exclude each other (the posterior never "
                          "has Sobol indices)")
-    speeds = (parse_values(args.speeds, "--speeds", 1, 500, "km/h", increasing=True)
+    speeds = (parse_values(args.speeds, "--speeds", *interval_ends(
+        Case.quantity("v").option_interval)[:2], "km/h", increasing=True)
               if args.speeds is not None else list(V_SPEEDS_KMH))
     if len(speeds) > 50:
         raise UsageError(f"--speeds: {len(speeds)} speeds, at most 50 allowed")

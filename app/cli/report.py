@@ -21,7 +21,10 @@ from app.cli.options import (
     add_rail,
     add_short_circuit,
     add_time_grid,
+    case_from_args,
+    dashboard_interval,
 )
+from app.results.case import Case
 
 
 def register(subparsers) -> None:
@@ -29,8 +32,8 @@ def register(subparsers) -> None:
     add_operating_point(p)
     # the report reproduces the dashboard: its sliders' ranges (app/dashboard/dashboard.py, there
     # in kN m and ms) bound the short circuit and the simulated time
-    add_short_circuit(p, m0="[0, 2e5]", f="[10, 300]", decay="[0, 0.3]", phase="[-0.01, 0.01]")
-    add_time_grid(p, "simulated time", t_end="[0.2, 5]")
+    add_short_circuit(p, dashboard=True)
+    add_time_grid(p, "simulated time", t_end=dashboard_interval(Case.quantity("t_end")))
     add_rail(p)
     p.add_argument("--variant", default="", metavar="TEXT",
                    help="design variant: name:value,… (SI units) applied to the set")
@@ -57,12 +60,8 @@ def cmd_report(args: argparse.Namespace) -> None:
         parameters = apply_variant(base_parameters(base), changes)
     except VariantError as error:
         raise UsageError(f"--variant: {error}") from None
-    n0 = parameters["wheel_force"] if args.n0 is None else args.n0
-    bm = parameters["motor_slope"] if args.bm is None else args.bm
-    text = build_report(set_key(base, changes), args.rail, args.s0, args.v, n0 / 1e3, bm,
-                        args.m0 / 1e3, args.f, args.decay,
-                        None if args.phase is None else args.phase * 1e3, args.t_end,
-                        progress=lambda step: print(f"bogie report: {step}…", file=sys.stderr,
-                                                    flush=True))
+    case = case_from_args(args, set_key(base, changes), parameters)
+    text = build_report(case, progress=lambda step: print(f"bogie report: {step}…",
+                                                           file=sys.stderr, flush=True))
     out.write_text(text, encoding="utf-8")
     print(f"wrote {out} ({len(text.encode()) / 1e6:.1f} MB, self-contained)")

@@ -1,6 +1,7 @@
 """What several commands run alike: the history an option set describes (``bogie response``,
-``bogie spectrum``), and a study on the engine with its progress bar (``bogie study``, ``bogie
-envelope``).  Below the command modules (none of them imports another), above the options."""
+``bogie spectrum``), and a study on the engine (:func:`study_engine`: Ctrl-C exits with status
+130 wherever it comes) with its progress bar (``bogie study``, ``bogie envelope``, ``bogie
+assess``).  Below the command modules (none of them imports another), above the options."""
 
 from __future__ import annotations
 
@@ -8,8 +9,11 @@ import argparse
 import math
 import sys
 import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 from app.cli.options import (
+    EXIT_INTERRUPTED,
     UsageError,
     anti_slip_from,
     check_creep_arguments,
@@ -79,15 +83,31 @@ class ProgressBar:
         self.stream.flush()
 
 
-def start_engine(args: argparse.Namespace):
-    """(engine or None, map_unordered, where) for --serial / --scheduler / a local cluster."""
+@contextmanager
+def study_engine(args: argparse.Namespace, label: str,
+                 interrupted: Callable[[], str] = lambda: "") -> Iterator[tuple]:
+    """The study engine of the options (``--serial``, ``--scheduler``, else a local cluster) for
+    the ``with`` block: ``(map_unordered, where)``.  Ctrl-C while the engine starts, runs or
+    stops prints ``<label>: interrupted<interrupted()>`` on stderr and exits with status 130
+    (:data:`EXIT_INTERRUPTED`), no traceback; an unreachable scheduler is bad input
+    (:class:`UsageError`); the engine is closed whatever happens."""
     from model.studies.engine import EngineUnavailable, StudyEngine, serial_map_unordered
 
-    if args.serial:
-        return None, serial_map_unordered, "this process (serial)"
-    engine = StudyEngine(args.scheduler, args.workers, args.connect_timeout)
+    engine = None
     try:
-        engine.start()
-    except EngineUnavailable as error:
-        raise UsageError(str(error)) from None
-    return engine, engine.map_unordered, engine.description
+        try:
+            if args.serial:
+                yield serial_map_unordered, "this process (serial)"
+                return
+            engine = StudyEngine(args.scheduler, args.workers, args.connect_timeout)
+            try:
+                engine.start()
+            except EngineUnavailable as error:
+                raise UsageError(str(error)) from None
+            yield engine.map_unordered, engine.description
+        finally:
+            if engine is not None:
+                engine.close()
+    except KeyboardInterrupt:
+        print(f"\n{label}: interrupted{interrupted()}", file=sys.stderr)
+        raise SystemExit(EXIT_INTERRUPTED) from None

@@ -21,21 +21,21 @@ import argparse
 import json
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
 from app.cli.options import (
-    EXIT_INTERRUPTED,
     UsageError,
     add_engine_options,
     add_rail,
     add_uncertainty_options,
     bounded,
-    parse_values,
     positive_int,
+    quantity_values,
     uncertainty_options,
 )
-from app.cli.runs import ProgressBar, start_engine
+from app.cli.runs import ProgressBar, study_engine
 
 
 def _common(p: argparse.ArgumentParser) -> None:
@@ -89,22 +89,19 @@ def register(subparsers) -> None:
 
 
 def _parameters(args):
-    from model.contact.creep import CREEP_PRESETS
     from model.mechanics.parameters import load_parameters
+    from model.studies.envelope import rail_parameters
 
-    parameters = load_parameters(args.params)
-    if args.rail != "calibrated":
-        parameters = parameters.replace(**CREEP_PRESETS[args.rail])
-    return parameters
+    return rail_parameters(load_parameters(args.params), args.rail)
 
 
 def _grids(args, parameters):
     from model.mechanics.operating_point import KMH
 
-    v = [x * KMH for x in parse_values(args.v, "--v", 1, 500, "km/h", increasing=True)]
-    n0 = (parse_values(args.n0, "--n0", 1e3, 1e6, "N") if args.n0 is not None
+    v = [x * KMH for x in quantity_values(args.v, "v", increasing=True)]
+    n0 = (quantity_values(args.n0, "N0") if args.n0 is not None
           else [parameters["wheel_force"]])
-    bm = (parse_values(args.bm, "--bm", 0, 1e9, "N m s/rad") if args.bm is not None
+    bm = (quantity_values(args.bm, "b_M") if args.bm is not None
           else [parameters["motor_slope"]])
     return v, n0, bm
 
@@ -113,7 +110,7 @@ def cmd_map(args: argparse.Namespace) -> None:
     from model.studies.maps import MapStudy
 
     parameters = _parameters(args)
-    s0 = parse_values(args.s0, "--s0", 1e-9, 1 - 1e-9, "-", increasing=True)
+    s0 = quantity_values(args.s0, "s0", increasing=True)
     v, n0, bm = _grids(args, parameters)
     _run(args, MapStudy(s0, v, n0, bm, max_frequency_hz=args.max_frequency,
                         method=args.method), parameters)
@@ -128,8 +125,6 @@ def cmd_limit(args: argparse.Namespace) -> None:
 
 
 def cmd_uncertainty(args: argparse.Namespace) -> None:
-    from pathlib import Path
-
     from model.mechanics.parameters import load_parameters
     from model.studies.engine import in_order
     from model.studies.uncertainty import UncertaintyError, run_uncertainty
@@ -144,21 +139,15 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
     options = uncertainty_options(args)
     parameters = load_parameters(args.params)
     bar, start = ProgressBar("study uncertainty", unit="model runs"), time.monotonic()
-    engine, mapper, where = start_engine(args)
-    try:
+    with study_engine(args, "study uncertainty", lambda: " (nothing written)") as (mapper, where):
         print(f"study uncertainty: n = {n} on {where}", file=sys.stderr)
-        result = run_uncertainty(parameters, n, seed=args.seed, map_fn=in_order(mapper), **options,
-                                 chunk_size=args.chunk_size,
-                                 progress=lambda done, total: bar(done, total,
-                                                                  time.monotonic() - start))
-    except UncertaintyError as error:
-        raise UsageError(str(error)) from None
-    except KeyboardInterrupt:
-        print("\nstudy uncertainty: interrupted (nothing written)", file=sys.stderr)
-        raise SystemExit(EXIT_INTERRUPTED) from None
-    finally:
-        if engine is not None:
-            engine.close()
+        try:
+            result = run_uncertainty(parameters, n, seed=args.seed, map_fn=in_order(mapper),
+                                     **options, chunk_size=args.chunk_size,
+                                     progress=lambda done, total: bar(done, total,
+                                                                      time.monotonic() - start))
+        except UncertaintyError as error:
+            raise UsageError(str(error)) from None
     data = result.as_dict()
     out.write_text(json.dumps(data, indent=1, allow_nan=False), encoding="utf-8")
     if args.json:
@@ -173,8 +162,6 @@ def _run(args: argparse.Namespace, study, parameters) -> None:
 
     progress = ProgressBar(f"study {study.kind}")
     if not args.resume:  # refuse a bad --out before starting a cluster
-        from pathlib import Path
-
         out = Path(args.out)
         if out.exists():
             raise UsageError(f"'{out}' exists: continue it with --resume, or remove it")
@@ -182,22 +169,17 @@ def _run(args: argparse.Namespace, study, parameters) -> None:
             raise UsageError(f"directory '{out.parent}' does not exist")
     else:
         prepare_store(args.out, study, parameters, resume=True)  # refuses another study's store
-    engine = None
-    try:
-        engine, mapper, where = start_engine(args)
+    def interrupted() -> str:
+        from model.studies.store import finished_chunks
+
+        done = len(finished_chunks(args.out)) if Path(args.out).exists() else 0
+        return (f"; {done} of {len(study.chunks())} chunks finished in {args.out}; continue "
+                "with --resume")
+
+    with study_engine(args, f"study {study.kind}", interrupted) as (mapper, where):
         print(f"study {study.kind}: {len(study.chunks())} chunks on {where}", file=sys.stderr)
         run = run_into_store(study, parameters, args.out, mapper, resume=args.resume,
                              progress=progress)
-    except KeyboardInterrupt:
-        from model.studies.store import finished_chunks
-
-        done = len(finished_chunks(args.out))
-        print(f"\nstudy {study.kind}: interrupted; {done} of {len(study.chunks())} chunks "
-              f"finished in {args.out}; continue with --resume", file=sys.stderr)
-        raise SystemExit(EXIT_INTERRUPTED) from None
-    finally:
-        if engine is not None:
-            engine.close()
     dataset = open_study(args.out)
     summary = {"out": args.out, "study": study.kind, "chunks": run.total,
                "skipped_chunks": run.skipped, "computed_chunks": run.computed,

@@ -8,7 +8,7 @@ where they run), :mod:`.layout` (the page and the tabs), :mod:`.downloads`, :mod
 variant, uncertainty band, design loads with its grid envelope, resonances) gets the dashboard object and
 talks to it through its small public interface (``state()``, ``alive()``, ``post()``,
 ``run_locked()``, ``warn()``, ``clear_warning()``, ``when_shown()``, ``flush_view()``,
-``params_path``, ``set_key``, ``study_owner``, ``show_history()``, ``show_mode()``); no view imports
+``base_key``, ``set_key``, ``study_owner``, ``show_history()``, ``show_mode()``); no view imports
 :mod:`.dashboard`.  May use :mod:`app.report`, :mod:`app.results`, :mod:`app.services`
 and ``model``; never the server or the command line.
 """

@@ -1,12 +1,16 @@
 """The dashboard's controls column: the published cases, the operating point, the short circuit,
 the creep model and the downloads.
 
+The case's quantities become the dashboard's parameters (:func:`case_parameters`) and its
+controls (:class:`Controls`) by one loop over their declarations
+(:data:`app.results.case.QUANTITIES`: label, unit, range, step, format, default): a slider per
+number, a select per choice, an "automatic" switch for a quantity that may be automatic.
 Controls are built per dashboard (never shared class attributes) and write into its parameters
 on ``value_throttled`` (slider release / keyboard step), so a drag triggers one computation; while
 an operating-point slider is held, its ``value`` asks for a preview
-(:mod:`app.dashboard.drag_preview`).  Each
-control has a CSS class (``ctl-<parameter>``, ``case-stable``/``case-unstable``): Panel puts the
-label into the Bokeh model's title, and tests and scripts find the controls by their class.
+(:mod:`app.dashboard.drag_preview`).  Each control has a CSS class (``ctl-<parameter>``,
+``case-stable``/``case-unstable``): Panel puts the label into the Bokeh model's title, and tests
+and scripts find the controls by their class.
 """
 
 from __future__ import annotations
@@ -14,24 +18,39 @@ from __future__ import annotations
 from functools import partial
 
 import panel as pn
+import param
 
+from app.results.case import Quantity
 from app.results.preview import PREVIEWED
 
 PUBLISHED_SPEED_KMH = 120.0  # the speed of the study's two published cases [km/h]
 PUBLISHED_CASES = {"stable": 0.005, "unstable": 0.014}  # their creepage s0 [-]
+# the sections of the controls column and the roles of the quantities in each
+SECTIONS = (("### Operating point", ("point", "override", "set")),
+            ("### Short circuit M_C(t)", ("short_circuit", "horizon")))
 
-# parameter -> (label with unit, step, number format)
-SLIDERS = {
-    "s0": ("creepage s0 [-]", 0.0001, "0.0000"),
-    "v": ("speed v [km/h]", 5.0, "0"),
-    "N0": ("wheel force N0 [kN]", 1.0, "0"),
-    "b_M": ("motor slope b_M [N m s/rad]", 100.0, "0"),
-    "M0": ("short circuit M0 [kN m]", 1.0, "0"),
-    "f": ("frequency f [Hz]", 1.0, "0"),
-    "D": ("decay D [-]", 0.005, "0.000"),
-    "dt": ("time shift Δt [ms]", 0.05, "0.00"),
-    "t_end": ("simulated time [s]", 0.1, "0.0"),
-}
+
+def automatic_name(q: Quantity) -> str:
+    """The dashboard's switch of a quantity that may be automatic (``dt`` -> ``dt_auto``)."""
+    return f"{q.name}_auto"
+
+
+def case_parameters(quantities) -> dict[str, param.Parameter]:
+    """The dashboard's parameters of ``quantities``: a number within the dashboard's range (its
+    default the declared one; the set's value is set per dashboard) or a choice, and a switch
+    for a quantity that may be automatic (on by default)."""
+    parameters: dict[str, param.Parameter] = {}
+    for q in quantities:
+        if q.choice:
+            parameters[q.name] = param.Selector(default=q.default, objects=list(q.choices),
+                                                doc=q.doc)
+            continue
+        if q.automatic:
+            parameters[automatic_name(q)] = param.Boolean(True, doc=f"{q.label} automatic: "
+                                                                    f"{q.automatic}")
+        default = q.default if q.default is not None else min(max(0.0, q.low), q.high)
+        parameters[q.name] = param.Number(default, bounds=q.bounds, doc=f"{q.doc} [{q.unit}]")
+    return parameters
 
 
 class ControlSlider(pn.widgets.FloatSlider):
@@ -47,22 +66,23 @@ class ControlSlider(pn.widgets.FloatSlider):
 class Controls:
     """The controls column of one dashboard (``column``); ``sliders``: parameter -> slider.
 
-    ``dashboard``: its parameters (:data:`SLIDERS`, ``dt_auto``, ``rail``), ``state()``,
+    ``dashboard``: its ``case_type`` (the quantities), their parameters, ``state()``,
     ``warn(text)``, ``run_locked(function)``, ``show_published_case(s0)`` and ``drag_preview``
     (:class:`app.dashboard.drag_preview.DragPreview`); ``creep_controls``: the nonlinear view's controls;
     ``downloads``: the download buttons."""
 
     def __init__(self, dashboard, creep_controls: list, downloads: list):
         self.dashboard = dashboard
-        self.sliders = {name: self._slider(name, *spec) for name, spec in SLIDERS.items()}
-        sliders = self.sliders
-        sliders["dt"].disabled = dashboard.dt_auto
-        dashboard.param.watch(lambda e: setattr(sliders["dt"], "disabled", e.new), "dt_auto")
-        dt_auto = pn.widgets.Checkbox.from_param(dashboard.param.dt_auto,
-                                                 label="Δt automatic (continuous torque)",
-                                                 css_classes=["ctl-dt_auto"])
-        rail = pn.widgets.Select.from_param(dashboard.param.rail, label="rail condition (creep law)",
-                                            css_classes=["ctl-rail"], sizing_mode="stretch_width")
+        quantities = dashboard.case_type.quantities
+        self.sliders = {q.name: self._slider(q) for q in quantities if not q.choice}
+        self.switches: dict[str, pn.widgets.Widget] = {}  # "automatic" switches, choices
+        for q in quantities:
+            if q.choice:
+                self.switches[q.name] = pn.widgets.Select.from_param(
+                    dashboard.param[q.name], label=q.label, css_classes=[f"ctl-{q.name}"],
+                    sizing_mode="stretch_width")
+            elif q.automatic:
+                self.switches[q.name] = self._automatic(q)
         cases = []
         for key, s0 in PUBLISHED_CASES.items():
             button = pn.widgets.Button(label=f"Published case s0 = {s0} ({key})",
@@ -70,20 +90,33 @@ class Controls:
                                        css_classes=[f"case-{key}"], sizing_mode="stretch_width")
             button.on_click(lambda _event, s0=s0: dashboard.show_published_case(s0))
             cases.append(button)
-        self.column = pn.Column(
-            f"### Published cases ({PUBLISHED_SPEED_KMH:g} km/h)", *cases,
-            "### Operating point", sliders["s0"], sliders["v"], sliders["N0"], sliders["b_M"],
-            rail,
-            "### Short circuit M_C(t)", sliders["M0"], sliders["f"], sliders["D"], dt_auto,
-            sliders["dt"], sliders["t_end"],
-            *creep_controls,
-            "### Downloads", *downloads, width=300)
+        column = [f"### Published cases ({PUBLISHED_SPEED_KMH:g} km/h)", *cases]
+        for title, roles in SECTIONS:
+            column.append(title)
+            # the numbers of the section in declaration order, then its choices (the rail)
+            for q in sorted((q for q in quantities if q.role in roles), key=lambda q: q.choice):
+                if q.name in self.switches:
+                    column.append(self.switches[q.name])
+                if q.name in self.sliders:
+                    column.append(self.sliders[q.name])
+        self.column = pn.Column(*column, *creep_controls, "### Downloads", *downloads,
+                                width=300)
 
-    def _slider(self, name: str, label: str, step: float, fmt: str = "0[.]000") -> ControlSlider:
-        dashboard = self.dashboard
-        p = dashboard.param[name]
-        widget = ControlSlider(label=label, start=p.bounds[0], end=p.bounds[1], step=step,
-                               value=getattr(dashboard, name), format=fmt,
+    def _automatic(self, q: Quantity) -> pn.widgets.Checkbox:
+        """The switch of a quantity that may be automatic; its slider is off while it is on."""
+        dashboard, name = self.dashboard, automatic_name(q)
+        slider = self.sliders[q.name]
+        slider.disabled = getattr(dashboard, name)
+        dashboard.param.watch(lambda e: setattr(slider, "disabled", e.new), name)
+        return pn.widgets.Checkbox.from_param(dashboard.param[name],
+                                              label=f"{q.symbol} automatic "
+                                                    f"({q.automatic})",
+                                              css_classes=[f"ctl-{name}"])
+
+    def _slider(self, q: Quantity) -> ControlSlider:
+        dashboard, name = self.dashboard, q.name
+        widget = ControlSlider(label=q.slider_label, start=q.low, end=q.high, step=q.step,
+                               value=getattr(dashboard, name), format=q.format,
                                css_classes=[f"ctl-{name}"], sizing_mode="stretch_width")
         widget.param.watch(partial(self._set_control, name), "value_throttled")
         if name in PREVIEWED:  # the operating point: a preview follows the held slider

@@ -12,16 +12,21 @@ locus, time histories, tables); its pieces have modules of their own:
 * :mod:`.session` — the served session's document, its URL query, showing results with its lock.
 
 The views (modes, nonlinear creep, sensitivity, studies, variant, design loads, resonances) get the
-dashboard object and use its public interface only: ``state()``, ``alive()``, ``post(doc,
-function, *args)``, ``run_locked(function, *args)``, ``warn(text)``, ``clear_warning()``,
-``when_shown(tab, function, *args)``, ``flush_view(tab)``, ``params_path``, ``set_key``,
-``study_owner`` (the session's claim in the server's study queue), ``show_history(key,
-history)`` and ``show_companion(key, history)`` (the nonlinear view: which history the peak
-table describes, and the nonlinear one beside an unbounded linear one), ``show_mode(mode,
-where)`` (a mode picked elsewhere, shown in the Modes view), the parameters, the
-last valid results (``point``, ``response``, ``history``, ``locus_result``), the nonlinear view's
-creep switch and anti-slip key (``nonlinear``) and the plots they draw on.  A rejected parameter
-combination shows a notice and keeps the last valid results on screen.
+dashboard object and use its public interface only: ``state()`` (the case record on the
+controls, :class:`app.results.case.Case`), ``latest`` (the newest one, readable from any thread),
+``sweep()``, ``alive()``, ``post(doc, function, *args)``, ``run_locked(function, *args)``,
+``warn(text)``, ``clear_warning()``, ``when_shown(tab, function, *args)``, ``flush_view(tab)``,
+``base_key``, ``set_key``, ``study_owner`` (the session's claim in the server's study queue),
+``show_history(key, history)`` and ``show_companion(key, history)`` (the nonlinear view: which
+history the peak table describes, and the nonlinear one beside an unbounded linear one),
+``show_mode(mode, where)`` (a mode picked elsewhere, shown in the Modes view), the parameters,
+the last valid results (``point``, ``response``, ``history``, ``locus_result``), the nonlinear
+view's creep switch and anti-slip key (``nonlinear``) and the plots they draw on.  A rejected
+parameter combination shows a notice and keeps the last valid results on screen.
+
+The case's quantities (:data:`app.results.case.QUANTITIES`) are the dashboard's parameters
+(:func:`app.dashboard.controls.case_parameters`): a new quantity is a new parameter, slider,
+link argument and part of :meth:`BogieDashboard.state` without a line here.
 """
 
 from __future__ import annotations
@@ -33,7 +38,7 @@ import panel as pn
 import param
 
 from app.dashboard import layout
-from app.dashboard.controls import PUBLISHED_SPEED_KMH, Controls
+from app.dashboard.controls import PUBLISHED_SPEED_KMH, Controls, automatic_name, case_parameters
 from app.dashboard.design_loads_view import DesignLoadsView
 from app.dashboard.downloads import Downloads
 from app.dashboard.drag_preview import DragPreview
@@ -44,12 +49,12 @@ from app.dashboard.resonance_view import ResonanceView
 from app.dashboard.scheduler import Scheduler
 from app.dashboard.sensitivity_view import SensitivityView
 from app.dashboard.session import post, run_locked, served_document, session_query
-from app.dashboard.stages import State, key_value
 from app.dashboard.studies_view import StudiesView
 from app.dashboard.url_state import make_query, parse_query
 from app.dashboard.variant_view import VariantView
 from app.dashboard.verdicts_view import VerdictsView
 from app.results import compute
+from app.results.case import Case, CaseBase, Sweep
 from app.results.eigenvalue_sweep import Fig6Plot
 from app.results.plots import CreepPlot, ModeShapePlot, ResponsePlots, RootLocusPlot
 from app.results.tables import eigen_table_html, peaks_html
@@ -59,73 +64,62 @@ skip_detached_markup_models()  # the views' tabs are dynamic (app/dashboard/pane
 # the page loads the script of each extension model up front: the mode table (Tabulator) sits in
 # a tab that reaches the browser only when it is opened
 pn.extension("tabulator")
-# the parameters whose change is computed (the others only change the view)
-COMPUTED = ["s0", "v", "N0", "b_M", "M0", "f", "D", "dt_auto", "dt", "t_end", "rail", "locus",
-            "variant"]
-
 
 class BogieDashboard(pn.viewable.Viewer):
     """Stability and short-circuit load of the bogie at one operating point."""
 
-    s0 = param.Number(0.005, bounds=(0.0005, 0.03), doc="longitudinal creepage s0 [-]")
-    v = param.Number(120.0, bounds=(10.0, 250.0), doc="speed v [km/h]")
-    N0 = param.Number(100.0, bounds=(40.0, 160.0), doc="static wheel force N0 [kN]")
-    b_M = param.Number(3000.0, bounds=(0.0, 20000.0), doc="motor slope b_M [N m s/rad]")
-    M0 = param.Number(50.0, bounds=(0.0, 200.0), doc="short-circuit amplitude M0 [kN m]")
-    f = param.Number(90.0, bounds=(10.0, 300.0), doc="short-circuit frequency f [Hz]")
-    D = param.Number(0.04, bounds=(0.0, 0.3), doc="short-circuit decay D [-]")
-    dt_auto = param.Boolean(True, doc="Δt such that the motor torque is continuous at t = 0")
-    dt = param.Number(0.0, bounds=(-10.0, 10.0), doc="short-circuit time shift Δt [ms]")
-    t_end = param.Number(2.0, bounds=(0.2, 5.0), doc="simulated time [s]")
-    rail = param.Selector(default="calibrated", objects=list(compute.RAIL_CONDITIONS),
-                          doc="rail condition (creep law)")
+    case_type = Case  # the record of the case's quantities (their declarations: case_type.quantities)
+    locals().update(case_parameters(Case.quantities))  # one parameter per quantity
     locus = param.Selector(default="s0", objects=["s0", "v"], doc="root locus over s0 or v")
     zoom = param.Selector(default="all", objects=["all", "low"], doc="root locus view")
     mode = param.Integer(1, bounds=(1, compute.N_COMPLEX_TABLE), doc="mode shown (ν)")
     variant = param.String("", doc="design variant: differences from the bundled set, "
                                    "name:value,… in SI units (app.results.variants)")
 
-    def __init__(self, params_path: str | None = None, query=None, **params):
-        """``params_path``: the bundled parameter file (None: the calibrated set); ``query``:
-        URL query arguments to restore (served: the session's, app.dashboard.url_state); ``params``:
-        parameter values (they win over the query)."""
+    def __init__(self, base_key: str | None = None, query=None, **params):
+        """``base_key``: the bundled parameter set (a parameter file; None: the calibrated set),
+        the set a variant refers to; ``query``: URL query arguments to restore (served: the
+        session's, app.dashboard.url_state); ``params``: parameter values (they win over the
+        query)."""
         limit_blas_threads()
         if query is None:
             query = session_query()
         values, variant, query_tab, query_notices = parse_query(
-            query, type(self).param, None, base=str(params_path or ""))
+            query, type(self).param, None, base=str(base_key or ""),
+            quantities=self.case_type.quantities)
         params = {**values, **({"variant": variant} if variant else {}), **params}
         super().__init__(**params)
-        self._params_path = str(params_path or "")
-        base = compute.parameters(self._params_path, "calibrated")
+        self._base_key = str(base_key or "")
+        base = compute.parameters(self._base_key)
         with param.parameterized.discard_events(self):
-            if "N0" not in params:
-                self.N0 = base["wheel_force"] / 1e3
-            if "b_M" not in params:
-                self.b_M = base["motor_slope"]
+            # a quantity whose default is the set's (N0, b_M, …) starts at the set's value
+            for name, value in self.case_type.defaults(base).items():
+                if self.case_type.quantity(name).from_set and name not in params:
+                    setattr(self, name, value)
         self.point: compute.PointResult | None = None  # last valid results
         self.limit: compute.LimitResult | None = None
-        self._limit_for: tuple | None = None  # (rail, v, N0, b_M) of self.limit
+        self._limit_for: CaseBase | None = None  # the limit key of self.limit
         self.locus_result: compute.LocusResult | None = None
-        self.shown_locus: tuple | None = None  # (locus key, dense?) of the locus on screen
+        self.shown_locus: tuple[Sweep, bool] | None = None  # (sweep, dense?) of the locus on screen
         self.response: compute.ResponseView | None = None  # the linear history
         # the history the peak table, the CSV and the report describe: the linear one, or the
         # nonlinear one with nonlinear creep on (None while it is computed); and its key
         self.history: compute.ResponseView | None = None
-        self.history_key: tuple | None = None
+        self.history_key: compute.HistoryKey | None = None
         self._peaks_note = ""  # why there is no history yet
         # beside an unbounded linear history: the nonlinear creep's (show_companion) and its key
         self.companion: compute.ResponseView | None = None
-        self.companion_key: tuple | None = None
+        self.companion_key: compute.HistoryKey | None = None
         self._companion_note = ""
         self.error = ""  # last rejection message ("" if the current parameters are valid)
         self.closed = False  # the served session has ended: nothing more is computed for it
         # the session's claim on its study in the server's queue (Studies and Design loads tabs:
         # one study at a time per session)
         self.study_owner = secrets.token_hex(8)
+        self.latest: CaseBase = self.state()  # the newest state (read by worker threads)
         self.scheduler = Scheduler(self)
         self._build()
-        self.param.watch(self._on_change, COMPUTED)
+        self.param.watch(self._on_change, self.computed_parameters())
         self._restore_tab(query_tab, query_notices)
         self.param.watch(self._share, list(self.param))
         self.tabs.param.watch(self._share, "active")
@@ -148,7 +142,7 @@ class BogieDashboard(pn.viewable.Viewer):
     # --- the page ------------------------------------------------------------------------------
 
     def _build(self) -> None:
-        m = compute.model(self._params_path, "calibrated")
+        m = compute.model(self._base_key)
         self.locus_plot = RootLocusPlot()
         self.fig6 = Fig6Plot()
         self.creep_plot = CreepPlot()
@@ -223,24 +217,41 @@ class BogieDashboard(pn.viewable.Viewer):
         self.closed = True
 
     @property
-    def params_path(self) -> str:
-        """The bundled parameter file in use ("": the calibrated set); the variant, if any,
-        changes it (:attr:`set_key`)."""
-        return self._params_path
+    def base_key(self) -> str:
+        """The key of the bundled parameter set in use (a parameter file; "": the calibrated
+        set); the variant, if any, changes it (:attr:`set_key`)."""
+        return self._base_key
 
     @property
     def set_key(self) -> str:
         """The parameter set in use for app.results.compute: the bundled file, or a variant of it."""
-        return f"{self._params_path}|{self.variant}" if self.variant else self._params_path
+        return f"{self._base_key}|{self.variant}" if self.variant else self._base_key
 
-    def state(self) -> State:
-        """The parameters as the primitives a computation depends on (:mod:`app.dashboard.stages`)."""
-        rnd = lambda x, n=6: float(round(x, n))  # noqa: E731 - cache keys without float noise
-        return State(self.set_key, self.rail, key_value("s0", self.s0), key_value("v", self.v),
-                     key_value("N0", self.N0), key_value("b_M", self.b_M), rnd(self.M0, 3),
-                     rnd(self.f, 3),
-                     rnd(self.D, 5), None if self.dt_auto else rnd(self.dt, 4), rnd(self.t_end, 3),
-                     self.locus)
+    def computed_parameters(self) -> list[str]:
+        """The parameters whose change is computed (the others only change the view): every
+        quantity's, its "automatic" switch, the root locus's sweep and the variant."""
+        names = []
+        for q in self.case_type.quantities:
+            names += [automatic_name(q), q.name] if q.automatic else [q.name]
+        return [*names, "locus", "variant"]
+
+    def state(self) -> CaseBase:
+        """The case on the controls (:class:`app.results.case.Case`): what a computation depends
+        on, each value rounded as the record keeps it (no float noise in the cache's keys)."""
+        values = {}
+        for q in self.case_type.quantities:
+            automatic = q.automatic and getattr(self, automatic_name(q))
+            values[q.name] = None if automatic else getattr(self, q.name)
+        return self.case_type(set_key=self.set_key, **values)
+
+    def sweep(self, case: CaseBase | None = None) -> Sweep:
+        """The root locus on the controls through ``case``'s point (default: the state's)."""
+        return (self.state() if case is None else case).sweep(self.locus)
+
+    def state_changed(self, case: CaseBase, settled) -> None:
+        """The views that compute from every state start (called with the session's lock):
+        the verdict, once ``settled`` (a future: the state's follow-ups have ended)."""
+        self.verdicts.request(case, after=settled)
 
     def post(self, doc, function, *args) -> None:
         """``function(*args)`` on the session's next tick, with its document lock; nothing if the
@@ -321,13 +332,14 @@ class BogieDashboard(pn.viewable.Viewer):
     # --- computing and showing results ---------------------------------------------------------
 
     def _on_change(self, *_events) -> None:
+        self.latest = self.state()
         doc = served_document()
         if doc is None:
             self.scheduler.refresh()
         else:
             self.scheduler.request(doc)
 
-    def show_fast(self, state: State, fast) -> None:
+    def show_fast(self, state: CaseBase, fast) -> None:
         """Show the first answer ``(point result, response result)`` for ``state``."""
         point, response = fast
         self.drag_preview.end()
@@ -340,22 +352,18 @@ class BogieDashboard(pn.viewable.Viewer):
         self.when_shown("modes", self._show_modes, point)
         self.locus_plot.zoom(self.zoom == "low")
         # the sensitivity tornado is computed when its tab is open, shown when ready
-        self.when_shown("sensitivity", self.sensitivity.request, self, state)
+        self.when_shown("sensitivity", self.sensitivity.request, state)
         self.when_shown("design-loads", self.design_loads.request_worst_case, state)
         self.resonances.request(state)  # computed while its tab is open
-        # the indicator is on the first screen; served, it is computed after the root locus's
-        # and s0*(v)'s follow-ups (Scheduler._limit_done)
-        self.verdicts.request(state, after_follow_ups=True)
         # the nonlinear result follows; the peak table shows the history of the creep model in
         # use (show_history, called by the nonlinear view)
         self.nonlinear.on_fast(state)
 
-    def show_history(self, key: tuple, history: compute.ResponseView | None,
+    def show_history(self, key: compute.HistoryKey, history: compute.ResponseView | None,
                      note: str = "") -> None:
         """The history the peak table, its limit crossings, the CSV download and the report
         describe: the linear one, or the nonlinear one when the nonlinear creep model is on
-        (``history`` None: not ready, ``note`` says why).  ``key``: its arguments of
-        :func:`app.results.compute.history_result`."""
+        (``history`` None: not ready, ``note`` says why).  ``key``: which history."""
         self.history, self.history_key = history, key
         self._peaks_note = note
         self._show_peaks()
@@ -363,12 +371,11 @@ class BogieDashboard(pn.viewable.Viewer):
         if history is not None:
             self.when_shown("design-loads", self.design_loads.show_history, key, history)
 
-    def show_companion(self, key: tuple | None, companion: compute.ResponseView | None,
-                       note: str = "") -> None:
+    def show_companion(self, key: compute.HistoryKey | None,
+                       companion: compute.ResponseView | None, note: str = "") -> None:
         """The nonlinear creep's history beside a linear one that grows without bound (the peak
         table's physical answer at an unstable point; ``companion`` None: not ready or not
-        wanted, ``note`` says why).  ``key``: its arguments of
-        :func:`app.results.compute.history_result` (None: none)."""
+        wanted, ``note`` says why).  ``key``: which history (None: none)."""
         self.companion, self.companion_key, self._companion_note = companion, key, note
         self._show_peaks()
 
@@ -383,7 +390,7 @@ class BogieDashboard(pn.viewable.Viewer):
         (raises what the model raises)."""
         if self.history is not None:
             return self.history
-        return compute.history_result(*self.history_key)
+        return self.history_key.result
 
     def _show_modes(self, point: compute.PointResult) -> None:
         """The Modes tab: eigenvalue table, mode table, mode choice and the selected mode."""
@@ -401,19 +408,19 @@ class BogieDashboard(pn.viewable.Viewer):
             self.click.show_point_mode()
             self.sensitivity.show(mode=self.mode)
 
-    def show_limit(self, state: State, limit: compute.LimitResult) -> None:
+    def show_limit(self, state: CaseBase, limit: compute.LimitResult) -> None:
         """Show the stability limit s0*(v) computed for ``state``."""
-        self.limit, self._limit_for = limit, state.limit_key
+        self.limit, self._limit_for = limit, state.limit_key()
         self.creep_plot.update_limit(limit)
         self.when_shown("fig-6", self.fig6.update_limit, limit.s0_limit)
         self._show_status()
 
-    def show_locus(self, state: State, locus: compute.LocusResult) -> None:
-        """Show the root locus computed for ``state`` (nothing if another sweep is shown now)."""
-        if self.state().locus_key != state.locus_key:
+    def show_locus(self, sweep: Sweep, locus: compute.LocusResult) -> None:
+        """Show the root locus computed for ``sweep`` (nothing if another sweep is shown now)."""
+        if self.sweep() != sweep:
             return  # a late result of a sweep no longer shown
         self.locus_result = locus
-        self.shown_locus = (state.locus_key, locus.dense)
+        self.shown_locus = (sweep, locus.dense)
         self.locus_plot.update_locus(locus)
         self.when_shown("fig-6", self.fig6.update_locus, locus)
         self.locus_plot.zoom(self.zoom == "low")
@@ -432,8 +439,8 @@ class BogieDashboard(pn.viewable.Viewer):
         word = "STABLE" if point.stable else "UNSTABLE"
         self.status.object = (f'<div class="status-box {"ok" if point.stable else "bad"}">'
                               f"{word}</div>")
-        s0, v_kmh = point.key[2], point.key[3]
-        if self.limit is None or self._limit_for != (point.key[1], *point.key[3:]):
+        s0, v_kmh = point.case.s0, point.case.v
+        if self.limit is None or self._limit_for != point.case.limit_key():
             limit = "s0*(v): computing…"
         elif self.limit.s0_limit is None:
             limit = f"s0*(v): none ({html.escape(self.limit.message)})"

@@ -16,7 +16,7 @@ disc clutch, claw clutch torques, gear mesh force; ID1 and ID2) at the dashboard
 
 The computations run off the main thread when served, on the shared pools of
 :mod:`app.services.thread_pools` with one waiting request per session and kind
-(``LatestRequest``), and only while the tab is shown (the dashboard calls
+(:class:`app.dashboard.jobs.ViewJob`), and only while the tab is shown (the dashboard calls
 :meth:`DesignLoadsView.request_worst_case` and :meth:`DesignLoadsView.show_history` through
 ``when_shown``).  The nonlinear history's spectrum runs on the nonlinear creep model's own
 worker, after that history (one worker: it never computes the same history twice).
@@ -25,18 +25,18 @@ worker, after that history (one worker: it never computes the same history twice
 from __future__ import annotations
 
 import html
-import logging
 from functools import partial
 
 import panel as pn
 
 from app.dashboard.envelope_grid import EnvelopeGrid
+from app.dashboard.jobs import ViewJob
 from app.results import compute
+from app.results.case import CaseBase
 from app.results.load_plots import LoadCollectivePlot, RainflowMatrixPlot, WorstCasePlot
 from app.results.tables import spectra_html, worst_case_html
-from app.services.thread_pools import FOLLOW_UP_POOL, NONLINEAR_POOL, LatestRequest
+from app.services.thread_pools import FOLLOW_UP_POOL, NONLINEAR_POOL
 
-log = logging.getLogger(__name__)
 PARTS = {compute.PART_LABELS[part]: part for part in compute.PARTS}
 INTRO = """The largest load each drive part can see decides its size.  The short circuit's time
 shift Δt was not published: the **worst case over every fault instant** (linear creep, closed
@@ -54,14 +54,12 @@ class DesignLoadsView:
         ``point``, ``nonlinear``) and what :class:`app.dashboard.envelope_grid.EnvelopeGrid`
         reads; ``queue``: the server's study queue (default: the process's)."""
         self.dash = dashboard
-        self._worst_requests = LatestRequest(FOLLOW_UP_POOL, dashboard.alive)
-        self._spectra_requests = LatestRequest(NONLINEAR_POOL, dashboard.alive)
+        self._worst_job = ViewJob(FOLLOW_UP_POOL, dashboard.alive, "worst case")
+        self._spectra_job = ViewJob(NONLINEAR_POOL, dashboard.alive, "load spectrum")
         self.worst: compute.WorstCaseView | None = None  # shown
         self.spectra: compute.SpectraView | None = None  # shown
         self.nonlinear_history: compute.ResponseView | None = None  # overlaid (nonlinear creep)
-        self._wanted_worst: tuple | None = None
-        self._wanted_spectra: tuple | None = None
-        self._spectra_key: tuple | None = None  # the key of the spectra shown
+        self._spectra_key: compute.HistoryKey | None = None  # the key of the spectra shown
         self.part = pn.widgets.RadioButtonGroup(options=PARTS, value="disc_clutch.torque",
                                                 css_classes=["ctl-loads-part"])
         self.worst_note = pn.pane.HTML("", css_classes=["loads-worst-note"],
@@ -95,87 +93,46 @@ class DesignLoadsView:
 
     # --- requests ------------------------------------------------------------------------------
 
-    @staticmethod
-    def _served_doc():
-        doc = pn.state.curdoc
-        return doc if doc is not None and doc.session_context is not None else None
-
-    def _compute(self, requests: LatestRequest, function, key: tuple, wanted, apply,
-                 fail) -> None:
-        """``function(*key)`` on ``requests``' pool when served (at once otherwise), shown with
-        ``apply(key, result)`` if ``wanted()`` is still ``key``; an error goes to
-        ``fail(key, error)``."""
-        doc = self._served_doc()
-        if doc is None:
-            try:
-                result = function(*key)
-            except Exception as error:  # shown as a note; the dashboard stays alive
-                fail(key, error)
-                return
-            apply(key, result)
-            return
-
-        def if_wanted():
-            return function(*key) if wanted() == key else None
-
-        def done(future) -> None:
-            if future.cancelled() or wanted() != key:
-                return
-            error = future.exception()
-            if error is not None:
-                self.dash.post(doc, fail, key, error)
-            elif future.result() is not None:
-                self.dash.post(doc, apply, key, future.result())
-
-        requests.submit(if_wanted).add_done_callback(done)
-
-    def request_worst_case(self, state) -> None:
+    def request_worst_case(self, state: CaseBase) -> None:
         """The worst case over every fault instant at the dashboard's ``state`` (its point, the
         excitation and the simulated time)."""
-        key = (*state.point, state.M0, state.f, state.D, state.dt, state.t_end)
-        self._wanted_worst = key
-        if self.worst is not None and self.worst.key == key:
-            self._apply_worst(key, self.worst)  # back to the point shown: its note again
+        if self.worst is not None and self.worst.case == state:
+            self._worst_job.want(state)
+            self._apply_worst(state, self.worst)  # back to the point shown: its note again
             return
         self.worst_note.object = "<i>computing the worst case over every fault instant…</i>"
-        self._compute(self._worst_requests, compute.worst_case_result, key,
-                      lambda: self._wanted_worst, self._apply_worst,
-                      partial(self._failed, self.worst_note, "the worst case"))
+        self._worst_job.start(state, lambda: compute.worst_case_result(state), self._apply_worst,
+                              partial(self._failed, self.worst_note, "the worst case"))
 
-    def show_history(self, key: tuple, history: compute.ResponseView) -> None:
+    def show_history(self, key: compute.HistoryKey, history: compute.ResponseView) -> None:
         """The history on screen changed (the linear one, or the nonlinear one with nonlinear
-        creep on): overlay it and count its cycles.  ``key``: its arguments of
-        :func:`app.results.compute.history_result`."""
+        creep on): overlay it and count its cycles.  ``key``: which history."""
         self.nonlinear_history = history if history.nonlinear else None
         if self.worst is not None:
             self._redraw_worst()
-        self._wanted_spectra = key
         if self.spectra is not None and self._spectra_key == key:
+            self._spectra_job.want(key)
             self._apply_spectra(key, self.spectra)
             return
         self.spectra_note.object = "<i>counting the cycles…</i>"
-        self._compute(self._spectra_requests, compute.spectra_result, key,
-                      lambda: self._wanted_spectra, self._apply_spectra,
-                      partial(self._failed, self.spectra_note, "the load spectrum"))
+        self._spectra_job.start(key, lambda: compute.spectra_result(key.case, key.anti_slip),
+                                self._apply_spectra,
+                                partial(self._failed, self.spectra_note, "the load spectrum"))
 
-    def _failed(self, note, what: str, key: tuple, error: Exception) -> None:
-        if not isinstance(error, ValueError | ArithmeticError):
-            log.error("%s failed", what, exc_info=error)
+    def _failed(self, note, what: str, _key, error: BaseException) -> None:
         message = error.args[0] if error.args else type(error).__name__
         note.object = f"<i>{what} is not available here: {html.escape(str(message))}</i>"
 
     # --- showing -------------------------------------------------------------------------------
 
-    def _apply_worst(self, key: tuple, worst: compute.WorstCaseView) -> None:
-        if key != self._wanted_worst:
-            return
+    def _apply_worst(self, case: CaseBase, worst: compute.WorstCaseView) -> None:
         self.worst = worst
         self.worst_table.object = worst_case_html(worst)
         point = self.dash.point
-        s0, v_kmh = key[2], key[3]
-        text = (f"At s0 = {s0:g}, v = {v_kmh:g} km/h, rail {html.escape(key[1])}: linear creep, "
-                "closed form over every fault instant Δt (totals: pre-fault + perturbation).")
-        if point is not None and point.key == key[:6] and not point.stable:
+        text = (f"At s0 = {case.s0:g}, v = {case.v:g} km/h, rail {html.escape(case.rail)}: "
+                "linear creep, closed form over every fault instant Δt (totals: pre-fault + "
+                "perturbation).")
+        if point is not None and point.case == case.point() and not point.stable:
             text += (" <b>The operating point is unstable:</b> the linear response grows "
                      "without bound, and so does its worst case — it says “unstable”, not a "
                      "design load.  The nonlinear creep model bounds the history (the creep "
@@ -186,9 +143,7 @@ class DesignLoadsView:
         self.worst_note.object = f"<div style='font-size:13px'>{text}</div>"
         self._redraw_worst()
 
-    def _apply_spectra(self, key: tuple, spectra: compute.SpectraView) -> None:
-        if key != self._wanted_spectra:
-            return
+    def _apply_spectra(self, key: compute.HistoryKey, spectra: compute.SpectraView) -> None:
         self.spectra, self._spectra_key = spectra, key
         self.spectra_table.object = spectra_html(spectra)
         point = self.dash.point
@@ -196,7 +151,7 @@ class DesignLoadsView:
                 f"(Δt = {spectra.fault_instant * 1e3:.4g} ms), the one the Response tab's peak "
                 "table describes.")
         if spectra.history == compute.LINEAR_HISTORY and point is not None \
-                and point.key == key[:6] and not point.stable:
+                and point.case == key.case.point() and not point.stable:
             text += (" <b>Unstable point, linear creep:</b> this is the spectrum of a blow-up "
                      "and means nothing; switch the creep model to nonlinear.")
         self.spectra_note.object = f"<div style='font-size:13px'>{text}</div>"

@@ -14,7 +14,7 @@ import json
 import numpy as np
 import panel as pn
 
-from app.report.page import build_report
+from app.report.page import ReportHistory, build_report
 from app.results import compute
 from model.mechanics.parameters import dumps_parameters
 
@@ -67,8 +67,9 @@ class Downloads:
         p = self.dashboard.point
         lam = p.eigenvalues
         order = np.lexsort((lam.real, lam.imag))
-        data = {"operating_point": {"s0": p.key[2], "v_kmh": p.key[3], "N0": p.key[4] * 1e3,
-                                    "b_M": p.key[5], "rail": p.key[1]},
+        # the point's quantities by their file keys, in the files' units (SI, v in km/h)
+        point = {key: value for key, value in p.case.files().items() if value is not None}
+        data = {"operating_point": point,
                 "stable": p.stable, "max_real_part": p.max_real_part, "flutter_pairs": p.flutter,
                 "divergent_real": p.divergence, "rigid_body": p.n_rigid,
                 "modes": [{"nu": m.number, "re": m.eigenvalue.real, "im_hz": m.im_hz,
@@ -80,18 +81,16 @@ class Downloads:
     def parameters_toml(self) -> io.StringIO:
         """The parameter set in use (variant applied, rail condition's creep law), as TOML."""
         state = self.dashboard.state()
-        p = compute.parameters(state.params_path, state.rail)
+        p = compute.parameters_for(state)
+        point = ", ".join(q.said(getattr(state, q.name)) for q in state.of_role("point"))
         header = (f"parameter set in use by the dashboard (rail condition: {state.rail})\n"
-                  f"operating point: s0 = {state.s0}, v = {state.v} km/h, N0 = {state.N0} kN, "
-                  f"b_M = {state.b_M} N m s/rad")
+                  f"operating point: {point}")
         return io.StringIO(dumps_parameters(p, header))
 
     def report_html(self) -> io.StringIO:
         """The self-contained HTML report of the current state (:mod:`app.report.page`)."""
         state = self.dashboard.state()
         key = self.dashboard.history_key
-        anti_slip = key[-1] if key is not None else None  # None: linear creep
-        return io.StringIO(build_report(state.params_path, state.rail, state.s0, state.v,
-                                        state.N0, state.b_M, state.M0, state.f, state.D,
-                                        state.dt, state.t_end, anti_slip=anti_slip,
-                                        companion_anti_slip=self.dashboard.nonlinear.valid))
+        history = ReportHistory(None if key is None else key.anti_slip,  # None: linear creep
+                                self.dashboard.nonlinear.valid)
+        return io.StringIO(build_report(state, history))

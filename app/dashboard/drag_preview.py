@@ -8,7 +8,7 @@ A slider sends its ``value`` while it is dragged and ``value_throttled`` when it
 what is known already, at most one reduced eigenproblem, never a dense eigen-analysis).  The
 previews of a session never queue: one runs at a time on the preview pool
 (:data:`app.services.thread_pools.PREVIEW_POOL`, below the first answers' priority) and only the
-newest value waits (:class:`app.services.thread_pools.LatestRequest`).  A release, a full answer
+newest value waits (:class:`app.dashboard.jobs.ViewJob`).  A release, a full answer
 or a rejection ends the drag: a preview still running is not shown.  Previews start with a
 slider's second value before its release: a keyboard step sends one value and its release, and
 gets no preview, only its full answer.
@@ -17,17 +17,15 @@ gets no preview, only its full answer.
 from __future__ import annotations
 
 import html
-import logging
 import math
-from dataclasses import replace
 from functools import partial
 
-from app.dashboard.session import post, served_document
-from app.dashboard.stages import MODEL_ERRORS, State, key_value
+from app.dashboard.jobs import ViewJob
+from app.dashboard.session import served_document
+from app.dashboard.stages import MODEL_ERRORS
+from app.results.case import CaseBase
 from app.results.preview import PREVIEWED, Preview, describe, preview
-from app.services.thread_pools import PREVIEW_POOL, LatestRequest
-
-log = logging.getLogger(__name__)
+from app.services.thread_pools import PREVIEW_POOL
 
 
 class DragPreview:
@@ -41,7 +39,7 @@ class DragPreview:
 
     def __init__(self, dashboard):
         self.dashboard = dashboard
-        self._requests = LatestRequest(PREVIEW_POOL, dashboard.alive)
+        self._job = ViewJob(PREVIEW_POOL, dashboard.alive, "preview")
         self._drag = 0  # the drag a preview belongs to: a release or a full answer ends it
         self._saved_status: str | None = None  # the status the previews cover while shown
         self._preview_html = ""  # the status pane's text while a preview is shown
@@ -87,23 +85,22 @@ class DragPreview:
         if not (math.isfinite(value) and low <= value <= high):
             return  # only a doctored client sends one; its release gets the notice
         committed = dashboard.state()
-        state = replace(committed, **{name: key_value(name, value)})
+        state = committed.replace(**{name: value})
         if state == committed:  # dragged back to the value on screen (or released there)
             self.end()
             return
         drag = self._drag
-        if doc is None:  # without a server (tests): at once
-            self._show(drag, name, state, self._compute(drag, name, state))
-            return
-        future = self._requests.submit(self._compute, drag, name, state)
-        future.add_done_callback(partial(self._computed, doc, drag, name, state))
+        shown = dashboard.shown_locus
+        sweep = shown[0] if shown is not None else dashboard.sweep(state)
+        self._job.start((drag, name, state), partial(self._compute, name, state, sweep),
+                        lambda _key, result: self._show(drag, name, state, result), doc=doc)
 
     def release(self) -> None:
         """The slider is let go (or stepped by a key): previews not yet shown are dropped."""
         self._drag += 1
         self._moves = 0
         self._waiting = None
-        self._requests.cancel()
+        self._job.forget()
 
     def end(self) -> None:
         """A full answer (or a rejection) is shown: the preview is taken down (call with the
@@ -120,28 +117,15 @@ class DragPreview:
 
     # --- computing and showing --------------------------------------------------------------------
 
-    def _compute(self, drag: int, name: str, state: State) -> Preview | None:
-        """The preview (None: superseded, or the point is invalid)."""
-        if drag != self._drag:
-            return None
-        shown = self.dashboard.shown_locus
-        locus_key = shown[0] if shown is not None else state.locus_key
+    @staticmethod
+    def _compute(name: str, state: CaseBase, sweep) -> Preview | None:
+        """The preview (None: the point is invalid)."""
         try:
-            return preview(state.point, locus_key, name)
+            return preview(state, sweep, name)
         except MODEL_ERRORS:
             return None
 
-    def _computed(self, doc, drag: int, name: str, state: State, future) -> None:
-        if future.cancelled():
-            return
-        error = future.exception()
-        if error is not None:
-            log.error("preview failed", exc_info=error)
-            return
-        if future.result() is not None:
-            post(doc, self._show, drag, name, state, future.result())
-
-    def _show(self, drag: int, name: str, state: State, result: Preview | None) -> None:
+    def _show(self, drag: int, name: str, state: CaseBase, result: Preview | None) -> None:
         dashboard = self.dashboard
         if result is None or drag != self._drag or dashboard.state() == state:
             return

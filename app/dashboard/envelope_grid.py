@@ -36,23 +36,20 @@ import panel as pn
 from app.dashboard.queued_study import QueuedStudyControls
 from app.dashboard.url_state import fit_phase, scenario_query
 from app.results import compute
+from app.results.case import Case
 from app.results.load_plots import EnvelopeMapPlot
 from app.results.tables import format_load
 from app.services.study_queue import StudyQueue, StudyTicket, study_queue
-from model.mechanics.operating_point import KMH
 
 log = logging.getLogger(__name__)
+# the quantities an envelope varies -> (slider step, slider format) of its range controls; the
+# label, unit, dashboard parameter and SI factor are the quantity's (app.results.case)
+AXIS_STEPS = {"s0": (0.0005, "0.0000"), "v": (5.0, "0"), "N0": (5.0, "0"), "b_M": (250.0, "0"),
+              "M0": (5.0, "0"), "f": (5.0, "0"), "D": (0.005, "0.000")}
 # axis -> (label, display unit, dashboard parameter, SI value per display unit, slider step,
-# slider format, store dimension)
-AXES = {
-    "s0": ("creepage s0", "-", "s0", 1.0, 0.0005, "0.0000"),
-    "v": ("speed v", "km/h", "v", KMH, 5.0, "0"),
-    "N0": ("wheel force N0", "kN", "N0", 1e3, 5.0, "0"),
-    "b_M": ("motor slope b_M", "N m s/rad", "b_M", 1.0, 250.0, "0"),
-    "M0": ("short-circuit amplitude M0", "kN m", "M0", 1e3, 5.0, "0"),
-    "f": ("short-circuit frequency f", "Hz", "f", 1.0, 5.0, "0"),
-    "D": ("short-circuit decay D", "-", "D", 1.0, 0.005, "0.000"),
-}
+# slider format)
+AXES = {name: (Case.quantity(name).label, Case.quantity(name).unit, name, Case.quantity(name).si,
+               *steps) for name, steps in AXIS_STEPS.items()}
 DEFAULT_RANGES = {"s0": (0.002, 0.012), "v": (60.0, 200.0), "N0": (80.0, 120.0),
                   "b_M": (1000.0, 5000.0), "M0": (25.0, 100.0), "f": (50.0, 150.0),
                   "D": (0.02, 0.1)}
@@ -145,7 +142,7 @@ def envelope_rows(data: EnvelopeData):
 class EnvelopeGrid(QueuedStudyControls):
     """Ask the server for a grid envelope at the dashboard's point; follow it; open a finished
     one.  The dashboard provides ``param`` (its parameters and their bounds), ``nonlinear`` (the
-    creep switch and the anti-slip key in use), ``params_path``, ``set_key``, ``study_owner``,
+    creep switch and the anti-slip key in use), ``base_key``, ``set_key``, ``study_owner``,
     ``variant`` and ``run_locked``."""
 
     UNIT, WHAT = "chunks", "envelope"
@@ -297,11 +294,12 @@ class EnvelopeGrid(QueuedStudyControls):
         grid[y_axis] = self._axis_values(y_axis, self.range_y.value, counts[1])
         si = {axis: tuple(float(x) for x in grid[axis] * AXES[axis][3]) for axis in AXES}
         # the dashboard's set (its variant included); the study applies the rail's creep law
-        parameters = compute.parameters(d.set_key, "calibrated")
-        model = compute.model(d.set_key, d.rail)
+        case = d.state()
+        parameters = compute.parameters(d.set_key, "calibrated", case.overrides())
+        model = compute.model_for(case)
         creep = "nonlinear" if nonlinear else "linear"
-        first = compute.operating_point(d.set_key, d.rail, grid["s0"][0], grid["v"][0],
-                                        grid["N0"][0], grid["b_M"][0])
+        first = case.replace(**{q.name: grid[q.name][0]
+                                for q in case.of_role("point")}).operating_point()
         outputs, units = resolve_outputs(model, first, list(compute.DRIVE_PARTS), creep)
         protection = {}
         if nonlinear:
@@ -421,7 +419,7 @@ class EnvelopeGrid(QueuedStudyControls):
         from model.mechanics.parameters import parameter_hash
 
         stored = data.attrs.get("parameters_hash")
-        base = self.dashboard.params_path
+        base = self.dashboard.base_key
         for variant in dict.fromkeys((self._variant, self.dashboard.variant, "")):
             key = f"{base}|{variant}" if variant else base
             try:

@@ -125,7 +125,7 @@ class ModeClickThrough:
             return
         mode = point.modes[self.dashboard.mode - 1]
         self.shown = mode
-        s0, v = point.key[2], point.key[3]
+        s0, v = point.case.s0, point.case.v
         self.detail.object = mode_detail_html(mode, f"at the current point s0 = {s0:g}, "
                                                     f"v = {v:g} km/h")
 
@@ -147,8 +147,7 @@ class ModeClickThrough:
         s0, v = (value, state.v) if locus.parameter == "s0" else (state.s0, value)
         re, im = float(data["x"][index]), float(data["y"][index]) * 2 * math.pi
         try:
-            mode = compute.mode_near(state.params_path, state.rail, s0, v, state.N0, state.b_M,
-                                     re, im)
+            mode = compute.mode_near(state.replace(s0=s0, v=v), re, im)
         except Exception as error:  # a model rejection: say so, keep the views
             dashboard.warn(f"Mode at the tapped point not shown: {error}")
             return

@@ -16,8 +16,8 @@ linear one, or with nonlinear creep on the nonlinear one (none while it is compu
 linear creep at an unstable point, the nonlinear history beside the unbounded linear one
 (``dashboard.show_companion``: the peak table's physical answer).  The
 nonlinear histories are computed by :func:`app.results.compute.nonlinear_histories` (the report
-uses them too); the reaction-time search here takes primitives only (``pn.cache`` keys) and
-returns plain read-only data, like :mod:`app.results.compute`.
+uses them too); the reaction-time search here is kept in the results cache like them and
+returns plain read-only data.  Each computation is a :class:`app.dashboard.jobs.ViewJob`.
 """
 
 from __future__ import annotations
@@ -27,15 +27,18 @@ import logging
 import weakref
 from contextvars import ContextVar
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 import panel as pn
 
+from app.dashboard.jobs import ViewJob
+from app.dashboard.session import served_document
 from app.results import compute
-from app.results.compute import NonlinearHistories, nonlinear_histories
+from app.results.cache import Superseded
+from app.results.case import CaseBase
+from app.results.compute import HistoryKey, NonlinearHistories, nonlinear_histories
 from app.results.plots import SeriesSource
-from app.services.thread_pools import NONLINEAR_POOL, SEARCH_POOL, LatestRequest, ignore_outcome
+from app.services.thread_pools import NONLINEAR_POOL, SEARCH_POOL
 from model.analysis.antislip import required_reaction_time
 from model.analysis.nonlinear import AntiSlip, NonlinearError
 
@@ -54,8 +57,9 @@ REACTION_QUIET_MS = 1000  # [ms] the search starts when the operating point has 
 _VIEWS: weakref.WeakSet = weakref.WeakSet()
 
 
-class ReactionSuperseded(Exception):
-    """A reaction search stopped because no session wants its result any more."""
+class ReactionSuperseded(Superseded):
+    """A reaction search stopped because no session wants its result any more (a session
+    waiting for the same search computes it itself)."""
 
 
 _WATCHED: ContextVar[bool] = ContextVar("bogie_reaction_watched", default=False)
@@ -66,13 +70,13 @@ def _stop_unless_wanted(key: tuple) -> None:
         raise ReactionSuperseded(key)
 
 
-def wanted_reaction(*key) -> Reaction:
+def wanted_reaction(case: CaseBase, threshold: float, rate: float) -> Reaction:
     """:func:`reaction` for the dashboard's views: it stops (ReactionSuperseded) as soon as no
-    live view wants ``key`` any more — checked before it starts and after every run of its
-    delay grid.  Called directly, :func:`reaction` always completes."""
+    live view wants it any more — checked before it starts and after every run of its delay
+    grid.  Called directly, :func:`reaction` always completes."""
     token = _WATCHED.set(True)
     try:
-        return reaction(*key)
+        return reaction(case, threshold, rate)
     finally:
         _WATCHED.reset(token)
 
@@ -94,23 +98,28 @@ def anti_slip_key(enabled: bool, delay: float, threshold: float, rate: float) ->
     return (bool(enabled), float(delay), float(threshold), float(rate))
 
 
-@pn.cache(max_items=64)
-def reaction(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
-             M0_kNm: float, f: float, D: float, dt_ms: float | None, threshold: float,
-             rate: float) -> Reaction:
+def reaction_key(case: CaseBase, threshold: float, rate: float) -> tuple:
+    """What a reaction search depends on: the case (its horizon left out: 2 s) and the
+    protection's threshold and rate."""
+    return (case.without("t_end"), float(threshold), float(rate))
+
+
+def reaction(case: CaseBase, threshold: float, rate: float) -> Reaction:
     """Required reaction time against M_ad (model.analysis.antislip) on a coarse grid: 11 delays,
-    5 kHz, 2 s — about 20 nonlinear runs."""
-    key = (params_path, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, threshold, rate)
-    _stop_unless_wanted(key)
-    m = compute.model(params_path, rail)
-    op = compute.operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
-    result = required_reaction_time(
-        m, op, compute.excitation(M0_kNm, f, D, dt_ms),
-        anti_slip=AntiSlip(True, 0.1, threshold, rate),
-        delays=REACTION_DELAYS, t_end=2.0, fs=max(REACTION_FS, 20.0 * float(f)),
-        checkpoint=lambda: _stop_unless_wanted(key))  # between blocks of every run
-    return Reaction(result.required_delay, result.reason, result.detection_time,
-                    result.reaction_after_fault, result.limit)
+    5 kHz, 2 s — about 20 nonlinear runs (kept in the results cache)."""
+    key = reaction_key(case, threshold, rate)
+    point = key[0]
+
+    def search() -> Reaction:
+        _stop_unless_wanted(key)
+        result = required_reaction_time(
+            compute.model_for(point), point.operating_point(), point.short_circuit(),
+            anti_slip=AntiSlip(True, 0.1, threshold, rate),
+            delays=REACTION_DELAYS, t_end=2.0, fs=max(REACTION_FS, 20.0 * float(point.f)),
+            checkpoint=lambda: _stop_unless_wanted(key))  # between blocks of every run
+        return Reaction(result.required_delay, result.reason, result.detection_time,
+                        result.reaction_after_fault, result.limit)
+    return compute.cached("reaction", point, search, key[1], key[2])
 
 
 class NonlinearView:
@@ -118,9 +127,9 @@ class NonlinearView:
 
     def __init__(self, dashboard):
         self.dash = dashboard
-        # one waiting history and one waiting reaction search per session (app.services.thread_pools)
-        self._histories = LatestRequest(NONLINEAR_POOL, dashboard.alive)
-        self._searches = LatestRequest(SEARCH_POOL, dashboard.alive)
+        # one waiting history and one waiting reaction search per session (app.dashboard.jobs)
+        self._histories = ViewJob(NONLINEAR_POOL, dashboard.alive, "nonlinear history")
+        self._searches = ViewJob(SEARCH_POOL, dashboard.alive, "reaction time")
         self.creep = pn.widgets.RadioButtonGroup(
             options=list(CREEP_MODELS), value="linear",
             css_classes=["ctl-creep"], sizing_mode="stretch_width")
@@ -149,12 +158,11 @@ class NonlinearView:
         self.reaction: Reaction | None = None
         self._state = None  # the dashboard state of the linear result on screen
         self._shown_key = None
-        self._reaction_key = None
         self._progress = ""
         _VIEWS.add(self)
-        doc = self._served_doc()
+        doc = served_document()
         if doc is not None:  # a closed session wants no reaction time any more
-            doc.on_session_destroyed(lambda _context: setattr(self, "_reaction_key", None))
+            doc.on_session_destroyed(lambda _context: self._searches.forget())
         self._add_glyphs()
         for widget in (self.creep, self.anti_slip, self.delay, self.threshold, self.rate):
             widget.param.watch(self._on_change, "value")
@@ -206,35 +214,33 @@ class NonlinearView:
 
     # --- requests --------------------------------------------------------------------------
 
-    def _served_doc(self):
-        doc = pn.state.curdoc
-        return doc if doc is not None and doc.session_context is not None else None
-
     def _on_change(self, *_events) -> None:
         if self.dash.point is None or self._state is None:
             return
         self.update()
 
-    def prefetch(self, state) -> None:
+    def prefetch(self, state: CaseBase, doc=None) -> None:
         """Served: start the nonlinear history of ``state`` as soon as the linear first answer
-        is computed (it shares the operating point's eigendecomposition; its result is cached for
-        :meth:`on_fast`), before that answer is sent and drawn."""
+        is computed (it shares the operating point's eigendecomposition; its result is kept for
+        :meth:`on_fast`), before that answer is sent and drawn (``doc``: the session's
+        document)."""
         if self.creep.value != "nonlinear":
             return
         key = self._key(state)
         if key != self._shown_key:
-            future = self._histories.submit(nonlinear_histories, *key)
-            ignore_outcome(future)  # on_fast shows its result or its error
+            self._histories.start(("history", key), lambda: nonlinear_histories(
+                key.case, key.anti_slip), lambda _k, _r: None, doc=doc)
 
     def on_fast(self, state) -> None:
         """Hook: the dashboard has shown the linear result for ``state``."""
         self._state = state
         self.update()
 
-    def _key(self, state=None):
-        """The nonlinear history's cache key for ``state`` (default: the one shown)."""
-        s = self._state if state is None else state
-        return (*s.point, s.M0, s.f, s.D, s.dt, s.t_end, self.valid)
+    def _key(self, state=None, anti_slip=...) -> HistoryKey:
+        """The nonlinear history of ``state`` (default: the one shown) with the anti-slip key
+        in use."""
+        return HistoryKey(self._state if state is None else state,
+                          self.valid if anti_slip is ... else anti_slip)
 
     def update(self) -> None:
         try:
@@ -251,20 +257,28 @@ class NonlinearView:
         if self.creep.value == "linear":
             self._clear()
             self._progress = ""
-            self.dash.show_history((*key[:-1], None), self.dash.response)
+            self.dash.show_history(self._key(anti_slip=None), self.dash.response)
             self._request_companion(key)
         elif key != self._shown_key:
             self._progress = "nonlinear creep: computing…"
             self.dash.show_history(key, None, "computing the nonlinear history…")
-            self._start(key, partial(nonlinear_histories, *key), self._apply_histories)
+            self._start_history("history", key, self._apply_histories)
         else:
+            self._histories.want(("history", key))
             self.dash.show_history(key, self.histories.response)
         if self.creep.value == "nonlinear" and self.dash.companion_key is not None:
             self.dash.show_companion(None, None)  # the table shows the nonlinear history itself
         self._request_reaction()
         self._render_status()
 
-    def _request_companion(self, key) -> None:
+    def _start_history(self, kind: str, key: HistoryKey, apply) -> None:
+        """The nonlinear history ``key`` on the nonlinear creep model's worker (``kind``:
+        "history" shown as such, or "companion" beside a linear one)."""
+        self._histories.start((kind, key), lambda: nonlinear_histories(key.case, key.anti_slip),
+                              lambda _k, histories: apply(key, histories),
+                              lambda _k, error: self._reject(error))
+
+    def _request_companion(self, key: HistoryKey) -> None:
         """Linear creep on: beside a linear history that grows without bound, the nonlinear
         history of ``key`` (the anti-slip controls as set) for the peak table."""
         response = self.dash.response
@@ -275,99 +289,51 @@ class NonlinearView:
         if key == self.dash.companion_key and self.dash.companion is not None:
             return
         self.dash.show_companion(key, None, "computing…")
-        self._start(key, partial(nonlinear_histories, *key), self._apply_companion)
+        self._start_history("companion", key, self._apply_companion)
 
-    def _apply_companion(self, key, histories: NonlinearHistories) -> None:
+    def _apply_companion(self, key: HistoryKey, histories: NonlinearHistories) -> None:
         if self.creep.value != "linear" or key != self._key():
             return  # superseded
         self.dash.show_companion(key, histories.response)
 
     def _reaction_key_of(self, state) -> tuple:
-        """The reaction search's cache key at the dashboard ``state``."""
-        return (*state.point, state.M0, state.f, state.D, state.dt, self.valid[2], self.valid[3])
+        """The reaction search's key at the dashboard ``state``."""
+        return reaction_key(state, self.valid[2], self.valid[3])
 
     def wants_reaction(self, key: tuple) -> bool:
         """Whether this view still waits for the reaction search ``key`` (any thread): the one it
         asked for, its session open, and the sliders not moved on since (a change whose linear
-        answer is still being computed stops the search at once, not when that answer is shown)."""
-        return (key == self._reaction_key and self.dash.alive()
-                and self._reaction_key_of(self.dash.state()) == key)
+        answer is still being computed stops the search at once, not when that answer is
+        shown; ``dash.latest`` is the newest state, set on the session's event loop)."""
+        return (key == self._searches.wanted and self.dash.alive()
+                and self._reaction_key_of(self.dash.latest) == key)
 
     def _request_reaction(self) -> None:
         point = self.dash.point
         if point is None or point.stable:
-            self.reaction, self._reaction_key = None, None
+            self.reaction = None
+            self._searches.forget()
             return
         key = self._reaction_key_of(self._state)
-        if key == self._reaction_key and self.reaction is not None:
+        if key == self._searches.wanted and self.reaction is not None:
             return
-        self._reaction_key = key
         self.reaction = None
-        self._start(key, partial(wanted_reaction, *key), self._apply_reaction)
+        # a reaction-time search (tens of nonlinear runs, mostly Python: it holds the GIL most
+        # of the time, which thread priorities cannot take away) starts only when the
+        # operating point has stayed for REACTION_QUIET_MS: not while a slider is stepped
+        self._searches.start(key, lambda: wanted_reaction(*key), self._apply_reaction,
+                             lambda _k, error: self._reject(error), delay_ms=REACTION_QUIET_MS)
 
-    def _start(self, key, work, apply) -> None:
-        doc = self._served_doc()
-        if doc is None:  # tests without a server: synchronous
-            try:
-                apply(key, work())
-            except compute.ModelRejected as error:
-                self._reject(error)
-            except (NonlinearError, ValueError, np.linalg.LinAlgError) as error:
-                self._reject(error)
-            return
-
-        def if_current():
-            return work() if self._current(key, apply) else None
-
-        # workers of their own (app.services.thread_pools), at a lower priority than the linear first answer;
-        # a request superseded before it starts is skipped
-        if apply == self._apply_reaction:
-            # a reaction-time search (tens of nonlinear runs, mostly Python: it holds the GIL
-            # most of the time, which thread priorities cannot take away) starts only when the
-            # operating point has stayed for REACTION_QUIET_MS: not while a slider is stepped
-            def start_if_quiet() -> None:
-                if self._current(key, apply):
-                    future = self._searches.submit(if_current)
-                    future.add_done_callback(partial(self._done, doc, key, apply))
-
-            doc.add_timeout_callback(start_if_quiet, REACTION_QUIET_MS)
-            return
-        future = self._histories.submit(if_current)
-        future.add_done_callback(partial(self._done, doc, key, apply))
-
-    def _current(self, key, apply) -> bool:
-        """Whether a request is still the one to show (checked before it starts)."""
-        if apply == self._apply_reaction:
-            return key == self._reaction_key
-        creep = "linear" if apply == self._apply_companion else "nonlinear"
-        return self.creep.value == creep and self._state is not None and key == self._key()
-
-    def _done(self, doc, key, apply, future) -> None:
-        if future.cancelled():
-            return  # replaced by a newer request, or the session has ended
-        error = future.exception()
-        if isinstance(error, ReactionSuperseded):
-            return  # no longer wanted (module comment at _VIEWS)
-        if error is not None:
-            if not isinstance(error, ValueError | np.linalg.LinAlgError):
-                log.error("nonlinear computation failed", exc_info=error)
-            self.dash.post(doc, self._reject, error)
-            return
-        if future.result() is not None:
-            self.dash.post(doc, apply, key, future.result())
-
-    def _apply_histories(self, key, histories: NonlinearHistories) -> None:
+    def _apply_histories(self, key: HistoryKey, histories: NonlinearHistories) -> None:
         if self.creep.value != "nonlinear" or key != self._key():
             return  # superseded
         self._show(key, histories)
 
-    def _apply_reaction(self, key, result: Reaction) -> None:
-        if key != self._reaction_key:
-            return
+    def _apply_reaction(self, _key, result: Reaction) -> None:
         self.reaction = result
         self._render_status()
 
-    def _reject(self, error: Exception) -> None:
+    def _reject(self, error: BaseException) -> None:
         message = error.args[0] if error.args else str(error)
         if self.creep.value == "nonlinear" and self._state is not None \
                 and self._key() != self._shown_key:

@@ -21,13 +21,19 @@ import logging
 
 import panel as pn
 
+from app.dashboard.jobs import ViewJob
 from app.results import compute, resonance
 from app.results.resonance_plots import CampbellPlot, FrfPlot, RipplePlot
 from app.results.tables import crossings_html
-from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest
+from app.services.thread_pools import SIDE_VIEW_POOL
+from model.analysis.campbell import MOTOR_INPUTS
 from model.mechanics.excitation import DEFAULT_ORDERS, parse_amplitudes, parse_orders
 
 log = logging.getLogger(__name__)
+# the results of the view: kind -> the function of its key (a case record and the settings)
+RESULTS = {"frf": resonance.frf_result, "campbell": resonance.campbell_result,
+           "ripple": resonance.ripple_result}
+
 class ResonanceView:
     """The view, its settings and plots; ``layout`` is what the dashboard's tab shows."""
 
@@ -36,9 +42,9 @@ class ResonanceView:
         self.campbell_plot = CampbellPlot()
         self.frf_plot = FrfPlot()
         self.ripple_plot = RipplePlot()
-        outputs = [name for name, _ in resonance.output_names(dashboard.params_path, "calibrated")]
+        outputs = [name for name, _ in resonance.output_names(dashboard.base_key)]
         self.input = pn.widgets.Select(label="rippling motor (input)",
-                                       options=list(resonance.MOTOR_INPUTS), width=200,
+                                       options=list(MOTOR_INPUTS), width=200,
                                        css_classes=["ctl-resonance-input"])
         self.output = pn.widgets.Select(label="output (FRF and forced response)", options=outputs,
                                         value=resonance.DEFAULT_OUTPUT, width=280,
@@ -62,10 +68,9 @@ class ResonanceView:
         self.ripple_view: resonance.RippleView | None = None
         self._state = None  # the dashboard state of the last request
         self.shown = False  # the view's tab is open (it computes only then)
-        self._wanted: dict[str, tuple] = {}  # kind -> key of the newest request
         self._shown: dict[str, tuple] = {}  # kind -> key of the result on screen
-        self._requests = {kind: LatestRequest(SIDE_VIEW_POOL, dashboard.alive)
-                          for kind in ("frf", "campbell", "ripple")}
+        self._jobs = {kind: ViewJob(SIDE_VIEW_POOL, dashboard.alive, f"resonances ({kind})")
+                      for kind in RESULTS}
         for widget in (self.orders, self.fixed, self.ripple):
             widget.param.watch(self._on_text, "value")
         self.input.param.watch(lambda _e: self._recompute(), "value")
@@ -114,13 +119,14 @@ class ResonanceView:
     # --- computing and showing ------------------------------------------------------------------
 
     def keys(self, state) -> dict[str, tuple]:
-        """The arguments of each result for the dashboard's ``state`` and the view's settings."""
+        """The arguments of each result for the dashboard's ``state`` (a case record) and the
+        view's settings."""
         s = self.settings
         motor = self.input.value
-        common = (state.params_path, state.rail, state.s0, state.N0, state.b_M)
-        return {"frf": (*state.point, motor),
-                "campbell": (*common, s["orders"], s["fixed"], motor),
-                "ripple": (*common, s["ripple"], motor)}
+        over_speed = state.point().without("v")  # the diagrams span the speeds
+        return {"frf": (state.point(), motor),
+                "campbell": (over_speed, s["orders"], s["fixed"], motor),
+                "ripple": (over_speed, s["ripple"], motor)}
 
     def on_shown(self, shown: bool) -> None:
         """The dashboard opened (or left) the view's tab: compute for its state if needed."""
@@ -137,45 +143,24 @@ class ResonanceView:
             return
         self.campbell_plot.mark_speed(state.v)
         self.ripple_plot.mark_speed(state.v)
-        functions = {"frf": resonance.frf_result, "campbell": resonance.campbell_result,
-                     "ripple": resonance.ripple_result}
-        doc = pn.state.curdoc
-        served = doc is not None and doc.session_context is not None
         for kind, key in self.keys(state).items():
-            self._wanted[kind] = key
+            job = self._jobs[kind]
             if self._shown.get(kind) == key:
+                job.want(key)
                 continue
-            if not served:
-                try:
-                    self._apply(kind, key, functions[kind](*key))
-                except Exception as error:
-                    self._failed(kind, key, error)
-                continue
-            self.note.object = "<i>computing the resonances… (the Campbell diagram takes a few " \
-                               "seconds)</i>"
-            future = self._requests[kind].submit(self._if_wanted, kind, key, functions[kind])
-            future.add_done_callback(lambda f, kind=kind, key=key: self._done(doc, kind, key, f))
+            if job.wanted != key:
+                self.note.object = ("<i>computing the resonances… (the Campbell diagram takes a "
+                                    "few seconds)</i>")
+            job.start(key, lambda kind=kind, key=key: RESULTS[kind](*key),
+                      lambda key, result, kind=kind: self._apply(kind, key, result),
+                      lambda key, error, kind=kind: self._failed(kind, key, error))
 
-    def _if_wanted(self, kind: str, key: tuple, function):
-        return function(*key) if self._wanted.get(kind) == key else None
-
-    def _done(self, doc, kind: str, key: tuple, future) -> None:
-        if future.cancelled() or self._wanted.get(kind) != key:
-            return
-        if future.exception() is not None:
-            self.dashboard.post(doc, self._failed, kind, key, future.exception())
-        elif future.result() is not None:
-            self.dashboard.post(doc, self._apply, kind, key, future.result())
-
-    def _failed(self, kind: str, key: tuple, error: Exception) -> None:
-        if self._wanted.get(kind) == key:
-            log.warning("resonances (%s) failed: %s", kind, error)
-            message = error.args[0] if error.args else str(error)
-            self.note.object = f"<i>{kind} not shown: {html.escape(str(message))}</i>"
+    def _failed(self, kind: str, key: tuple, error: BaseException) -> None:
+        log.warning("resonances (%s) failed: %s", kind, error)
+        message = error.args[0] if error.args else str(error)
+        self.note.object = f"<i>{kind} not shown: {html.escape(str(message))}</i>"
 
     def _apply(self, kind: str, key: tuple, result) -> None:
-        if self._wanted.get(kind) != key:
-            return
         self._shown[kind] = key
         if kind == "frf":
             self.frf = result
@@ -186,7 +171,7 @@ class ResonanceView:
         else:
             self.ripple_view = result
         self._redraw()
-        if all(self._shown.get(k) == self._wanted.get(k) for k in self._wanted):
+        if all(self._shown.get(kind) == job.wanted for kind, job in self._jobs.items()):
             self.note.object = ""
 
     def _redraw(self) -> None:
@@ -211,8 +196,8 @@ class ResonanceView:
             return
         v, name = float(data["v"][index]), str(data["name"][index])
         try:
-            mode = compute.mode_near(state.params_path, state.rail, state.s0, v, state.N0,
-                                     state.b_M, float(data["re"][index]), float(data["im"][index]))
+            mode = compute.mode_near(state.replace(v=v), float(data["re"][index]),
+                                     float(data["im"][index]))
         except Exception as error:  # a model rejection: say so, keep the views
             self.dashboard.warn(f"Mode at the tapped point not shown: {error}")
             return

@@ -21,15 +21,16 @@ from __future__ import annotations
 import html
 import logging
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 import panel as pn
 from bokeh.models import ColumnDataSource, FactorRange
 from bokeh.plotting import figure
 
+from app.dashboard.jobs import ViewJob
 from app.results import compute
-from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest
+from app.results.case import Case, CaseBase
+from app.services.thread_pools import SIDE_VIEW_POOL
 from model.analysis.sensitivity import eigen_sensitivities, limit_sensitivity
 
 log = logging.getLogger(__name__)
@@ -43,7 +44,7 @@ POSITIVE, NEGATIVE = "#c0392b", "#2e86c1"
 class SensitivityData:
     """Sensitivities at one dashboard point (plain data)."""
 
-    key: tuple  # (params_path, rail, s0, v_kmh, N0_kN, b_M)
+    key: Case  # the point
     names: tuple[str, ...]  # parameters, then s0, v, N0, b_M
     values: np.ndarray  # their values [SI]
     derivatives: np.ndarray  # len(names) x modes, dλ/dp [1/s per unit]
@@ -55,22 +56,24 @@ class SensitivityData:
     limit_note: str
 
 
-@lru_cache(maxsize=32)
-def sensitivity_data(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                     b_M: float) -> SensitivityData:
-    """All sensitivities the chart can show at a point (cached per point)."""
-    model = compute.model(params_path, rail)
-    op = compute.operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
-    sens = eigen_sensitivities(model, op)
-    limit = compute.limit_result(params_path, rail, v_kmh, N0_kN, b_M)
-    names = normalized = None
-    note = f"no stability limit at {v_kmh:g} km/h ({limit.message})"
-    if limit.s0_limit is not None:
-        result = limit_sensitivity(model, op.v, op.N0, op.b_M, s0_limit=limit.s0_limit)
-        names, normalized, note = result.names, result.normalized, result.note
-    return SensitivityData((params_path, rail, s0, v_kmh, N0_kN, b_M), sens.names, sens.values,
-                           sens.derivatives, sens.eigenvalues, sens.descriptions, sens.notes,
-                           names, normalized, note)
+def sensitivity_data(case: CaseBase) -> SensitivityData:
+    """All sensitivities the chart can show at the case's point (kept in the results cache)."""
+    point = case.point()
+
+    def compute_data() -> SensitivityData:
+        model = compute.model_for(point)
+        op = point.operating_point()
+        sens = eigen_sensitivities(model, op)
+        limit = compute.limit_result(point)
+        names = normalized = None
+        note = f"no stability limit at {point.v:g} km/h ({limit.message})"
+        if limit.s0_limit is not None:
+            result = limit_sensitivity(model, op.v, op.N0, op.b_M, s0_limit=limit.s0_limit)
+            names, normalized, note = result.names, result.normalized, result.note
+        return SensitivityData(point, sens.names, sens.values, sens.derivatives,
+                               sens.eigenvalues, sens.descriptions, sens.notes, names,
+                               normalized, note)
+    return compute.cached("sensitivities", point, compute_data)
 
 
 def ranked(data: SensitivityData, target: str, mode: int) -> tuple[list[str], np.ndarray, str]:
@@ -105,8 +108,7 @@ class SensitivityView:
         it has ended)."""
         self.data: SensitivityData | None = None
         self.mode = 1
-        self._wanted: tuple | None = None  # key of the newest requested point
-        self._requests = LatestRequest(SIDE_VIEW_POOL, alive)
+        self._job = ViewJob(SIDE_VIEW_POOL, alive, "sensitivities")
         self.target = pn.widgets.RadioButtonGroup(options=TARGETS, value="growth",
                                                   css_classes=["ctl-sensitivity-target"])
         self.source = ColumnDataSource({"name": [], "value": [], "color": []})
@@ -121,47 +123,22 @@ class SensitivityView:
                                pn.pane.Bokeh(self.figure, sizing_mode="stretch_width"),
                                sizing_mode="stretch_width", css_classes=["sensitivity-view"])
 
-    def request(self, dashboard, state) -> None:
-        """Compute for the dashboard's point ``state.point`` (on its worker threads when served,
-        else at once) and show when ready, if the point is still the current one."""
-        key = state.point
-        self._wanted = key
+    def request(self, state: CaseBase) -> None:
+        """Compute for the dashboard's point ``state.point()`` (on its worker threads when
+        served, else at once) and show when ready, if the point is still the current one."""
+        key = state.point()
         if self.data is not None and self.data.key == key:
+            self._job.want(key)
             self.show()
             return
         self.note.object = "<i>computing sensitivities…</i>"
-        doc = pn.state.curdoc
-        if doc is None or doc.session_context is None:
-            try:
-                self._apply(sensitivity_data(*key))
-            except Exception as error:
-                self._failed(key, error)
-            return
-        future = self._requests.submit(self._if_wanted, key)
+        self._job.start(key, lambda: sensitivity_data(key), self._apply, self._failed)
 
-        def done(f) -> None:
-            if f.cancelled() or key != self._wanted or (
-                    f.exception() is None and f.result() is None):
-                return
-            if f.exception() is not None:
-                dashboard.post(doc, self._failed, key, f.exception())
-                return
-            dashboard.post(doc, self._apply, f.result())
+    def _failed(self, _key, error: BaseException) -> None:
+        log.warning("sensitivities failed: %s", error)
+        self.note.object = f"<i>sensitivities not available: {html.escape(str(error))}</i>"
 
-        future.add_done_callback(done)
-
-    def _if_wanted(self, key: tuple) -> SensitivityData | None:
-        """The sensitivities of ``key``, unless another point was asked for meanwhile."""
-        return sensitivity_data(*key) if key == self._wanted else None
-
-    def _failed(self, key: tuple, error: Exception) -> None:
-        if key == self._wanted:
-            log.warning("sensitivities failed: %s", error)
-            self.note.object = f"<i>sensitivities not available: {html.escape(str(error))}</i>"
-
-    def _apply(self, data: SensitivityData) -> None:
-        if data.key != self._wanted:
-            return
+    def _apply(self, _key, data: SensitivityData) -> None:
         self.data = data
         self.show()
 

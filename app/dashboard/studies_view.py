@@ -33,6 +33,7 @@ from bokeh.palettes import RdBu10
 from app.dashboard.queued_study import QueuedStudyControls
 from app.dashboard.uncertainty_band import BandLayer, UncertaintyBand, band_mismatch, read_band
 from app.results import compute
+from app.results.case import Case
 from app.results.plots import new_figure
 from app.services.study_queue import StudyQueue, StudyTicket, study_queue
 from model.mechanics.operating_point import KMH
@@ -148,7 +149,8 @@ class StudiesView(QueuedStudyControls, pn.viewable.Viewer):
         self.s0_points = pn.widgets.IntInput(label="s0 points", value=40, start=1,
                                              end=settings.max_study_points,
                                              css_classes=["study-s0-points"], width=110)
-        self.v_range = pn.widgets.RangeSlider(label="speed v [km/h]", start=10.0, end=250.0,
+        v_low, v_high = Case.quantity("v").bounds  # the dashboard's speeds
+        self.v_range = pn.widgets.RangeSlider(label="speed v [km/h]", start=v_low, end=v_high,
                                               value=(40.0, 250.0), step=5.0, format="0",
                                               css_classes=["study-v"])
         self.v_points = pn.widgets.IntInput(label="v points", value=20, start=1,
@@ -258,7 +260,7 @@ class StudiesView(QueuedStudyControls, pn.viewable.Viewer):
             return
         try:
             study = self.study()
-            parameters = compute.parameters(self.dashboard.params_path, self.dashboard.rail)
+            parameters = compute.parameters(self.dashboard.base_key, self.dashboard.rail)
             ticket = self.queue.submit(self.owner, study, parameters)
         except ValueError as error:  # StudyRefused is a ValueError
             self._reject(str(error.args[0] if error.args else error))
@@ -340,8 +342,7 @@ class StudiesView(QueuedStudyControls, pn.viewable.Viewer):
         d = self.dashboard
         # the set's hash with the result's creep law (a different rail is its own reason)
         rail = self.uncertainty.rail if self.uncertainty is not None else d.rail
-        parameters = compute.parameters(d.params_path, rail if rail in compute.RAIL_CONDITIONS
-                                        else d.rail)
+        parameters = compute.parameters(d.base_key, rail if rail in compute.RAILS else d.rail)
         return parameter_hash(parameters), d.N0 * 1e3, d.b_M, d.rail, "the dashboard's set"
 
     def check_band(self) -> None:

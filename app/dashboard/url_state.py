@@ -2,12 +2,14 @@
 
     /app?s0=0.014&v=200&n0=100000&bm=3000&m0=50000&f=90&decay=0.04&t_end=2
 
-``v`` [km/h], ``n0`` [N], ``bm`` [N m s/rad], ``m0`` [N m], ``f`` [Hz], ``decay`` [-],
-``phase`` [s] (Δt; absent: automatic), ``t_end`` [s] as in ``bogie response``; ``rail``
-(calibrated/dry/wet), ``locus`` (s0/v), ``zoom`` (all/low), ``mode`` (ν), ``tab`` (the view)
-and ``variant`` (a design variant as its differences from the bundled set, ``name:value,…`` in SI
-units, :mod:`app.results.variants`).  Opening such a link restores that state, controls included; a bad
-value gives a notice naming it and leaves that setting at its default.
+The case's quantities by their declared link names and units (:data:`app.results.case.QUANTITIES`,
+the command line's: ``v`` [km/h], ``n0`` [N], ``bm`` [N m s/rad], ``m0`` [N m], ``f`` [Hz],
+``decay`` [-], ``phase`` [s] (Δt; absent: automatic), ``t_end`` [s] as in ``bogie response``;
+``rail`` (calibrated/dry/wet)); ``locus`` (s0/v), ``zoom`` (all/low), ``mode`` (ν), ``tab`` (the
+view) and ``variant`` (a design variant as its differences from the bundled set,
+``name:value,…`` in SI units, :mod:`app.results.variants`).  Opening such a link restores that
+state, controls included; a bad value gives a notice naming it and leaves that setting at its
+default.
 
 No Panel here: :func:`parse_query` and :func:`make_query` work on plain mappings.
 """
@@ -18,23 +20,22 @@ import math
 from collections.abc import Mapping
 from urllib.parse import urlencode
 
+from app.results.case import QUANTITIES, Quantity
 from app.results.variants import VariantError, apply_variant, base_parameters, decode, encode
 
 MAX_QUERY_VALUE = 200  # characters of one query value read (longer: rejected), except variant
+VIEW_CHOICES = {"locus": "locus", "zoom": "zoom"}  # query name -> parameter of the view
 
-# query name -> (dashboard parameter, factor: parameter = query value × factor, unit of the query)
-NUMBERS: dict[str, tuple[str, float, str]] = {
-    "s0": ("s0", 1.0, "-"),
-    "v": ("v", 1.0, "km/h"),
-    "n0": ("N0", 1e-3, "N"),
-    "bm": ("b_M", 1.0, "N m s/rad"),
-    "m0": ("M0", 1e-3, "N m"),
-    "f": ("f", 1.0, "Hz"),
-    "decay": ("D", 1.0, "-"),
-    "phase": ("dt", 1e3, "s"),
-    "t_end": ("t_end", 1.0, "s"),
-}
-CHOICES = {"rail": "rail", "locus": "locus", "zoom": "zoom"}  # query name -> parameter
+
+def numbers(quantities=QUANTITIES) -> dict[str, Quantity]:
+    """query name -> the number quantity it sets (value in the query's unit, the declared
+    outer unit)."""
+    return {q.link: q for q in quantities if q.link and not q.choice}
+
+
+def choices(quantities=QUANTITIES) -> dict[str, str]:
+    """query name -> the parameter of a choice: the case's choices and the view's."""
+    return {**{q.link: q.name for q in quantities if q.link and q.choice}, **VIEW_CHOICES}
 
 
 def _text(value) -> str:
@@ -46,14 +47,15 @@ def _text(value) -> str:
     return str(value)
 
 
-def parse_query(query: Mapping, parameters, tabs: list[str] | None, base: str = ""
-                ) -> tuple[dict, str, str | None, list[str]]:
+def parse_query(query: Mapping, parameters, tabs: list[str] | None, base: str = "",
+                quantities=QUANTITIES) -> tuple[dict, str, str | None, list[str]]:
     """Read a query: (parameter values to set, variant text, tab name or None, notices).
 
     ``parameters`` is the dashboard's ``param`` namespace (bounds and choices are read from it),
     ``tabs`` the tab names (``None``: the tab is returned unchecked), ``base`` the bundled set
-    a variant refers to.  Unknown names are ignored with a notice; each bad value gives a notice
-    and is left out (its default stays)."""
+    a variant refers to, ``quantities`` the dashboard's case quantities.  Unknown names are
+    ignored with a notice; each bad value gives a notice and is left out (its default stays)."""
+    by_link, choice_of = numbers(quantities), choices(quantities)
     values: dict = {}
     notices: list[str] = []
     variant, tab = "", None
@@ -63,28 +65,29 @@ def parse_query(query: Mapping, parameters, tabs: list[str] | None, base: str = 
         if name != "variant" and len(text) > MAX_QUERY_VALUE:
             notices.append(f"{name}: value too long (at most {MAX_QUERY_VALUE} characters)")
             continue
-        if name in NUMBERS:
-            target, factor, unit = NUMBERS[name]
+        if name in by_link:
+            q = by_link[name]
+            unit = q.outer_unit
             try:
                 number = float(text)
             except ValueError:
                 notices.append(f"{name} = '{text[:40]}' is not a number [{unit}]")
                 continue
-            value = number * factor
-            low, high = parameters[target].bounds
+            value = q.from_outer(number)
+            low, high = parameters[q.name].bounds
             if not math.isfinite(value) or not low <= value <= high:
                 notices.append(f"{name} = {text[:40]} {unit} is outside "
-                               f"[{low / factor:g}, {high / factor:g}] {unit}")
+                               f"[{q.to_outer(low):g}, {q.to_outer(high):g}] {unit}")
                 continue
-            values[target] = value
-            if target == "dt":
-                values["dt_auto"] = False
-        elif name in CHOICES:
-            objects = parameters[CHOICES[name]].objects
+            values[q.name] = value
+            if q.automatic:  # a value given: not automatic
+                values[f"{q.name}_auto"] = False
+        elif name in choice_of:
+            objects = parameters[choice_of[name]].objects
             if text not in objects:
                 notices.append(f"{name} = '{text[:40]}' is not one of {', '.join(objects)}")
                 continue
-            values[CHOICES[name]] = text
+            values[choice_of[name]] = text
         elif name == "mode":
             low, high = parameters["mode"].bounds
             if not text.isdigit() or not low <= int(text) <= high:
@@ -114,14 +117,16 @@ def _number(value: float) -> str:
 
 
 def make_query(dashboard, tab: str | None = None) -> str:
-    """The query (without '?') that restores ``dashboard``'s settings: the operating point and
-    the excitation always (as in the CLI), the rest when it differs from the default."""
+    """The query (without '?') that restores ``dashboard``'s settings: the case's numbers always
+    (as in the CLI; one that is automatic: absent), the rest when it differs from the
+    default."""
+    quantities = dashboard.case_type.quantities
     items: list[tuple[str, str]] = []
-    for name, (target, factor, _unit) in NUMBERS.items():
-        if target == "dt" and dashboard.dt_auto:
+    for name, q in numbers(quantities).items():
+        if q.automatic and getattr(dashboard, f"{q.name}_auto"):
             continue
-        items.append((name, _number(getattr(dashboard, target) / factor)))
-    for name, target in CHOICES.items():
+        items.append((name, _number(q.to_outer(getattr(dashboard, q.name)))))
+    for name, target in choices(quantities).items():
         if getattr(dashboard, target) != dashboard.param[target].default:
             items.append((name, getattr(dashboard, target)))
     if dashboard.mode != dashboard.param["mode"].default:

@@ -13,13 +13,15 @@ import html
 import io
 import math
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 import panel as pn
 from bokeh.models import ColumnDataSource
 
+from app.dashboard.jobs import ViewJob
+from app.dashboard.session import served_document
 from app.results import compute
+from app.results.case import CaseBase
 from app.results.plots import UNSTABLE, new_figure
 from app.results.variants import (
     EDITABLE,
@@ -35,7 +37,7 @@ from app.results.variants import (
     set_hash,
     set_key,
 )
-from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest, ignore_outcome
+from app.services.thread_pools import SIDE_VIEW_POOL
 from model.mechanics.parameters import SCHEMA, ParameterError
 from model.studies.calibration_bounds import parameter_rows
 
@@ -53,16 +55,14 @@ class Side:
     limits: dict[float, float | None]  # v [km/h] -> s0*(v) [-] (None: none in the range)
 
 
-def side(state, key: str, speeds=LIMIT_SPEEDS_KMH) -> Side:
+def side(state: CaseBase, key: str, speeds=LIMIT_SPEEDS_KMH) -> Side:
     """Eigenvalues, response and s0*(v) of the set ``key`` at ``state``'s operating point (all
-    from the cached computations of :mod:`app.results.compute`)."""
-    args = (key, state.rail, state.s0, state.v, state.N0, state.b_M)
+    from the results cache of :mod:`app.results.compute`)."""
+    case = state.replace(set_key=key)
     limits = {}
     for v in sorted({*speeds, state.v}):
-        limits[v] = compute.limit_result(key, state.rail, v, state.N0, state.b_M).s0_limit
-    return Side(key, compute.point_result(*args),
-                compute.response_result(*args, state.M0, state.f, state.D, state.dt,
-                                        state.t_end), limits)
+        limits[v] = compute.limit_result(case.replace(v=v)).s0_limit
+    return Side(key, compute.point_result(case), compute.response_result(case), limits)
 
 
 def _cell(base: float | None, variant: float | None, spec: str, scale: float = 1.0) -> str:
@@ -127,9 +127,9 @@ class VariantView(pn.viewable.Viewer):
     def __init__(self, dashboard, **params):
         super().__init__(**params)
         self.dashboard = dashboard
-        self._requests = LatestRequest(SIDE_VIEW_POOL, dashboard.alive)
-        self.base_name = dashboard.params_path
-        self.base = compute.parameters(self.base_name, "calibrated")
+        self._job = ViewJob(SIDE_VIEW_POOL, dashboard.alive, "variant comparison")
+        self.base_name = dashboard.base_key
+        self.base = compute.parameters(self.base_name)
         self.inputs: dict[str, pn.widgets.FloatInput] = {}
         # the calibration's bounds of the baseline's fitted parameters (as bogie parameters)
         self.bounds = {row["name"]: row for row in parameter_rows(self.base)
@@ -264,14 +264,14 @@ class VariantView(pn.viewable.Viewer):
         self.set_changes(changes)
 
     def _download(self):
-        parameters = compute.parameters(self.dashboard.set_key, "calibrated")
+        parameters = compute.parameters(self.dashboard.set_key)
         return io.StringIO(dumps_variant(parameters, self.base_name, self.changes))
 
     def _on_variant(self, *_events) -> None:
         changes = self.changes
         for name, widget in self.inputs.items():
             widget.value = changes.get(name, self.base[name])
-        parameters = compute.parameters(self.dashboard.set_key, "calibrated")
+        parameters = compute.parameters(self.dashboard.set_key)
         diff = differences(self.base, parameters)
         listed = "".join(f"<li>{html.escape(n)}: {a:.6g} → <b>{b:.6g}</b> {SCHEMA[n][0]}</li>"
                          for n, (a, b) in diff.items())
@@ -302,43 +302,22 @@ class VariantView(pn.viewable.Viewer):
 
     def compare(self) -> None:
         """Compute both sides at the current operating point and show them (served: on a worker
-        thread, shown when ready; otherwise at once)."""
+        thread, shown when ready if the dashboard has not moved on; otherwise at once)."""
         self._stale = False
         state = self.dashboard.state()
         base_key = set_key(self.base_name, {})
-        doc = pn.state.curdoc
-        if doc is None or doc.session_context is None:
-            self._show(state, self._compute(state, base_key))
-            return
-        self.table.object = "<i>⏳ comparing with the baseline…</i>"
-        future = self._requests.submit(self._compute_if_current, state, base_key)
-        ignore_outcome(future)
-        future.add_done_callback(partial(self._done, doc, state))
+        if served_document() is not None:
+            self.table.object = "<i>⏳ comparing with the baseline…</i>"
+        self._job.start(state, lambda: (side(state, base_key), side(state, state.set_key)),
+                        self._show, self._failed)
 
-    @staticmethod
-    def _compute(state, base_key: str) -> tuple[Side, Side]:
-        return side(state, base_key), side(state, state.params_path)
-
-    def _compute_if_current(self, state, base_key: str) -> tuple[Side, Side] | None:
-        """Both sides, unless the dashboard has moved on before the comparison started."""
-        return self._compute(state, base_key) if self.dashboard.state() == state else None
-
-    def _done(self, doc, state, future) -> None:
-        if future.cancelled():
-            return
-        error = future.exception()
-
-        def show():
-            if error is None and future.result() is None:
-                return  # superseded before it started
-            if error is not None:
-                self.table.object = ""
-                self.dashboard.warn(f"Comparison failed: {error}")
-            elif self.dashboard.state() == state:
-                self._show(state, future.result())
-        self.dashboard.post(doc, show)
+    def _failed(self, _state, error: BaseException) -> None:
+        self.table.object = ""
+        self.dashboard.warn(f"Comparison failed: {error}")
 
     def _show(self, state, sides: tuple[Side, Side]) -> None:
+        if self.dashboard.state() != state:
+            return  # the dashboard has moved on
         self.comparison = sides
         base, variant = sides
         self.table.object = comparison_html(base, variant, state.v)

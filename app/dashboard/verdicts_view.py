@@ -5,27 +5,30 @@ the safety factors per load case — and a strength-data file that replaces the 
 refused with a notice; the previous data are kept).
 
 The assessment (:func:`app.results.verdicts.assessment_result`) runs on a worker thread for each
-operating point shown; it takes a few seconds (the short-circuit case's grid over every fault
-instant), so the indicator says "computing" meanwhile.
+state of the dashboard (:class:`app.dashboard.jobs.ViewJob`), asked for when the state changes
+and started once that state's follow-ups (dense root locus, s0*(v)) have ended, whatever their
+outcome; it takes a few seconds (the short-circuit case's grid over every fault instant, the
+ripple case's speed sweep), so the indicator says "computing" meanwhile.
 """
 
 from __future__ import annotations
 
 import html
-import tomllib
-from functools import partial
 
 import panel as pn
 
 from app.dashboard import layout
+from app.dashboard.jobs import ViewJob
+from app.dashboard.session import served_document
+from app.results.case import Case
 from app.results.verdicts import (
     assessment_result,
     check_rows,
     indicator_html,
     safety_factor_figure,
 )
-from app.services.thread_pools import SIDE_VIEW_POOL, LatestRequest, ignore_outcome
-from model.mechanics.parameters import ASSESSMENT_SCHEMA, ParameterError
+from app.services.thread_pools import SIDE_VIEW_POOL
+from model.mechanics.parameters import ASSESSMENT_SCHEMA, ParameterError, parse_entries
 
 MAX_STRENGTH_BYTES = 50_000
 COLUMNS = ("component", "check", "load case", "load [kN m]", "capacity [kN m]", "safety factor",
@@ -34,9 +37,11 @@ COLUMNS = ("component", "check", "load case", "load [kN m]", "capacity [kN m]", 
 
 def strength_from_toml(data: bytes, base) -> tuple:
     """The strength data of an uploaded TOML file (entries ``name = { value = …, unit = "…" }``
-    of :data:`model.mechanics.parameters.ASSESSMENT_SCHEMA`), checked against ``base`` (a
-    :class:`model.mechanics.parameters.Parameters`): ((name, value), …); raises ParameterError
-    naming what is wrong."""
+    of :data:`model.mechanics.parameters.ASSESSMENT_SCHEMA`, read as a parameter file's entries
+    are), checked against ``base`` (a :class:`model.mechanics.parameters.Parameters`):
+    ((name, value), …); raises ParameterError naming what is wrong."""
+    import tomllib
+
     if len(data) > MAX_STRENGTH_BYTES:
         raise ParameterError(f"strength file too large ({len(data)} bytes, at most "
                              f"{MAX_STRENGTH_BYTES})")
@@ -44,18 +49,11 @@ def strength_from_toml(data: bytes, base) -> tuple:
         table = tomllib.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
         raise ParameterError(f"strength file is not valid TOML: {error}") from None
-    changes = {}
-    for name, entry in table.items():
+    for name in table:
         if name not in ASSESSMENT_SCHEMA:
             raise ParameterError(f"'{name[:60]}' is not a strength datum (allowed: "
                                  f"{', '.join(list(ASSESSMENT_SCHEMA)[:4])}, …)")
-        if not isinstance(entry, dict) or "value" not in entry:
-            raise ParameterError(f"parameter '{name}' must be a table {{ value = …, unit = … }}")
-        unit = ASSESSMENT_SCHEMA[name][0]
-        if entry.get("unit", unit) != unit:
-            raise ParameterError(f"parameter '{name}' has unit '{entry['unit']}', expected "
-                                 f"'{unit}'")
-        changes[name] = entry["value"]
+    changes, _ = parse_entries(table, "strength file", unit_required=False)
     base.replace(**changes)  # validates each value and the geometry (names the parameter)
     return tuple(sorted((name, float(value)) for name, value in changes.items()))
 
@@ -65,10 +63,9 @@ class VerdictsView:
 
     def __init__(self, dashboard):
         self.dashboard = dashboard
-        self._requests = LatestRequest(SIDE_VIEW_POOL, dashboard.alive)
+        self._job = ViewJob(SIDE_VIEW_POOL, dashboard.alive, "verdict")
         self.strength: tuple = ()  # uploaded strength data ((name, value), …)
         self.result = None  # the assessment on screen
-        self._after_follow_ups = None  # the key waiting for its state's follow-ups (served)
         self.rows: list[dict] = []
         self._waiting: tuple | None = None  # not served: the key to assess when the tab opens
         self._tab_open = False
@@ -105,43 +102,30 @@ class VerdictsView:
 
     # --- computing ----------------------------------------------------------------------------
 
-    def _key(self, state) -> tuple:
-        return (state.params_path, state.rail, state.s0, state.v, state.N0, state.b_M, state.M0,
-                state.f, state.D, self.strength)
+    def _key(self, case: Case) -> tuple:
+        """What the assessment of ``case`` depends on: its point and short circuit (every
+        fault instant, the load cases' horizons) and the strength data."""
+        return (case.without("dt", "t_end"), self.strength)
 
-    def request(self, state, after_follow_ups: bool = False) -> None:
-        """Assess ``state``'s operating point (served: on a worker thread; not served, as in
-        tests without a server: when the Verdicts tab is opened).  ``after_follow_ups``: the
-        dashboard's scheduler starts it with :meth:`start` once the dense root locus and s0*(v)
-        of that state are done (its short-circuit envelope, mostly Python, would share the GIL
-        with them and delay them by about a second after a speed step)."""
-        key = self._key(state)
-        doc = pn.state.curdoc
-        if doc is None or doc.session_context is None:
+    def request(self, case: Case, after=None) -> None:
+        """Assess ``case``'s operating point (served: on a worker thread, started once
+        ``after`` — a future: the state's follow-ups — is done; its short-circuit envelope,
+        mostly Python, would share the GIL with the dense root locus and delay it by about a
+        second after a speed step; not served, as in tests without a server: when the Verdicts
+        tab is opened)."""
+        key = self._key(case)
+        if served_document() is None:
             self._waiting = key
             if self._tab_open:
                 self.on_shown(True)
             else:
                 self.indicator.object = indicator_html(None, "open the Verdicts tab")
             return
+        if key == self._job.wanted:
+            return  # asked for already (its answer, or the one on screen, stands)
         self.indicator.object = indicator_html(None, "computing…")
-        if after_follow_ups:
-            self._after_follow_ups = key
-            return
-        self._submit(doc, state, key)
-
-    def start(self, state) -> None:
-        """The follow-ups of ``state`` are done: assess it if it is the one waiting for them."""
-        key = self._key(state)
-        doc = pn.state.curdoc
-        if key == self._after_follow_ups and doc is not None:
-            self._after_follow_ups = None
-            self._submit(doc, state, key)
-
-    def _submit(self, doc, state, key) -> None:
-        future = self._requests.submit(self._compute_if_current, state, key)
-        ignore_outcome(future)
-        future.add_done_callback(partial(self._done, doc, key))
+        self._job.start(key, lambda: assessment_result(*key), self._show, self._failed,
+                        after=after)
 
     def on_shown(self, shown: bool) -> None:
         """The Verdicts tab opened (``shown``) or closed; not served, the assessment waiting
@@ -151,20 +135,8 @@ class VerdictsView:
             key, self._waiting = self._waiting, None
             self._show(key, assessment_result(*key))
 
-    def _compute_if_current(self, state, key):
-        return assessment_result(*key) if self.dashboard.state() == state else None
-
-    def _done(self, doc, key, future) -> None:
-        if future.cancelled():
-            return
-        error = future.exception()
-
-        def show():
-            if error is not None:
-                self.indicator.object = indicator_html(None, f"not assessed: {error}")
-            elif future.result() is not None and self._key(self.dashboard.state()) == key:
-                self._show(key, future.result())
-        self.dashboard.post(doc, show)
+    def _failed(self, _key, error: BaseException) -> None:
+        self.indicator.object = indicator_html(None, f"not assessed: {error}")
 
     def _show(self, key, result) -> None:
         self.result = result
@@ -185,8 +157,7 @@ class VerdictsView:
             return
         state = self.dashboard.state()
         try:
-            strength = strength_from_toml(event.new, compute.parameters(state.params_path,
-                                                                        state.rail))
+            strength = strength_from_toml(event.new, compute.parameters_for(state))
         except ParameterError as error:
             self.notice.object = (f"**Strength data not used:** {html.escape(str(error))} — the "
                                   "previous data are kept.")
@@ -194,7 +165,7 @@ class VerdictsView:
             return
         self.notice.visible = False
         self.strength = strength
-        self.request(state)
+        self.request(state)  # at once: the state's follow-ups are not waited for
 
     def _clicked(self, event) -> None:
         """A row: its load's history on the Response tab (its s0 and v; the nonlinear creep
@@ -206,8 +177,9 @@ class VerdictsView:
         dash = self.dashboard
         if row["s0"] is None or row["v_kmh"] is None or row["load case"] == "starting":
             return
-        dash.param.update(s0=min(max(row["s0"], 0.0005), 0.03),
-                          v=min(max(row["v_kmh"], 10.0), 250.0))
+        bounds = {name: dash.case_type.quantity(name).bounds for name in ("s0", "v")}
+        dash.param.update(s0=min(max(row["s0"], bounds["s0"][0]), bounds["s0"][1]),
+                          v=min(max(row["v_kmh"], bounds["v"][0]), bounds["v"][1]))
         nonlinear = row["load case"] == "unstable_adhesion"
         dash.nonlinear.creep.value = "nonlinear" if nonlinear else "linear"
         if nonlinear:

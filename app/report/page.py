@@ -33,6 +33,7 @@ from bokeh.layouts import column, row
 
 from app.report.embedding import EmbeddedFigures, embed_inline
 from app.results import compute, resonance
+from app.results.case import CaseBase
 from app.results.eigenvalue_sweep import Fig6Plot
 from app.results.load_plots import LoadCollectivePlot
 from app.results.plots import CreepPlot, ResponsePlots, RootLocusPlot
@@ -86,31 +87,15 @@ def code_version() -> str:
 
 
 @dataclass(frozen=True)
-class ReportCase:
-    """What a report is made for, in the units of :mod:`app.results.compute`."""
+class ReportHistory:
+    """Which history the report describes besides its case."""
 
-    set_key: str  # the parameter set: a bundled file or a variant of it (app.results.variants)
-    rail: str  # rail condition (creep law)
-    s0: float  # creepage [-]
-    v_kmh: float  # speed [km/h]
-    N0_kN: float  # static wheel force [kN]
-    b_M: float  # motor slope [N m s/rad]
-    M0_kNm: float  # short-circuit amplitude [kN m]
-    f: float  # short-circuit frequency [Hz]
-    D: float  # short-circuit decay [-]
-    dt_ms: float | None  # short-circuit time shift [ms] (None: continuous motor torque)
-    t_end: float  # simulated time [s]
     # nonlinear creep: ID2's anti-slip key (enabled, delay [s], threshold [m/s], rate [1/s]);
     # None: the linear closed form
     anti_slip: tuple | None = None
     # the anti-slip key of the nonlinear history shown beside a linear one that grows without
     # bound (default: the protection off, its parameters the defaults)
     companion_anti_slip: tuple = compute.ANTI_SLIP_OFF
-
-    @property
-    def point(self) -> tuple:
-        """The operating point's arguments of :mod:`app.results.compute`."""
-        return (self.set_key, self.rail, self.s0, self.v_kmh, self.N0_kN, self.b_M)
 
 
 @dataclass(frozen=True)
@@ -132,32 +117,32 @@ class ReportResults:
     companion: compute.ResponseView | None = None
 
 
-def report_results(case: ReportCase, say=lambda _text: None) -> ReportResults:
-    """Compute (or take from the cache) what the report shows; ``say(text)`` names each step."""
+def report_results(case: CaseBase, history: ReportHistory = ReportHistory(),
+                   say=lambda _text: None) -> ReportResults:
+    """Compute (or take from the results cache) what the report of ``case`` shows;
+    ``say(text)`` names each step."""
     say("eigenvalues and modes")
-    point = compute.point_result(*case.point)
-    excitation = (case.M0_kNm, case.f, case.D, case.dt_ms, case.t_end)
-    say("short-circuit response" + (" (nonlinear creep)" if case.anti_slip is not None else ""))
-    response = compute.history_result(*case.point, *excitation, case.anti_slip)
+    point = compute.point_result(case)
+    say("short-circuit response" + (" (nonlinear creep)" if history.anti_slip is not None
+                                    else ""))
+    response = compute.history_result(case, history.anti_slip)
     companion = None
     if not response.load_peaks.bounded:
         say("short-circuit response with nonlinear creep (the linear one grows without bound)")
-        companion = compute.history_result(*case.point, *excitation, case.companion_anti_slip)
+        companion = compute.history_result(case, history.companion_anti_slip)
     say("root locus (dense sweep over s0)")
-    locus = compute.dense_locus_result(case.set_key, case.rail, "s0", case.v_kmh, case.N0_kN,
-                                       case.b_M)
+    locus = compute.dense_locus_result(case.sweep("s0"))
     say("stability limit s0*(v)")
-    limit = compute.limit_result(case.set_key, case.rail, case.v_kmh, case.N0_kN, case.b_M)
+    limit = compute.limit_result(case)
     say("design loads: worst case over the fault instant, load spectra")
-    worst = compute.worst_case_result(*case.point, *excitation)
-    spectra = compute.spectra_result(*case.point, *excitation, case.anti_slip)
+    worst = compute.worst_case_result(case)
+    spectra = compute.spectra_result(case, history.anti_slip)
     say("resonances: Campbell diagram, frequency response, torque ripple")
-    common = (case.set_key, case.rail, case.s0, case.N0_kN, case.b_M)
-    campbell = resonance.campbell_result(*common)
-    frf = resonance.frf_result(*case.point)
-    ripple = resonance.ripple_result(*common)
+    campbell = resonance.campbell_result(case)
+    frf = resonance.frf_result(case)
+    ripple = resonance.ripple_result(case)
     say("verdicts: safety factors of every fit, shaft and coupling")
-    assessment = assessment_result(*case.point, case.M0_kNm, case.f, case.D)
+    assessment = assessment_result(case)
     return ReportResults(point, response, locus, limit, worst, spectra, campbell, frf, ripple,
                          assessment, companion)
 
@@ -184,12 +169,12 @@ def report_figures(results: ReportResults) -> dict:
         collectives.append(plot.figure)
     campbell = CampbellPlot()
     campbell.update(results.campbell)
-    campbell.mark_speed(results.point.key[3])
+    campbell.mark_speed(results.point.case.v)
     frf = FrfPlot()
     frf.update(results.frf, resonance.DEFAULT_OUTPUT)
     ripple = RipplePlot()
     ripple.update(results.ripple, resonance.DEFAULT_OUTPUT)
-    ripple.mark_speed(results.point.key[3])
+    ripple.mark_speed(results.point.case.v)
     figures = {} if results.assessment is None else {
         "verdicts": safety_factor_figure(results.assessment)}
     return {
@@ -218,21 +203,14 @@ def _table(rows: list[tuple[str, str]]) -> str:
         for a, b in rows) + "</table>")
 
 
-def operating_table(case: ReportCase) -> str:
-    """The operating point and the excitation, in SI units (N, N m, s)."""
-    return _table([
-        ("creepage s0 [-]", f"{case.s0:g}"), ("speed v [km/h]", f"{case.v_kmh:g}"),
-        ("static wheel force N0 [N]", f"{case.N0_kN * 1e3:g}"),
-        ("motor slope b_M [N m s/rad]", f"{case.b_M:g}"), ("rail condition (creep law)", case.rail),
-        ("short circuit M0 [N m]", f"{case.M0_kNm * 1e3:g}"), ("frequency f [Hz]", f"{case.f:g}"),
-        ("decay D [-]", f"{case.D:g}"),
-        ("time shift Δt [s]", "automatic (continuous motor torque)" if case.dt_ms is None
-         else f"{case.dt_ms * 1e-3:g}"),
-        ("simulated time [s]", f"{case.t_end:g}"),
-        ("longitudinal creep", compute.anti_slip_description(case.anti_slip))])
+def operating_table(case: CaseBase, history: ReportHistory) -> str:
+    """The operating point, the excitation and the horizon, in SI units (N, N m, s), and the
+    creep model."""
+    return _table([*case.rows(),
+                   ("longitudinal creep", compute.anti_slip_description(history.anti_slip))])
 
 
-def stability_table(case: ReportCase, results: ReportResults) -> str:
+def stability_table(case: CaseBase, results: ReportResults) -> str:
     """The status numbers, s0*(v) and the margin to it, the adhesion limit."""
     point, limit = results.point, results.limit
     if limit.s0_limit is None:
@@ -245,7 +223,7 @@ def stability_table(case: ReportCase, results: ReportResults) -> str:
         ("largest Re λ [1/s]", f"{point.max_real_part:+.4f}"),
         ("flutter pairs (Re > 0)", str(point.flutter)),
         ("divergent real eigenvalues", str(point.divergence)),
-        (f"s0*({case.v_kmh:g} km/h) [-]", limit_text),
+        (f"s0*({case.v:g} km/h) [-]", limit_text),
         ("μ(s0), μ_max", f"{point.mu0:.4f}, {point.mu_max:.4f} at s = {point.s_max:.4f}"),
         ("M_ad = 2 N0 r0 μ_max [N m]", f"{point.M_ad:,.0f}")])
 
@@ -294,7 +272,7 @@ creepage (coloured by their damping ratio), the excitation orders and their cros
 {crossings_html(view)}
 <p>The frequency response of {resonance.DEFAULT_OUTPUT} at this operating point, and its
 steady amplitude over speed under the torque ripple {html.escape(ripple)} of
-{html.escape(results.ripple.key[-1])} (the sum over the orders: the largest the steady state
+{html.escape(results.ripple.input)} (the sum over the orders: the largest the steady state
 reaches).</p>
 {resonance_div}"""
 def verdicts_section(results: ReportResults, chart_div: str) -> str:
@@ -312,8 +290,8 @@ certification to EN 13103-1 / EN 13260 (docs/assessment.md).</p>"""
 
 # --- the page --------------------------------------------------------------------------------------
 
-def report_page(case: ReportCase, results: ReportResults, figures: EmbeddedFigures,
-                now: datetime.datetime) -> str:
+def report_page(case: CaseBase, history: ReportHistory, results: ReportResults,
+                figures: EmbeddedFigures, now: datetime.datetime) -> str:
     """The report as one HTML text: the tables of ``results``, the embedded ``figures``."""
     base_name, changes = split_key(case.set_key)
     parameters = parameters_of_key(case.set_key)
@@ -321,7 +299,7 @@ def report_page(case: ReportCase, results: ReportResults, figures: EmbeddedFigur
     point, divs = results.point, figures.divs
     verdict = "STABLE" if point.stable else "UNSTABLE"
     name = html.escape(base_name or "calibrated (bundled: assets/parameters/calibrated.toml)")
-    s0, v_kmh = case.s0, case.v_kmh
+    s0, v_kmh = case.s0, case.v
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <title>Bogie drive dynamics — report: {verdict} at s0 = {s0:g}, v = {v_kmh:g} km/h</title>
@@ -332,7 +310,7 @@ def report_page(case: ReportCase, results: ReportResults, figures: EmbeddedFigur
 <p class="sub">{now:%Y-%m-%d %H:%M} UTC · code {html.escape(code_version())} ·
 parameter set {name}{' (variant)' if changes else ''}, hash <code>{set_hash(parameters)}</code></p>
 <p><span class="verdict {'ok' if point.stable else 'bad'}">{verdict}</span></p>
-<div class="cols"><div><h2>Operating point and excitation</h2>{operating_table(case)}</div>
+<div class="cols"><div><h2>Operating point and excitation</h2>{operating_table(case, history)}</div>
 <div><h2>Stability</h2>{stability_table(case, results)}</div>
 <div><h2>Differences from the baseline</h2>{differences_table(diff)}</div></div>
 <h2>Root locus over s0 at {v_kmh:g} km/h ({len(results.locus.values)} points)</h2>{divs['locus']}
@@ -353,23 +331,16 @@ from the full 10 kHz history.</p>
 """
 
 
-def build_report(set_key: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
-                 M0_kNm: float, f: float, D: float, dt_ms: float | None, t_end: float,
-                 progress=None, now: datetime.datetime | None = None,
-                 anti_slip: tuple | None = None,
-                 companion_anti_slip: tuple = compute.ANTI_SLIP_OFF) -> str:
-    """The report as one HTML text.  Arguments as in :mod:`app.results.compute` (``set_key``: the
-    parameter set, a bundled file or a variant of it, :mod:`app.results.variants`); ``progress``:
-    called with the name of each step; ``now``: the date shown (default: now, UTC);
-    ``anti_slip``: with nonlinear creep, ID2's anti-slip key (enabled, delay [s], threshold
-    [m/s], rate [1/s]) — the histories, peaks and spectra are then the nonlinear ones;
-    ``companion_anti_slip``: the key of the nonlinear history the peak table shows beside a
-    linear one that grows without bound."""
-    case = ReportCase(set_key, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, t_end,
-                      None if anti_slip is None else tuple(anti_slip),
-                      tuple(companion_anti_slip))
+def build_report(case: CaseBase, history: ReportHistory = ReportHistory(), progress=None,
+                 now: datetime.datetime | None = None) -> str:
+    """The report of ``case`` (:class:`app.results.case.Case`: its parameter set — a bundled file
+    or a variant of it, :mod:`app.results.variants` —, operating point, short circuit and
+    simulated time) as one HTML text.  ``history``: with nonlinear creep, ID2's anti-slip key
+    (the histories, peaks and spectra are then the nonlinear ones) and the key of the nonlinear
+    history the peak table shows beside a linear one that grows without bound; ``progress``:
+    called with the name of each step; ``now``: the date shown (default: now, UTC)."""
     say = progress or (lambda _text: None)
-    results = report_results(case, say)
+    results = report_results(case, history, say)
     say("writing the report")
     now = now or datetime.datetime.now(datetime.UTC)
-    return report_page(case, results, embed_inline(report_figures(results)), now)
+    return report_page(case, history, results, embed_inline(report_figures(results)), now)

@@ -1,26 +1,28 @@
-"""What the dashboard computes, as plain data, cached across sessions.
+"""What the dashboard computes, as plain data, kept in the one results cache.
 
-Every function here takes primitives only (so :func:`panel.cache` keys them by value, not by
-object identity) and returns read-only plain data: results are shared between sessions and
-never mutated.  The physics is in :mod:`model`; this module only calls it and reshapes the
-results for plotting.  Units: SI, except where a name says otherwise (``v_kmh`` [km/h],
-``N0_kN`` [kN], ``M0_kNm`` [kN m], ``dt_ms`` [ms], ``im_hz`` [Hz]).
+Every function here takes a case record (:class:`app.results.case.Case`: the parameter set, the
+operating point, the short circuit, the horizon) and the result's own arguments, and returns
+read-only plain data from :data:`app.results.cache.RESULTS`, keyed by the kind of result, the
+parameter set's full hash and the part of the record the result depends on
+(:meth:`app.results.case.CaseBase.point`, ``limit_key``, ``sweep``): results are shared between
+sessions and never mutated.  The physics is in :mod:`model`; this module only calls it and
+reshapes the results for plotting.  Units: SI, except where a name says otherwise (a record's
+units: ``v`` [km/h], ``N0`` [kN], ``M0`` [kN m], ``dt`` [ms]; ``im_hz`` [Hz]).
 """
 
 from __future__ import annotations
 
 import math
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
-import panel as pn
 
+from app.results.cache import RESULTS
+from app.results.case import Case, CaseBase, Sweep
 from app.results.locus_geometry import locus_jumps, refine_grid
 from app.results.mode_drawing import point_displacements
+from app.results.variants import full_hash, parameters_of_key
 from model import (
-    KMH,
     NoStabilityLimit,
     adhesion_moment,
     build_model,
@@ -30,10 +32,9 @@ from model import (
 )
 from model.analysis.load_peaks import LoadPeaks
 from model.analysis.nonlinear import AntiSlip
-from model.contact.creep import CREEP_PRESETS
-from model.mechanics.operating_point import OperatingPoint
+from model.studies.envelope import RAILS, rail_parameters
+from model.studies.maps import set_model_source
 
-RAIL_CONDITIONS = ("calibrated", "dry", "wet")  # "calibrated": the creep law of the parameter set
 N_COMPLEX_TABLE = 10  # complex pairs in the eigenvalue / mode tables (Table 1 and 2 layout)
 N_REAL_TABLE = 10  # real eigenvalues in the eigenvalue table
 LOCUS_MAX_HZ = 20.0  # branches tracked up to this frequency [Hz]
@@ -76,60 +77,79 @@ class ModelRejected(ValueError):
     """A parameter combination the model rejects (message shown to the user)."""
 
 
-class Known:
-    """The results a cached function has computed, by its arguments, looked up without
-    computing anything (a dragged slider's preview asks only what is known).  Bounded like the
-    function's own cache; thread-safe."""
+# --- the parameter set and its model ------------------------------------------------------------
 
-    def __init__(self, size: int):
-        self.size = size
-        self._results: OrderedDict = OrderedDict()
-        self._lock = threading.Lock()
-
-    def remember(self, key: tuple, result) -> None:
-        with self._lock:
-            self._results[key] = result
-            self._results.move_to_end(key)
-            while len(self._results) > self.size:
-                self._results.popitem(last=False)
-
-    def get(self, key: tuple):
-        """The result for ``key`` if it was computed (and is still kept), else None."""
-        with self._lock:
-            return self._results.get(key)
+def _parameter_set(set_key: str, rail: str, overrides: tuple) -> tuple:
+    """(parameters, full hash) of a set key with the rail's creep law and the case's overrides
+    (kept: a file is read and validated once)."""
+    def make():
+        if rail not in RAILS:
+            raise ModelRejected(f"unknown rail condition '{rail}'; allowed: {', '.join(RAILS)}")
+        p = rail_parameters(parameters_of_key(set_key), rail)
+        changes = {name: value for name, value, tolerance in overrides
+                   if abs(value - p[name]) > tolerance}  # else the set's own value
+        if changes:
+            p = p.replace(**changes)
+        return p, full_hash(p)
+    return RESULTS.get(("parameters", set_key, rail, overrides), make)
 
 
-_KNOWN_POINTS = Known(256)  # point_result by its arguments
-_KNOWN_LIMITS = Known(128)  # limit_result by its arguments
-_KNOWN_LOCI = Known(128)  # locus_result / dense_locus_result by (arguments, dense)
+def parameters(set_key: str, rail: str = "calibrated", overrides: tuple = ()):
+    """The parameter set in use: the set key's (``""``: the calibrated default; a design
+    variant ``"FILE|name:value,…"``, :mod:`app.results.variants`) with the rail's creep law
+    (``"calibrated"`` keeps the set's, ``"dry"``/``"wet"``: Polach's presets) and ``overrides``
+    ((name, SI value, SI tolerance), …: a case's override quantities,
+    :meth:`app.results.case.CaseBase.overrides`; a value within its tolerance of the set's own
+    is the set's)."""
+    return _parameter_set(set_key, rail, tuple(overrides))[0]
 
 
-# --- model -----------------------------------------------------------------------------------
-
-@pn.cache(max_items=24)
-def parameters(params_path: str, rail: str):
-    """The parameter set in use: the file (``""``: calibrated default) or a design variant of
-    it (set key ``"FILE|name:value,…"``, :mod:`app.results.variants`) with the rail's creep law
-    (``"calibrated"`` keeps the set's, ``"dry"``/``"wet"``: Polach's presets)."""
-    from app.results.variants import parameters_of_key
-
-    p = parameters_of_key(params_path)
-    if rail == "calibrated":
-        return p
-    if rail not in CREEP_PRESETS:
-        raise ModelRejected(f"unknown rail condition '{rail}'; allowed: {', '.join(RAIL_CONDITIONS)}")
-    return p.replace(**CREEP_PRESETS[rail])
+def parameters_for(case: CaseBase):
+    """The parameter set of a case (its set key, rail and override quantities)."""
+    return parameters(case.set_key, case.rail, case.overrides())
 
 
-@pn.cache(max_items=24)
-def model(params_path: str, rail: str):
-    """The assembled model (shared read-only between sessions)."""
-    return build_model(parameters(params_path, rail))
+def set_hash_for(case: CaseBase) -> str:
+    """The full hash (:func:`app.results.variants.full_hash`) of a case's parameter set."""
+    return _parameter_set(case.set_key, case.rail, case.overrides())[1]
 
 
-def operating_point(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                    b_M: float) -> OperatingPoint:
-    return OperatingPoint.from_kmh(float(s0), float(v_kmh), float(N0_kN) * 1e3, float(b_M))
+def model_of(parameters):
+    """The assembled model of a parameter set: one object per set (its full hash), shared
+    read-only between sessions, kept with the decompositions of its last operating points."""
+    return RESULTS.get(("model", full_hash(parameters)), lambda: build_model(parameters),
+                       growing=True)
+
+
+# the checks and studies this process runs (model.studies.assessment, a study run here) take
+# their models from the same cache: one model object per parameter set
+set_model_source(model_of)
+
+
+def model(set_key: str, rail: str = "calibrated", overrides: tuple = ()):
+    """The assembled model of :func:`parameters`' set."""
+    p, digest = _parameter_set(set_key, rail, tuple(overrides))
+    return RESULTS.get(("model", digest), lambda: build_model(p), growing=True)
+
+
+def model_for(case: CaseBase):
+    """The assembled model of a case's parameter set."""
+    return model(case.set_key, case.rail, case.overrides())
+
+
+def cached(kind: str, case: CaseBase, compute, *extra):
+    """``compute()`` kept in the results cache under (kind, the case's set hash, the case,
+    extra): the key of every result the app computes."""
+    return RESULTS.get((kind, set_hash_for(case), case, *extra), compute)
+
+
+def _known(kind: str, case: CaseBase, *extra):
+    """The kept result of :func:`_cached`'s key, or None (nothing is computed)."""
+    try:
+        digest = set_hash_for(case)
+    except ValueError:
+        return None
+    return RESULTS.peek((kind, digest, case, *extra))
 
 
 # --- eigenvalues, modes, creep characteristic at the current point ---------------------------
@@ -152,7 +172,7 @@ class Mode:
 class PointResult:
     """Eigen-analysis of one operating point, reshaped for the views."""
 
-    key: tuple  # (params_path, rail, s0, v_kmh, N0_kN, b_M)
+    case: Case  # the point (the record's point(): the short circuit and the horizon left out)
     eigenvalues: np.ndarray  # all non-rigid eigenvalues [1/s]
     stable: bool
     max_real_part: float  # [1/s]
@@ -169,58 +189,56 @@ class PointResult:
     M_ad: float  # maximal adhesion moment 2 N0 r0 μ_max [N m]
 
 
-@pn.cache(max_items=256)
-def point_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                 b_M: float) -> PointResult:
-    """Eigenvalues, stability, mode descriptions and creep characteristic at one point."""
-    m = model(params_path, rail)
-    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
-    result = eigen_analysis(m, op)
-    modes = []
-    for number, i in enumerate(result.complex_index[:N_COMPLEX_TABLE], start=1):
-        character = mode_character(m, result, int(i))
-        lam = complex(result.eigenvalues[i])
-        modes.append(Mode(number, lam, lam.imag / (2 * math.pi), character.damping_ratio,
-                          character.description,
-                          point_displacements(m, result.mode_shape(int(i))),
-                          dict(character.kinetic), dict(character.strain)))
-    law = creep_law(m.parameters, op.N0)
-    s_max, mu_max = law.maximum(op.v)
-    s_grid = np.linspace(0.0, max(0.03, 1.5 * op.s0), 301)
-    point = PointResult(
-        key=(params_path, rail, s0, v_kmh, N0_kN, b_M), eigenvalues=result.eigenvalues,
-        stable=result.stable, max_real_part=result.max_real_part, flutter=result.flutter,
-        divergence=result.divergence, n_rigid=result.n_rigid, modes=modes,
-        real=result.real_eigenvalues[:N_REAL_TABLE], creep_s=s_grid, creep_mu=np.asarray(law.mu(s_grid, op.v)),
-        mu0=float(law.mu(op.s0, op.v)), s_max=s_max, mu_max=mu_max,
-        M_ad=adhesion_moment(m.parameters, op.v, op.N0))
-    _KNOWN_POINTS.remember(point.key, point)
-    return point
-
-
-def known_point(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                b_M: float) -> PointResult | None:
-    """:func:`point_result` of these arguments if it has been computed, else None (nothing is
-    computed)."""
-    return _KNOWN_POINTS.get((params_path, rail, s0, v_kmh, N0_kN, b_M))
-
-
-@pn.cache(max_items=64)
-def mode_near(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
-              re: float, im: float) -> Mode:
-    """The mode whose eigenvalue is nearest to re + i·im [1/s] at an operating point (a tapped
-    root-locus point): shape, description and energy shares; ``number`` is its rank among the
-    complex pairs by frequency (0 for a real eigenvalue)."""
-    m = model(params_path, rail)
-    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
-    result = eigen_analysis(m, op)
-    index = int(np.argmin(np.abs(result.eigenvalues - complex(re, im))))
+def _mode(m, result, index: int, number: int) -> Mode:
     character = mode_character(m, result, index)
     lam = complex(result.eigenvalues[index])
-    ranks = {int(i): k for k, i in enumerate(result.complex_index, start=1)}
-    return Mode(ranks.get(index, 0), lam, lam.imag / (2 * math.pi), character.damping_ratio,
+    return Mode(number, lam, lam.imag / (2 * math.pi), character.damping_ratio,
                 character.description, point_displacements(m, result.mode_shape(index)),
                 dict(character.kinetic), dict(character.strain))
+
+
+def point_result(case: CaseBase) -> PointResult:
+    """Eigenvalues, stability, mode descriptions and creep characteristic at the case's point."""
+    point = case.point()
+
+    def compute() -> PointResult:
+        m = model_for(point)
+        op = point.operating_point()
+        result = eigen_analysis(m, op)
+        modes = [_mode(m, result, int(i), number)
+                 for number, i in enumerate(result.complex_index[:N_COMPLEX_TABLE], start=1)]
+        law = creep_law(m.parameters, op.N0)
+        s_max, mu_max = law.maximum(op.v)
+        s_grid = np.linspace(0.0, max(0.03, 1.5 * op.s0), 301)
+        return PointResult(
+            case=point, eigenvalues=result.eigenvalues, stable=result.stable,
+            max_real_part=result.max_real_part, flutter=result.flutter,
+            divergence=result.divergence, n_rigid=result.n_rigid, modes=modes,
+            real=result.real_eigenvalues[:N_REAL_TABLE], creep_s=s_grid,
+            creep_mu=np.asarray(law.mu(s_grid, op.v)), mu0=float(law.mu(op.s0, op.v)),
+            s_max=s_max, mu_max=mu_max, M_ad=adhesion_moment(m.parameters, op.v, op.N0))
+    return cached("point", point, compute)
+
+
+def known_point(case: CaseBase) -> PointResult | None:
+    """:func:`point_result` of the case if it has been computed (and is kept), else None
+    (nothing is computed)."""
+    return _known("point", case.point())
+
+
+def mode_near(case: CaseBase, re: float, im: float) -> Mode:
+    """The mode whose eigenvalue is nearest to re + i·im [1/s] at the case's point (a tapped
+    root-locus point): shape, description and energy shares; ``number`` is its rank among the
+    complex pairs by frequency (0 for a real eigenvalue)."""
+    point = case.point()
+
+    def compute() -> Mode:
+        m = model_for(point)
+        result = eigen_analysis(m, point.operating_point())
+        index = int(np.argmin(np.abs(result.eigenvalues - complex(re, im))))
+        ranks = {int(i): k for k, i in enumerate(result.complex_index, start=1)}
+        return _mode(m, result, index, ranks.get(index, 0))
+    return cached("mode", point, compute, float(re), float(im))
 
 
 # --- stability limit ---------------------------------------------------------------------------
@@ -231,35 +249,36 @@ class LimitResult:
     message: str  # why there is none ("" otherwise)
 
 
-@pn.cache(max_items=128)
-def limit_result(params_path: str, rail: str, v_kmh: float, N0_kN: float,
-                 b_M: float) -> LimitResult:
-    """The stability limit s0*(v) at the current speed (model.analysis.stability)."""
-    from model.analysis.stability import stability_limit
+def limit_result(case: CaseBase) -> LimitResult:
+    """The stability limit s0*(v) at the case's speed, wheel force, motor slope and set
+    (model.analysis.stability)."""
+    key = case.limit_key()
 
-    m = model(params_path, rail)
-    # the root locus over s0 at this speed (usually cached: the dashboard shows it) brackets
-    # the first crossing between two of its points: ≈ 8 eigen-analyses instead of ≈ 20
-    locus = locus_result(params_path, rail, "s0", v_kmh, N0_kN, b_M)
-    turns = np.flatnonzero(~locus.stable[1:] & locus.stable[:-1])
-    bracket = None
-    if len(turns) and locus.stable[:turns[0] + 1].all():
-        bracket = (float(locus.values[turns[0]]), float(locus.values[turns[0] + 1]))
-    try:
-        limit = stability_limit(m, v_kmh * KMH, N0_kN * 1e3, b_M, s0_low=LOCUS_S0[0] / 2,
-                                xtol=LIMIT_XTOL, bracket=bracket)
-        result = LimitResult(limit.s0_limit, "")
-    except NoStabilityLimit as error:
-        result = LimitResult(None, str(error))
-    _KNOWN_LIMITS.remember((params_path, rail, v_kmh, N0_kN, b_M), result)
-    return result
+    def compute() -> LimitResult:
+        from model.analysis.stability import stability_limit
+
+        m = model_for(key)
+        # the root locus over s0 at this speed (usually kept: the dashboard shows it) brackets
+        # the first crossing between two of its points: ≈ 8 eigen-analyses instead of ≈ 20
+        locus = locus_result(Sweep("s0", key))
+        turns = np.flatnonzero(~locus.stable[1:] & locus.stable[:-1])
+        bracket = None
+        if len(turns) and locus.stable[:turns[0] + 1].all():
+            bracket = (float(locus.values[turns[0]]), float(locus.values[turns[0] + 1]))
+        op = key.replace(s0=LOCUS_S0[0]).operating_point()
+        try:
+            limit = stability_limit(m, op.v, op.N0, op.b_M, s0_low=LOCUS_S0[0] / 2,
+                                    xtol=LIMIT_XTOL, bracket=bracket)
+            return LimitResult(limit.s0_limit, "")
+        except NoStabilityLimit as error:
+            return LimitResult(None, str(error))
+    return cached("limit", key, compute)
 
 
-def known_limit(params_path: str, rail: str, v_kmh: float, N0_kN: float,
-                b_M: float) -> LimitResult | None:
-    """:func:`limit_result` of these arguments if it has been computed, else None (nothing is
+def known_limit(case: CaseBase) -> LimitResult | None:
+    """:func:`limit_result` of the case if it has been computed, else None (nothing is
     computed)."""
-    return _KNOWN_LIMITS.get((params_path, rail, v_kmh, N0_kN, b_M))
+    return _known("limit", case.limit_key())
 
 
 # --- root locus --------------------------------------------------------------------------------
@@ -284,71 +303,56 @@ def _sweep_range(parameter: str) -> tuple[float, float]:
     raise ModelRejected(f"root locus parameter must be 's0' or 'v', got '{parameter}'")
 
 
-def _sweep(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float, b_M: float,
-           shown: np.ndarray, dense: bool) -> LocusResult:
-    """Root locus over ``shown`` (display units) at the fixed quantities."""
+def _sweep(sweep: Sweep, shown: np.ndarray, dense: bool) -> LocusResult:
+    """Root locus over ``shown`` (the swept quantity's unit) through the sweep's point."""
     from model.analysis.locus import root_locus
 
-    m = model(params_path, rail)
-    if parameter == "s0":
-        op = operating_point(params_path, rail, float(shown[0]), fixed, N0_kN, b_M)
-        locus = root_locus(m, op, "s0", shown, max_frequency_hz=LOCUS_MAX_HZ,
-                           lambda_floor=LOCUS_LAMBDA_FLOOR)
-    else:
-        op = operating_point(params_path, rail, fixed, float(shown[0]), N0_kN, b_M)
-        locus = root_locus(m, op, "v", shown * KMH, max_frequency_hz=LOCUS_MAX_HZ,
-                           lambda_floor=LOCUS_LAMBDA_FLOOR)
+    m = model_for(sweep.case)
+    op = sweep.at(float(shown[0])).operating_point()
+    q = sweep.case.quantity(sweep.parameter)
+    locus = root_locus(m, op, sweep.parameter, shown * q.si, max_frequency_hz=LOCUS_MAX_HZ,
+                       lambda_floor=LOCUS_LAMBDA_FLOOR)
     upper = np.flatnonzero(locus.eigenvalues[0].imag >= 0)
     lam = locus.eigenvalues[:, upper]
-    return LocusResult(parameter, shown, lam, np.asarray(locus.stable), dense, locus_jumps(shown, lam))
+    return LocusResult(sweep.parameter, shown, lam, np.asarray(locus.stable), dense,
+                       locus_jumps(shown, lam))
 
 
-@pn.cache(max_items=64)
-def locus_result(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
-                 b_M: float) -> LocusResult:
-    """The coarse sweep (LOCUS_POINTS evenly spaced): tracked branches over s0 (at speed
-    ``fixed`` [km/h]) or over v (at creepage ``fixed``).  Shown first; brackets s0*(v)."""
-    shown = np.linspace(*_sweep_range(parameter), LOCUS_POINTS)
-    locus = _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=False)
-    _KNOWN_LOCI.remember((params_path, rail, parameter, fixed, N0_kN, b_M, False), locus)
-    return locus
+def locus_result(sweep: Sweep) -> LocusResult:
+    """The coarse sweep (LOCUS_POINTS evenly spaced): tracked branches over s0 (at the point's
+    speed) or over v (at its creepage).  Shown first; brackets s0*(v)."""
+    def compute() -> LocusResult:
+        shown = np.linspace(*_sweep_range(sweep.parameter), LOCUS_POINTS)
+        return _sweep(sweep, shown, dense=False)
+    return cached("locus", sweep.case, compute, sweep.parameter)
 
 
-@pn.cache(max_items=64)
-def dense_locus_result(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
-                       b_M: float) -> LocusResult:
+def dense_locus_result(sweep: Sweep) -> LocusResult:
     """The dense sweep (LOCUS_DENSE_POINTS), denser where the coarse sweep's branches move fast
     (:func:`refine_grid`); replaces the coarse one on screen."""
-    coarse = locus_result(params_path, rail, parameter, fixed, N0_kN, b_M)
-    shown = refine_grid(coarse.values, coarse.eigenvalues, LOCUS_DENSE_POINTS)
-    locus = _sweep(params_path, rail, parameter, fixed, N0_kN, b_M, shown, dense=True)
-    _KNOWN_LOCI.remember((params_path, rail, parameter, fixed, N0_kN, b_M, True), locus)
-    return locus
+    def compute() -> LocusResult:
+        coarse = locus_result(sweep)
+        shown = refine_grid(coarse.values, coarse.eigenvalues, LOCUS_DENSE_POINTS)
+        return _sweep(sweep, shown, dense=True)
+    return cached("dense locus", sweep.case, compute, sweep.parameter)
 
 
-def known_locus(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
-                b_M: float) -> LocusResult | None:
-    """The dense root locus of these arguments if it has been computed, else the coarse one,
-    else None (nothing is computed)."""
-    key = (params_path, rail, parameter, fixed, N0_kN, b_M)
-    return _KNOWN_LOCI.get((*key, True)) or _KNOWN_LOCI.get((*key, False))
+def known_locus(sweep: Sweep) -> LocusResult | None:
+    """The dense root locus of the sweep if it has been computed, else the coarse one, else
+    None (nothing is computed)."""
+    return (_known("dense locus", sweep.case, sweep.parameter)
+            or _known("locus", sweep.case, sweep.parameter))
 
 
-def reduced_estimate(params_path: str, rail: str, parameter: str, fixed: float, N0_kN: float,
-                     b_M: float, point: tuple):
-    """The eigenvalues at ``point`` = (s0, v_kmh, N0_kN, b_M) from the reduced model of the
-    root locus of the other arguments (:func:`model.analysis.locus.kept_sweep_estimate`: one
-    small eigenproblem, no dense solve), or None if that sweep's start is not kept."""
+def reduced_estimate(sweep: Sweep, case: CaseBase):
+    """The eigenvalues at the case's point from the reduced model of the root locus ``sweep``
+    (:func:`model.analysis.locus.kept_sweep_estimate`: one small eigenproblem, no dense solve),
+    or None if that sweep's start is not kept."""
     from model.analysis.locus import kept_sweep_estimate
 
-    m = model(params_path, rail)
-    low, high = _sweep_range(parameter)
-    if parameter == "s0":
-        ends = [operating_point(params_path, rail, x, fixed, N0_kN, b_M) for x in (low, high)]
-    else:
-        ends = [operating_point(params_path, rail, fixed, x, N0_kN, b_M) for x in (low, high)]
-    op = operating_point(params_path, rail, *point)
-    return kept_sweep_estimate(m, op, *ends, max_frequency_hz=LOCUS_MAX_HZ,
+    m = model_for(sweep.case)
+    ends = [sweep.at(x).operating_point() for x in _sweep_range(sweep.parameter)]
+    return kept_sweep_estimate(m, case.operating_point(), *ends, max_frequency_hz=LOCUS_MAX_HZ,
                                lambda_floor=LOCUS_LAMBDA_FLOOR)
 
 
@@ -441,34 +445,25 @@ def history_view(r, history: str, cut_growth: bool, peaks,
         load_peaks=peaks)
 
 
-def excitation(M0_kNm: float, f: float, D: float, dt_ms: float | None):
-    """The short circuit of the dashboard's units (:class:`model.analysis.response.ShortCircuit`):
-    ``M0_kNm`` [kN m], ``f`` [Hz], ``D`` [-], ``dt_ms`` [ms] (None: continuous motor torque)."""
-    from model.analysis.response import ShortCircuit
-
-    return ShortCircuit(M0=float(M0_kNm) * 1e3, f=float(f), D=float(D),
-                        dt=None if dt_ms is None else float(dt_ms) * 1e-3)
-
-
 def sampling_rate(f: float) -> float:
     """The histories' sampling rate [Hz]: RESPONSE_FS, at least 20 samples per period of f."""
     return max(RESPONSE_FS, 20.0 * float(f))
 
 
-@pn.cache(max_items=64)
-def response_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                    b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
-                    t_end: float) -> ResponseView:
+def response_result(case: CaseBase) -> ResponseView:
     """Short-circuit response of both drives (model.analysis.response), linear creep."""
-    from model.analysis.response import linear_load_peaks, short_circuit_response
+    def compute() -> ResponseView:
+        from model.analysis.response import linear_load_peaks, short_circuit_response
 
-    m = model(params_path, rail)
-    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
-    r = short_circuit_response(m, op, excitation(M0_kNm, f, D, dt_ms), t_end=float(t_end),
-                               fs=sampling_rate(f), outputs=list(HISTORY_OUTPUTS))
-    # the Response tab's plots (the Design loads tab draws the drive parts of its own result)
-    return history_view(r, LINEAR_HISTORY, cut_growth=True, peaks=linear_load_peaks(m, r),
-                        plotted=RESPONSE_OUTPUTS)
+        m = model_for(case)
+        r = short_circuit_response(m, case.operating_point(), case.short_circuit(),
+                                   t_end=float(case.t_end), fs=sampling_rate(case.f),
+                                   outputs=list(HISTORY_OUTPUTS))
+        # the Response tab's plots (the Design loads tab draws the drive parts of its own
+        # result)
+        return history_view(r, LINEAR_HISTORY, cut_growth=True, peaks=linear_load_peaks(m, r),
+                            plotted=RESPONSE_OUTPUTS)
+    return cached("response", case, compute)
 
 
 # --- the nonlinear creep model ----------------------------------------------------------------------
@@ -508,45 +503,57 @@ class NonlinearHistories:
         return self.response.peaks
 
 
-@pn.cache(max_items=32)
-def nonlinear_histories(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                        b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
-                        t_end: float, anti_slip: tuple) -> NonlinearHistories:
+def nonlinear_histories(case: CaseBase, anti_slip: tuple) -> NonlinearHistories:
     """The nonlinear response (model.analysis.nonlinear) of HISTORY_OUTPUTS; ``anti_slip``:
     (enabled, delay [s], threshold [m/s], rate [1/s]) of ID2's protection."""
-    from model.analysis.load_peaks import load_peaks
-    from model.analysis.nonlinear import AntiSlip, nonlinear_response
+    anti_slip = tuple(anti_slip)
 
-    m = model(params_path, rail)
-    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
-    enabled, delay, threshold, rate = anti_slip
-    protection = AntiSlip(True, delay, threshold, rate) if enabled else None
-    r = nonlinear_response(m, op, excitation(M0_kNm, f, D, dt_ms), float(t_end),
-                           sampling_rate(f), anti_slip=protection, outputs=list(HISTORY_OUTPUTS))
-    stride = max(1, len(r.t) // PATH_POINTS)
-    paths = {rim: (s[::stride].astype(np.float32),
-                   (r.utilisation[rim][::stride] * r.mu_max).astype(np.float32))
-             for rim, s in r.creepage.items()}
-    return NonlinearHistories(
-        # every drive part plotted: the Design loads tab overlays the nonlinear history
-        response=history_view(r, anti_slip_description(anti_slip), cut_growth=False,
-                              peaks=load_peaks(r.t, r.outputs, r.steady, r.units,
-                                               r.limit_crossings, "nonlinear",
-                                               split_note="nonlinear creep: not split")),
-        paths=paths, detection_time=r.detection_time, action_time=r.action_time,
-        max_creepage=float(max(s.max() for s in r.creepage.values())),
-        M_ad=float(r.limits["M_ad"]))
+    def compute() -> NonlinearHistories:
+        from model.analysis.load_peaks import load_peaks
+        from model.analysis.nonlinear import nonlinear_response
+
+        enabled, delay, threshold, rate = anti_slip
+        protection = AntiSlip(True, delay, threshold, rate) if enabled else None
+        r = nonlinear_response(model_for(case), case.operating_point(), case.short_circuit(),
+                               float(case.t_end), sampling_rate(case.f), anti_slip=protection,
+                               outputs=list(HISTORY_OUTPUTS))
+        stride = max(1, len(r.t) // PATH_POINTS)
+        paths = {rim: (s[::stride].astype(np.float32),
+                       (r.utilisation[rim][::stride] * r.mu_max).astype(np.float32))
+                 for rim, s in r.creepage.items()}
+        return NonlinearHistories(
+            # every drive part plotted: the Design loads tab overlays the nonlinear history
+            response=history_view(r, anti_slip_description(anti_slip), cut_growth=False,
+                                  peaks=load_peaks(r.t, r.outputs, r.steady, r.units,
+                                                   r.limit_crossings, "nonlinear",
+                                                   split_note="nonlinear creep: not split")),
+            paths=paths, detection_time=r.detection_time, action_time=r.action_time,
+            max_creepage=float(max(s.max() for s in r.creepage.values())),
+            M_ad=float(r.limits["M_ad"]))
+    return cached("nonlinear", case, compute, anti_slip)
 
 
-def history_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                   b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
-                   t_end: float, anti_slip: tuple | None) -> ResponseView:
+@dataclass(frozen=True)
+class HistoryKey:
+    """Which history: the case and the creep model (``anti_slip``: the nonlinear creep model
+    with ID2's anti-slip key (enabled, delay [s], threshold [m/s], rate [1/s]); None: the linear
+    closed form)."""
+
+    case: Case
+    anti_slip: tuple | None = None
+
+    @property
+    def result(self) -> ResponseView:
+        """The history (:func:`history_result`)."""
+        return history_result(self.case, self.anti_slip)
+
+
+def history_result(case: CaseBase, anti_slip: tuple | None) -> ResponseView:
     """The history the dashboard describes (peak table, CSV, spectra, report): the linear one
-    (``anti_slip`` None) or the nonlinear one with that anti-slip key (both cached)."""
-    point = (params_path, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, t_end)
+    (``anti_slip`` None) or the nonlinear one with that anti-slip key (both kept)."""
     if anti_slip is None:
-        return response_result(*point)
-    return nonlinear_histories(*point, tuple(anti_slip)).response
+        return response_result(case)
+    return nonlinear_histories(case, tuple(anti_slip)).response
 
 
 # --- design loads: the worst fault instant and the load spectrum -----------------------------------
@@ -557,7 +564,7 @@ class WorstCaseView:
     closed form: :mod:`model.analysis.fault_instant`), beside the history at the dashboard's Δt.
     Dicts are keyed by the DRIVE_PARTS names; values in the output's unit (N m or N)."""
 
-    key: tuple  # the arguments of worst_case_result
+    case: Case  # what it was computed for
     units: dict[str, str]
     max: dict[str, float]  # largest total over every Δt and the time grid
     min: dict[str, float]  # smallest
@@ -580,50 +587,52 @@ class WorstCaseView:
     plot: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = field(repr=False)
 
 
-@pn.cache(max_items=64)
-def worst_case_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                      b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
-                      t_end: float) -> WorstCaseView:
+def worst_case_result(case: CaseBase) -> WorstCaseView:
     """Max and min over every fault instant of each drive part's total, at each time and over
     the time grid of :func:`response_result` (three closed-form evaluations), and the history at
     the dashboard's Δt for comparison."""
-    from model.analysis.fault_instant import history_peaks, phase_families, worst_fault_instant
+    def compute() -> WorstCaseView:
+        from model.analysis.fault_instant import history_peaks, phase_families, worst_fault_instant
 
-    m = model(params_path, rail)
-    op = operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
-    shock = excitation(M0_kNm, f, D, dt_ms)
-    family = phase_families(m, op, [(shock.f, shock.D)], float(t_end), sampling_rate(f),
-                            list(DRIVE_PARTS))[0]
-    worst = worst_fault_instant(family, shock.M0)
-    dt = shock.shift(family.motor_torque)
-    at_dt = family.totals(shock.M0, dt)
-    peaks = history_peaks(family.t, at_dt, dt)
-    M_ad = adhesion_moment(m.parameters, op.v, op.N0)
-    names = family.names
-    # plots end where a torque of the worst case grows beyond GROWTH_CUT x M_ad (unstable)
-    torque = [j for j, name in enumerate(names) if family.units[name] == "N m"]
-    reach = np.maximum(np.abs(worst.upper[:, torque]), np.abs(worst.lower[:, torque])).max(axis=1)
-    beyond = np.flatnonzero(reach > GROWTH_CUT * M_ad)
-    stop = int(beyond[0]) + 1 if len(beyond) else len(family.t)
-    plot = {}
-    for j, name in enumerate(names):
-        td, ys = decimate(family.t[:stop], [worst.upper[:stop, j], worst.lower[:stop, j],
-                                            at_dt[:stop, j]])
-        plot[name] = (td.astype(np.float32), *(y.astype(np.float32) for y in ys))
-    by_name = lambda values: {name: float(values[j]) for j, name in enumerate(names)}  # noqa: E731
-    return WorstCaseView(
-        key=(params_path, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms, t_end),
-        units={name: family.units[name] for name in names},
-        max=by_name(worst.peaks.max), min=by_name(worst.peaks.min),
-        phase_of_max=by_name(worst.peaks.phase_of_max),
-        phase_of_min=by_name(worst.peaks.phase_of_min),
-        time_of_max=by_name(worst.peaks.time_of_max), time_of_min=by_name(worst.peaks.time_of_min),
-        at_dt_max=by_name(peaks.max), at_dt_min=by_name(peaks.min),
-        at_dt_time_of_max=by_name(peaks.time_of_max),
-        at_dt_time_of_min=by_name(peaks.time_of_min),
-        dt=float(dt), dt_auto=dt_ms is None, roots=family.continuity_phases(shock.M0),
-        period=1.0 / shock.f, M_ad=float(M_ad), truncated_at=family.truncated_at,
-        plot_cut=float(family.t[stop - 1]) if stop < len(family.t) else None, plot=plot)
+        m = model_for(case)
+        op = case.operating_point()
+        shock = case.short_circuit()
+        family = phase_families(m, op, [(shock.f, shock.D)], float(case.t_end),
+                                sampling_rate(case.f), list(DRIVE_PARTS))[0]
+        worst = worst_fault_instant(family, shock.M0)
+        dt = shock.shift(family.motor_torque)
+        at_dt = family.totals(shock.M0, dt)
+        peaks = history_peaks(family.t, at_dt, dt)
+        M_ad = adhesion_moment(m.parameters, op.v, op.N0)
+        names = family.names
+        # plots end where a torque of the worst case grows beyond GROWTH_CUT x M_ad (unstable)
+        torque = [j for j, name in enumerate(names) if family.units[name] == "N m"]
+        reach = np.maximum(np.abs(worst.upper[:, torque]),
+                           np.abs(worst.lower[:, torque])).max(axis=1)
+        beyond = np.flatnonzero(reach > GROWTH_CUT * M_ad)
+        stop = int(beyond[0]) + 1 if len(beyond) else len(family.t)
+        plot = {}
+        for j, name in enumerate(names):
+            td, ys = decimate(family.t[:stop], [worst.upper[:stop, j], worst.lower[:stop, j],
+                                                at_dt[:stop, j]])
+            plot[name] = (td.astype(np.float32), *(y.astype(np.float32) for y in ys))
+
+        def by_name(values):
+            return {name: float(values[j]) for j, name in enumerate(names)}
+        return WorstCaseView(
+            case=case, units={name: family.units[name] for name in names},
+            max=by_name(worst.peaks.max), min=by_name(worst.peaks.min),
+            phase_of_max=by_name(worst.peaks.phase_of_max),
+            phase_of_min=by_name(worst.peaks.phase_of_min),
+            time_of_max=by_name(worst.peaks.time_of_max),
+            time_of_min=by_name(worst.peaks.time_of_min),
+            at_dt_max=by_name(peaks.max), at_dt_min=by_name(peaks.min),
+            at_dt_time_of_max=by_name(peaks.time_of_max),
+            at_dt_time_of_min=by_name(peaks.time_of_min),
+            dt=float(dt), dt_auto=case.dt is None, roots=family.continuity_phases(shock.M0),
+            period=1.0 / shock.f, M_ad=float(M_ad), truncated_at=family.truncated_at,
+            plot_cut=float(family.t[stop - 1]) if stop < len(family.t) else None, plot=plot)
+    return cached("worst case", case, compute)
 
 
 @dataclass(frozen=True)
@@ -637,17 +646,17 @@ class SpectraView:
     # name -> rainflow matrix (counts: range bins x mean bins [-], range edges, mean edges [unit])
 
 
-@pn.cache(max_items=32)
-def spectra_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                   b_M: float, M0_kNm: float, f: float, D: float, dt_ms: float | None,
-                   t_end: float, anti_slip: tuple | None) -> SpectraView:
+def spectra_result(case: CaseBase, anti_slip: tuple | None) -> SpectraView:
     """Rainflow cycles, load collective, damage-equivalent ranges (m = 3 and 5, N_ref = 10⁷) and
     the rainflow matrix of each drive part's total in the history of :func:`history_result`."""
-    from model.analysis.load_spectrum import load_spectrum, rainflow_matrix
+    anti_slip = None if anti_slip is None else tuple(anti_slip)
 
-    response = history_result(params_path, rail, s0, v_kmh, N0_kN, b_M, M0_kNm, f, D, dt_ms,
-                              t_end, anti_slip)
-    spectra = {name: load_spectrum(response.outputs[name], name, response.units[name])
-               for name in DRIVE_PARTS}
-    matrices = {name: rainflow_matrix(s.cycles, RAINFLOW_BINS) for name, s in spectra.items()}
-    return SpectraView(response.history, response.fault_instant, spectra, matrices)
+    def compute() -> SpectraView:
+        from model.analysis.load_spectrum import load_spectrum, rainflow_matrix
+
+        response = history_result(case, anti_slip)
+        spectra = {name: load_spectrum(response.outputs[name], name, response.units[name])
+                   for name in DRIVE_PARTS}
+        matrices = {name: rainflow_matrix(s.cycles, RAINFLOW_BINS) for name, s in spectra.items()}
+        return SpectraView(response.history, response.fault_instant, spectra, matrices)
+    return cached("spectra", case, compute, anti_slip)

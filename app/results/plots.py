@@ -242,7 +242,7 @@ class CreepPlot:
                 and np.array_equal(shown["mu"], result.creep_mu)):
             # μ(s, v) depends on v and the creep law, not on s0: not sent again on an s0 step
             self.curve.data = {"s": result.creep_s, "mu": result.creep_mu}
-        s0 = result.key[2]
+        s0 = result.case.s0
         self.point.data = {"s": [s0], "mu": [result.mu0]}
         self.maximum.location = result.s_max
 

@@ -4,6 +4,9 @@ slider shows before its release computes the full answer.
 Sources, in this order (the first that decides gives the verdict; the eigenvalues shown come
 from the best source that has them):
 
+Everything is looked up in the one results cache (:mod:`app.results.cache`) the full answers
+fill:
+
 1. the point computed before (:func:`app.results.compute.known_point`): exact;
 2. the stability limit s0*(v) at the point's speed, wheel force and motor slope
    (:func:`app.results.compute.known_limit`): stable below it, exactly (it is the smallest
@@ -27,9 +30,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from app.results import compute
+from app.results.case import Case, CaseBase, Sweep
 from model import creep_law
 
-PREVIEWED = ("s0", "v", "N0", "b_M")  # the operating point's sliders that preview while dragged
+# the sliders that preview while dragged: the operating point's (a quantity that changes the
+# model, role "override", needs the model rebuilt: it is computed on release)
+PREVIEWED = Case.names("point")
 EXACT = "computed at this point"
 BELOW_LIMIT = "s0 below s0*(v), exact"
 ABOVE_LIMIT = "s0 at or above s0*(v)"
@@ -41,10 +47,9 @@ NOT_COVERED = "not computed yet"
 
 @dataclass(frozen=True)
 class Preview:
-    """What is known at one operating point without computing it (display units as in
-    :class:`app.results.compute.PointResult`'s key)."""
+    """What is known at one operating point without computing it."""
 
-    point: tuple  # (params_path, rail, s0 [-], v_kmh, N0_kN, b_M [N m s/rad])
+    point: Case  # the point (a record's point(): s0 [-], v [km/h], N0 [kN], b_M …)
     stable: bool | None  # None: nothing known decides it
     source: str  # where the verdict comes from (one of the names above)
     s0_limit: float | None  # s0*(v) at the point's speed, N0, b_M, if known [-]
@@ -56,11 +61,11 @@ class Preview:
 
     @property
     def s0(self) -> float:
-        return self.point[2]
+        return self.point.s0
 
     @property
     def v_kmh(self) -> float:
-        return self.point[3]
+        return self.point.v
 
 
 def along(locus: compute.LocusResult, x: float):
@@ -80,14 +85,12 @@ def along(locus: compute.LocusResult, x: float):
                                                             bool(locus.stable[i + 1]))
 
 
-def _covering_locus(point: tuple, first: str):
+def _covering_locus(point: CaseBase, first: str):
     """(locus, x) of a known root locus through the point, the sweep over ``first`` tried first;
     (None, None) if none is known."""
-    params_path, rail, s0, v_kmh, N0_kN, b_M = point
-    sweeps = {"s0": ("s0", v_kmh, s0), "v": ("v", s0, v_kmh)}
-    for parameter in (first, *(p for p in sweeps if p != first)):
-        _, fixed, x = sweeps[parameter]
-        locus = compute.known_locus(params_path, rail, parameter, fixed, N0_kN, b_M)
+    for parameter in (first, *(p for p in ("s0", "v") if p != first)):
+        x = getattr(point, parameter)
+        locus = compute.known_locus(point.sweep(parameter))
         if locus is not None and locus.values[0] <= x <= locus.values[-1]:
             return locus, x
     return None, None
@@ -98,21 +101,21 @@ def _leading(lam: np.ndarray) -> complex | None:
     return complex(finite[np.argmax(finite.real)]) if finite.size else None
 
 
-def preview(point: tuple, locus_key: tuple | None, dragged: str = "s0") -> Preview:
-    """The preview at ``point`` = (params_path, rail, s0, v_kmh, N0_kN, b_M) (rounded as the
-    dashboard's cache keys are); ``locus_key``: the root locus on screen (its reduced model is
-    the last source), ``dragged``: the slider moved (its sweep is tried first).  Costs at most
-    one reduced eigenproblem; raises what the model raises for an invalid point."""
-    params_path, rail, s0, v_kmh, N0_kN, b_M = point
-    m = compute.model(params_path, rail)
-    op = compute.operating_point(*point)  # validates the point (OperatingPointError)
+def preview(case: CaseBase, sweep: Sweep | None, dragged: str = "s0") -> Preview:
+    """The preview at the case's point; ``sweep``: the root locus on screen (its reduced model
+    is the last source), ``dragged``: the slider moved (its sweep is tried first).  Costs at
+    most one reduced eigenproblem; raises what the model raises for an invalid point."""
+    point = case.point()
+    s0 = point.s0
+    m = compute.model_for(point)
+    op = point.operating_point()  # validates the point (OperatingPointError)
     mu0 = float(creep_law(m.parameters, op.N0).mu(op.s0, op.v))
-    limit = compute.known_limit(params_path, rail, v_kmh, N0_kN, b_M)
+    limit = compute.known_limit(point)
     s0_limit = limit.s0_limit if limit is not None else None
     stable, source = None, NOT_COVERED
     lam, leading, leading_source, leading_error = np.zeros(0, complex), None, "", None
 
-    exact = compute.known_point(*point)
+    exact = compute.known_point(point)
     if exact is not None:
         stable, source = exact.stable, EXACT
         lam = np.array([mode.eigenvalue for mode in exact.modes], dtype=complex)
@@ -142,8 +145,8 @@ def preview(point: tuple, locus_key: tuple | None, dragged: str = "s0") -> Previ
         return Preview(point, stable, source, s0_limit, lam, leading, leading_source, None, mu0)
 
     estimate = None
-    if locus_key is not None:
-        estimate = compute.reduced_estimate(*locus_key, (s0, v_kmh, N0_kN, b_M))
+    if sweep is not None:
+        estimate = compute.reduced_estimate(sweep, point)
     if estimate is not None and estimate.eigenvalues.size:
         i = estimate.leading
         lam = estimate.eigenvalues[estimate.eigenvalues.imag >= 0]
@@ -158,9 +161,10 @@ def preview(point: tuple, locus_key: tuple | None, dragged: str = "s0") -> Previ
 def describe(result: Preview, dragged: str) -> list[str]:
     """The preview's lines of text (HTML-free, units given): the dragged value and the margin to
     the limit, the leading eigenvalue and where the verdict comes from."""
-    _set, _rail, s0, v_kmh, N0_kN, b_M = result.point
-    value = {"s0": f"s0 = {s0:.4f}", "v": f"v = {v_kmh:g} km/h", "N0": f"N0 = {N0_kN:g} kN",
-             "b_M": f"b_M = {b_M:g} N m s/rad"}[dragged]
+    point = result.point
+    s0, v_kmh = point.s0, point.v
+    value = (f"s0 = {s0:.4f}" if dragged == "s0"
+             else point.quantity(dragged).said(getattr(point, dragged)))
     if result.s0_limit is not None:
         limit = (f"limit s0* = {result.s0_limit:.4f} at {v_kmh:g} km/h "
                  f"(margin s0* − s0 = {result.s0_limit - s0:+.4f})")

@@ -1,12 +1,11 @@
 """What the Resonances view and the report compute (:mod:`model.analysis.campbell`,
-:mod:`model.analysis.frequency_response`), cached across sessions, as plain data.
+:mod:`model.analysis.frequency_response`), kept in the results cache, as plain data.
 
-Arguments are primitives (``panel.cache`` keys them by value) in the units of
-:mod:`app.results.compute` (``v_kmh`` [km/h], ``N0_kN`` [kN]); orders and ripples are their
-command-line texts (``"wheel:1,el:6"``, ``"el:6=250"``), parsed here (a bad text raises the
-model's one-line :class:`ValueError`).  The Campbell diagram spans the dashboard's speeds and
-names its modes at the middle of them, so it does not depend on the speed slider (the slider
-only moves the FRF's operating point and the line marking it).
+Arguments are a case record (:class:`app.results.case.Case`) and the view's settings; orders
+and ripples are their command-line texts (``"wheel:1,el:6"``, ``"el:6=250"``), parsed here (a
+bad text raises the model's one-line :class:`ValueError`).  The Campbell diagram spans the
+dashboard's speeds and names its modes at the middle of them, so it does not depend on the
+speed slider (the slider only moves the FRF's operating point and the line marking it).
 """
 
 from __future__ import annotations
@@ -14,9 +13,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import panel as pn
 
 from app.results import compute
+from app.results.case import Case, CaseBase
 from model.analysis.campbell import campbell, ripple_response, speeds_kmh
 from model.analysis.frequency_response import (
     DEFAULT_INPUT,
@@ -34,7 +33,7 @@ from model.mechanics.excitation import (
 )
 from model.mechanics.outputs import output_matrices
 
-SPEEDS_KMH = (10.0, 250.0)  # the dashboard's speed range [km/h]
+SPEEDS_KMH = Case.quantity("v").bounds  # the dashboard's speed range [km/h]
 CAMPBELL_SPEEDS = 200  # speeds of the diagram
 RIPPLE_SPEEDS = 241  # speeds of the forced response (1 km/h apart)
 FRF_POINTS = 2000  # log-spaced frequencies of the FRF (plus the resonances' points)
@@ -43,7 +42,6 @@ FRF_POINTS = 2000  # log-spaced frequencies of the FRF (plus the resonances' poi
 # torque has); the view and `bogie ripple` take any other
 DEFAULT_RIPPLE = "el:6=256,el:12=128"
 DEFAULT_OUTPUT = "ID1.driving_shaft.torque"
-MOTOR_INPUTS = ("ID1.motor.torque", "ID2.motor.torque")
 
 
 @dataclass(frozen=True)
@@ -72,7 +70,7 @@ class CampbellCrossing:
 class CampbellView:
     """The Campbell diagram for the views (read-only, shared between sessions)."""
 
-    key: tuple
+    case: Case  # its point, the speed left out
     v_kmh: np.ndarray  # (V,) [km/h]
     reference_kmh: float  # the speed the modes are named at [km/h]
     modes: tuple[CampbellMode, ...]
@@ -81,43 +79,46 @@ class CampbellView:
     input: str
 
 
-@pn.cache(max_items=16)
-def campbell_result(params_path: str, rail: str, s0: float, N0_kN: float, b_M: float,
-                    orders: str = DEFAULT_ORDERS, fixed_hz: tuple[float, ...] = (),
-                    input: str = DEFAULT_INPUT) -> CampbellView:
-    """The diagram over :data:`SPEEDS_KMH` at s0, N0, b_M (``orders``: their text;
-    ``fixed_hz``: fixed frequencies [Hz])."""
-    chosen = parse_orders(orders) + tuple(Order("fixed", float(f)) for f in fixed_hz)
-    chosen = tuple(dict.fromkeys(chosen))
-    m = compute.model(params_path, rail)
-    reference = 0.5 * (SPEEDS_KMH[0] + SPEEDS_KMH[1])
-    op = compute.operating_point(params_path, rail, s0, reference, N0_kN, b_M)
-    diagram = campbell(m, op, speeds_kmh(*SPEEDS_KMH, CAMPBELL_SPEEDS), chosen, load_excitation(),
-                       input=input)
-    modes = tuple(CampbellMode(mode.name, mode.f_hz, mode.zeta, mode.eigenvalues)
-                  for mode in diagram.modes)
-    lines = tuple((o.name, o.label, line) for o, line in zip(diagram.orders, diagram.lines_hz,
-                                                              strict=True))
-    crossings = tuple(CampbellCrossing(c.mode, c.order.name, c.order.label, c.v_kmh, c.f_hz,
-                                       c.zeta, *c.worst) for c in diagram.crossings)
-    return CampbellView((params_path, rail, s0, N0_kN, b_M, orders, fixed_hz, input),
-                        diagram.v_kmh, reference, modes, lines, crossings, input)
+def campbell_result(case: CaseBase, orders: str = DEFAULT_ORDERS,
+                    fixed_hz: tuple[float, ...] = (), input: str = DEFAULT_INPUT) -> CampbellView:
+    """The diagram over :data:`SPEEDS_KMH` at the case's creepage, wheel force, motor slope and
+    set (``orders``: their text; ``fixed_hz``: fixed frequencies [Hz])."""
+    point = case.point().without("v")
+    fixed_hz = tuple(float(f) for f in fixed_hz)
+
+    def compute_diagram() -> CampbellView:
+        chosen = parse_orders(orders) + tuple(Order("fixed", f) for f in fixed_hz)
+        chosen = tuple(dict.fromkeys(chosen))
+        reference = 0.5 * (SPEEDS_KMH[0] + SPEEDS_KMH[1])
+        op = point.replace(v=reference).operating_point()
+        diagram = campbell(compute.model_for(point), op,
+                           speeds_kmh(*SPEEDS_KMH, CAMPBELL_SPEEDS), chosen, load_excitation(),
+                           input=input)
+        modes = tuple(CampbellMode(mode.name, mode.f_hz, mode.zeta, mode.eigenvalues)
+                      for mode in diagram.modes)
+        lines = tuple((o.name, o.label, line) for o, line in zip(diagram.orders,
+                                                                  diagram.lines_hz, strict=True))
+        crossings = tuple(CampbellCrossing(c.mode, c.order.name, c.order.label, c.v_kmh, c.f_hz,
+                                           c.zeta, *c.worst) for c in diagram.crossings)
+        return CampbellView(point, diagram.v_kmh, reference, modes, lines, crossings, input)
+    return compute.cached("campbell", point, compute_diagram, orders, fixed_hz, input)
 
 
-@pn.cache(max_items=32)
-def frf_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float, b_M: float,
-               input: str = DEFAULT_INPUT) -> FrequencyResponse:
-    """H(f) from ``input`` to every output at the point (0.1…1000 Hz, the static gain first)."""
-    m = compute.model(params_path, rail)
-    op = compute.operating_point(params_path, rail, s0, v_kmh, N0_kN, b_M)
-    return frequency_response(m, op, input=input, points=FRF_POINTS)
+def frf_result(case: CaseBase, input: str = DEFAULT_INPUT) -> FrequencyResponse:
+    """H(f) from ``input`` to every output at the case's point (0.1…1000 Hz, the static gain
+    first)."""
+    point = case.point()
+    return compute.cached("frf", point, lambda: frequency_response(
+        compute.model_for(point), point.operating_point(), input=input, points=FRF_POINTS), input)
 
 
 @dataclass(frozen=True)
 class RippleView:
     """Steady amplitudes over speed under a ripple (read-only)."""
 
-    key: tuple
+    case: Case  # its point, the speed left out
+    ripple: str  # the ripple's text
+    input: str  # the rippling motor
     v_kmh: np.ndarray  # (V,) [km/h]
     orders: tuple[str, ...]  # "el:6", …
     labels: tuple[str, ...]  # "6× electrical", …
@@ -128,28 +129,32 @@ class RippleView:
     total: np.ndarray  # (outputs, V)
 
 
-@pn.cache(max_items=16)
-def ripple_result(params_path: str, rail: str, s0: float, N0_kN: float, b_M: float,
-                  ripple: str = DEFAULT_RIPPLE, input: str = DEFAULT_INPUT) -> RippleView:
+def ripple_result(case: CaseBase, ripple: str = DEFAULT_RIPPLE,
+                  input: str = DEFAULT_INPUT) -> RippleView:
     """The forced response over :data:`SPEEDS_KMH` to the ripple text ``ripple``."""
-    amplitudes = parse_amplitudes(ripple)
-    m = compute.model(params_path, rail)
-    op = compute.operating_point(params_path, rail, s0, SPEEDS_KMH[0], N0_kN, b_M)
-    result = ripple_response(m, op, speeds_kmh(*SPEEDS_KMH, RIPPLE_SPEEDS), amplitudes,
-                             load_excitation(), input=input)
-    return RippleView((params_path, rail, s0, N0_kN, b_M, ripple, input), result.v_kmh,
-                      tuple(o.name for o in result.orders), tuple(o.label for o in result.orders),
-                      result.amplitudes, result.names, result.units, result.by_order, result.total)
+    point = case.point().without("v")
+
+    def compute_ripple() -> RippleView:
+        amplitudes = parse_amplitudes(ripple)
+        op = point.replace(v=SPEEDS_KMH[0]).operating_point()
+        result = ripple_response(compute.model_for(point), op,
+                                 speeds_kmh(*SPEEDS_KMH, RIPPLE_SPEEDS), amplitudes,
+                                 load_excitation(), input=input)
+        return RippleView(point, ripple, input, result.v_kmh,
+                          tuple(o.name for o in result.orders),
+                          tuple(o.label for o in result.orders), result.amplitudes,
+                          result.names, result.units, result.by_order, result.total)
+    return compute.cached("ripple", point, compute_ripple, ripple, input)
 
 
-@pn.cache(max_items=8)
-def output_names(params_path: str, rail: str) -> tuple[tuple[str, str], ...]:
-    """(name, unit) of every named output of the set's model."""
-    m = compute.model(params_path, rail)
-    matrices = output_matrices(m, compute.operating_point(params_path, rail, 0.005, 120.0,
-                                                          m.parameters["wheel_force"] / 1e3,
-                                                          m.parameters["motor_slope"]))
-    return tuple(zip(matrices.names, matrices.units, strict=True))
+def output_names(set_key: str) -> tuple[tuple[str, str], ...]:
+    """(name, unit) of every named output of the set's model (the calibrated creep law)."""
+    point = Case(set_key=set_key, **Case.defaults(compute.parameters(set_key))).point()
+
+    def names() -> tuple[tuple[str, str], ...]:
+        matrices = output_matrices(compute.model_for(point), point.operating_point())
+        return tuple(zip(matrices.names, matrices.units, strict=True))
+    return compute.cached("output names", point, names)
 
 
 def parse_fixed(text: str) -> tuple[float, ...]:

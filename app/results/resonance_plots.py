@@ -170,7 +170,7 @@ class RipplePlot:
         colors = ["black"] + [Category10_10[k % 10] for k in range(len(ripple.orders))]
         self.source.data = {"xs": [ripple.v_kmh] * len(series), "ys": series, "label": labels,
                             "color": colors}
-        self.figure.title.text = f"{output} under a torque ripple of {ripple.key[-1]}"
+        self.figure.title.text = f"{output} under a torque ripple of {ripple.input}"
         self.figure.yaxis.axis_label = f"steady amplitude [{ripple.units[row]}]"
 
     def mark_speed(self, v_kmh: float) -> None:

@@ -29,7 +29,7 @@ def eigen_table_html(point: compute.PointResult) -> str:
         r_cell = (f'<td class="{"bad" if r > 0 else ""}">{r:+.4g}</td>' if r is not None
                   else "<td></td>")
         rows.append(f"<tr><td>{i + 1}</td>{c_cell}{r_cell}</tr>")
-    s0, v = point.key[2], point.key[3]
+    s0, v = point.case.s0, point.case.v
     return (f"<b>Eigenvalues at s0 = {s0:g}, v = {v:g} km/h</b> (Re [1/s] ± i Im [Hz]; "
             f"{point.n_rigid} rigid-body zeros deflated)"
             '<table class="bogie"><tr><th>#</th><th>complex</th><th>real (largest first)</th></tr>'

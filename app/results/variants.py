@@ -171,6 +171,16 @@ def set_hash(parameters: Parameters) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
+def full_hash(parameters: Parameters) -> str:
+    """SHA-256 (hex) of every value of a set, the strength data included (names in
+    :data:`model.mechanics.parameters.ALL_SCHEMA` order, each value's ``repr``): the key of a
+    set in the results cache (:mod:`app.results.cache`); two sets with equal hashes are equal
+    in every number (:func:`model.mechanics.parameters.parameter_hash` leaves the strength data
+    out: equal dynamics)."""
+    text = ";".join(f"{name}={float(parameters.values[name])!r}" for name in ALL_SCHEMA)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 def changes_from_toml(data: bytes, base: Parameters) -> dict[str, float]:
     """The differences from ``base`` of an uploaded parameter file (bytes of TOML in the format
     of :mod:`model.mechanics.parameters`); raises :class:`VariantError` for an oversized, undecodable,

@@ -1,5 +1,6 @@
 """The assessment as the dashboard and the report show it: computed once per operating point and
-set (cached), the verdict indicator, the checks' table and the bar chart of safety factors.
+set (kept in the results cache), the verdict indicator, the checks' table and the bar chart of
+safety factors.
 
 At the dashboard's operating point: a stable point is the short-circuit case's grid (that one
 point), an unstable one the unstable_adhesion case's point (the short-circuit case then takes the
@@ -12,13 +13,14 @@ import html
 import math
 
 import numpy as np
-import panel as pn
 from bokeh.models import ColumnDataSource, FactorRange, HoverTool, Span
 from bokeh.plotting import figure
 
+from app.results import compute
+from app.results.case import CaseBase
 from model.analysis.assessment import KIND_NAMES, VERDICT_WORDS, verdict_colour
 from model.analysis.response import ShortCircuit
-from model.mechanics.operating_point import KMH, OperatingPoint
+from model.mechanics.operating_point import KMH
 from model.studies.assessment import (
     Assessment,
     AssessmentOptions,
@@ -33,52 +35,60 @@ from model.studies.assessment import (
 CASE_COLOURS = {"short_circuit": "#1f77b4", "unstable_adhesion": "#d62728", "starting": "#2ca02c"}
 
 
-def _parameters(params_path: str, rail: str, strength: tuple):
-    from app.results import compute
-
-    parameters = compute.parameters(params_path, rail)
+def _parameters(case: CaseBase, strength: tuple):
+    parameters = compute.parameters_for(case)
     return parameters.replace(**dict(strength)) if strength else parameters
 
 
-@pn.cache(max_items=16)
-def assessment_result(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                      b_M: float, M0_kN: float, f: float, D: float,
-                      strength: tuple = ()) -> Assessment:
-    """The assessment at an operating point (primitives: the cache key), with the strength data
-    ``strength`` ((name, value) pairs) replacing the set's.  The same as
-    :func:`model.studies.assessment.assess` with these options; its unstable case is cached
+def assessment_result(case: CaseBase, strength: tuple = ()):
+    """The assessment at the case's point and short circuit (its Δt and horizon do not count:
+    every fault instant, the horizons of the load cases), with the strength data ``strength``
+    ((name, value) pairs) replacing the set's.  The same as
+    :func:`model.studies.assessment.assess` with these options; its unstable case is kept
     apart (:func:`unstable_case`): at a stable point it is the default one, which a step of
     the creepage or the speed leaves as it was."""
-    from model.analysis.eigen import bogie_system
-    from model.studies.maps import cached_model
+    key = case.without("dt", "t_end")
+    strength = tuple(strength)
 
-    parameters = _parameters(params_path, rail, strength)
-    op = OperatingPoint(s0, v_kmh * KMH, N0_kN * 1e3, b_M)
-    stable = float(np.max(bogie_system(cached_model(parameters), op).eigenvalues().real)) <= 1e-6
-    excitation = ShortCircuit(M0=M0_kN * 1e3, f=f, D=D)
-    if stable:
-        options = AssessmentOptions(s0=(s0,), v=(op.v,), N0=op.N0, b_M=b_M, excitation=excitation)
-    else:
-        options = AssessmentOptions(N0=op.N0, b_M=b_M, excitation=excitation, unstable_s0=s0,
-                                    unstable_v=op.v)
-    outputs = assessed_outputs(parameters)
-    unstable = unstable_case(params_path, rail, options.unstable_s0,
-                             round(options.unstable_v / KMH, 9), N0_kN, b_M, M0_kN, f, D,
-                             strength)
-    return assessment_of(parameters, [short_circuit_case(parameters, outputs, options), unstable,
-                                      starting_case(parameters, outputs, options)])
+    def compute_assessment() -> Assessment:
+        from model.analysis.eigen import bogie_system
+
+        parameters = _parameters(key, strength)
+        op = key.operating_point()
+        stable = float(np.max(bogie_system(compute.model_of(parameters),
+                                           op).eigenvalues().real)) <= 1e-6
+        excitation = key.short_circuit()
+        if stable:
+            options = AssessmentOptions(s0=(op.s0,), v=(op.v,), N0=op.N0, b_M=op.b_M,
+                                        excitation=excitation)
+        else:
+            options = AssessmentOptions(N0=op.N0, b_M=op.b_M, excitation=excitation,
+                                        unstable_s0=op.s0, unstable_v=op.v)
+        outputs = assessed_outputs(parameters)
+        unstable = unstable_case(key.replace(s0=options.unstable_s0,
+                                             v=round(options.unstable_v / KMH, 9)), strength)
+        return assessment_of(parameters, [short_circuit_case(parameters, outputs, options),
+                                          unstable, starting_case(parameters, outputs, options)])
+    return compute.cached("assessment", key, compute_assessment, strength)
 
 
-@pn.cache(max_items=16)
-def unstable_case(params_path: str, rail: str, s0: float, v_kmh: float, N0_kN: float,
-                  b_M: float, M0_kN: float, f: float, D: float, strength: tuple = ()) -> LoadCase:
-    """The unstable_adhesion case at (``s0``, ``v_kmh`` [km/h]) with nonlinear creep and the
-    default anti-slip protection (:func:`model.studies.assessment.unstable_adhesion_case`)."""
-    parameters = _parameters(params_path, rail, strength)
-    options = AssessmentOptions(N0=N0_kN * 1e3, b_M=b_M,
-                                excitation=ShortCircuit(M0=M0_kN * 1e3, f=f, D=D),
-                                unstable_s0=s0, unstable_v=v_kmh * KMH)
-    return unstable_adhesion_case(parameters, assessed_outputs(parameters), options)
+def unstable_case(case: CaseBase, strength: tuple = ()) -> LoadCase:
+    """The unstable_adhesion case at the case's point (its creepage and speed) with nonlinear
+    creep and the default anti-slip protection
+    (:func:`model.studies.assessment.unstable_adhesion_case`)."""
+    key = case.without("dt", "t_end")
+    strength = tuple(strength)
+
+    def compute_case() -> LoadCase:
+        parameters = _parameters(key, strength)
+        op = key.operating_point()
+        excitation = key.short_circuit()
+        options = AssessmentOptions(N0=op.N0, b_M=op.b_M,
+                                    excitation=ShortCircuit(M0=excitation.M0, f=excitation.f,
+                                                            D=excitation.D),
+                                    unstable_s0=op.s0, unstable_v=op.v)
+        return unstable_adhesion_case(parameters, assessed_outputs(parameters), options)
+    return compute.cached("unstable case", key, compute_case, strength)
 
 
 def indicator_html(result: Assessment | None, note: str = "") -> str:

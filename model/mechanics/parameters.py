@@ -284,18 +284,23 @@ def _check_value(name: str, value: object) -> float:
     return value
 
 
-def parse_parameters(table: Mapping[str, object], source: str = "<memory>") -> Parameters:
-    """Validate a parsed TOML table into :class:`Parameters` (raises :class:`ParameterError`)."""
+def parse_entries(table: Mapping[str, object], source: str = "<memory>",
+                  unit_required: bool = True) -> tuple[dict[str, float], dict[str, str]]:
+    """(values, notes) of a parameter file's entries ``name = { value = …, unit = "…", note =
+    "…" }`` (the one reader of that format): each name known, each value a finite number within
+    its bounds in the schema's unit (``unit_required`` False: an entry without a unit is taken
+    in the schema's); raises :class:`ParameterError` naming ``source`` and the entry."""
     values: dict[str, float] = {}
     notes: dict[str, str] = {}
     for name, entry in table.items():
         if name not in ALL_SCHEMA:
             raise ParameterError(f"{source}: unknown parameter '{name}'")
-        if not isinstance(entry, Mapping) or "value" not in entry or "unit" not in entry:
+        if not isinstance(entry, Mapping) or "value" not in entry or (
+                unit_required and "unit" not in entry):
             raise ParameterError(
                 f"{source}: parameter '{name}' must be a table {{ value = …, unit = \"…\", note = \"…\" }}")
         unit = ALL_SCHEMA[name][0]
-        if entry["unit"] != unit:
+        if entry.get("unit", unit) != unit:
             raise ParameterError(
                 f"{source}: parameter '{name}' has unit '{entry['unit']}', expected '{unit}'")
         try:
@@ -303,6 +308,12 @@ def parse_parameters(table: Mapping[str, object], source: str = "<memory>") -> P
         except ParameterError as error:
             raise ParameterError(f"{source}: {error}") from None
         notes[name] = str(entry.get("note", ""))
+    return values, notes
+
+
+def parse_parameters(table: Mapping[str, object], source: str = "<memory>") -> Parameters:
+    """Validate a parsed TOML table into :class:`Parameters` (raises :class:`ParameterError`)."""
+    values, notes = parse_entries(table, source)
     for name, default in OPTIONAL_DEFAULTS.items():
         if name not in values:
             values[name] = default
@@ -362,14 +373,10 @@ def check_strength_data(values: Mapping[str, float]) -> None:
 def _default_strength_data() -> tuple[dict[str, float], dict[str, str]]:
     """(values, notes) of the strength data in the default set's file."""
     table = tomllib.loads(CALIBRATED_FILE.read_text(encoding="utf-8"))
-    values, notes = {}, {}
-    for name in ASSESSMENT_SCHEMA:
-        entry = table.get(name)
-        if not isinstance(entry, Mapping) or "value" not in entry:
-            raise ParameterError(f"{CALIBRATED_FILE}: strength datum '{name}' is missing")
-        values[name] = _check_value(name, entry["value"])
-        notes[name] = str(entry.get("note", ""))
-    return values, notes
+    missing = [name for name in ASSESSMENT_SCHEMA if name not in table]
+    if missing:
+        raise ParameterError(f"{CALIBRATED_FILE}: strength datum '{missing[0]}' is missing")
+    return parse_entries({name: table[name] for name in ASSESSMENT_SCHEMA}, str(CALIBRATED_FILE))
 
 
 def load_parameters(path: str | Path | None = None) -> Parameters:

@@ -27,11 +27,23 @@ from model.studies.s0_line import check_s0, s0_line
 
 _MODELS: dict[str, BogieModel] = {}
 _MODELS_LOCK = threading.Lock()
+_MODEL_SOURCE = None  # where cached_model takes its models from (None: _MODELS)
+
+
+def set_model_source(source) -> None:
+    """Let :func:`cached_model` take its models from ``source(parameters)`` (None: its own
+    cache again): a served dashboard's results cache keeps one model per parameter set, which
+    the studies and checks it runs in its own process then share."""
+    global _MODEL_SOURCE
+    _MODEL_SOURCE = source
 
 
 def cached_model(parameters: Parameters) -> BogieModel:
     """The assembled model of a parameter set, kept per process by the set's hash (a worker
-    process assembles it once per study, not once per chunk)."""
+    process assembles it once per study, not once per chunk), or the one of the source set by
+    :func:`set_model_source`."""
+    if _MODEL_SOURCE is not None:
+        return _MODEL_SOURCE(parameters)
     key = parameter_hash(parameters)
     with _MODELS_LOCK:
         if key not in _MODELS:

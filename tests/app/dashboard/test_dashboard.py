@@ -58,8 +58,7 @@ def dash():
 
 def _verdict(dashboard) -> bool:
     m = compute.model("", dashboard.rail)
-    op = compute.operating_point("", dashboard.rail, dashboard.s0, dashboard.v, dashboard.N0,
-                                 dashboard.b_M)
+    op = dashboard.state().operating_point()
     return eigen_analysis(m, op, vectors=False).stable
 
 
@@ -88,8 +87,8 @@ def test_peak_table_of_the_published_cases(dash):
     m = compute.model("", "calibrated")
     for s0 in (0.005, 0.014):
         dash.show_published_case(s0)
-        op = compute.operating_point("", "calibrated", s0, dash.v, dash.N0, dash.b_M)
-        r = short_circuit_response(m, op, compute.excitation(dash.M0, dash.f, dash.D, None),
+        op = dash.state().replace(s0=s0).operating_point()
+        r = short_circuit_response(m, op, dash.state().replace(dt=None).short_circuit(),
                                    dash.t_end, compute.sampling_rate(dash.f), [name])
         table = dash.peaks.object
         if s0 == 0.005:
@@ -115,7 +114,7 @@ def test_peak_table_of_the_published_cases(dash):
 def test_views_show_the_current_point(dash):
     dash.param.update(s0=0.0065, v=100.0)
     m = compute.model("", "calibrated")
-    op = compute.operating_point("", "calibrated", 0.0065, 100.0, dash.N0, dash.b_M)
+    op = dash.state().replace(s0=0.0065, v=100.0).operating_point()
     result = eigen_analysis(m, op)
     # highlighted eigenvalues on the root locus = the model's lowest complex pairs
     shown = np.array(dash.locus_plot.current.data["x"]) + 1j * np.array(

@@ -37,18 +37,19 @@ from bokeh.document import Document
 from conftest import InProcessEngine, install_study_queue
 
 from app.results import compute
+from app.results.case import Case
 from app.results.tables import format_kilo, format_load
 from model.analysis.load_spectrum import N_REF
 
-POINT = ("", "calibrated", 0.005, 120.0, 100.0, 3000.0)
-EXCITATION = (50.0, 90.0, 0.04, None, 1.0)  # M0 [kN m], f, D, Δt automatic, t_end [s]
+# s0, v [km/h], N0 [kN], b_M; M0 [kN m], f, D, Δt automatic, t_end [s]
+CASE = Case(s0=0.005, v=120.0, N0=100.0, b_M=3000.0, M0=50.0, f=90.0, D=0.04, dt=None, t_end=1.0)
 
 
 # --- the cached computations ---------------------------------------------------------------------
 
 def test_worst_case_bounds_every_single_response_and_keeps_the_response_tabs_history():
-    worst = compute.worst_case_result(*POINT, *EXCITATION)
-    response = compute.response_result(*POINT, *EXCITATION)
+    worst = compute.worst_case_result(CASE)
+    response = compute.response_result(CASE)
     assert set(worst.units) == set(compute.DRIVE_PARTS)
     assert worst.dt == pytest.approx(response.fault_instant, abs=1e-15)
     assert worst.dt_auto
@@ -59,10 +60,9 @@ def test_worst_case_bounds_every_single_response_and_keeps_the_response_tabs_his
         assert worst.at_dt_max[name] == pytest.approx(y.max(), abs=1e-6 * scale)
         assert worst.at_dt_min[name] == pytest.approx(y.min(), abs=1e-6 * scale)
     # 36 single responses (the Response tab's own computation) at fault instants over a period
-    period = 1.0 / EXCITATION[1]
+    period = 1.0 / CASE.f
     grid = np.arange(36) / 36 * period - period / 2
-    singles = [compute.response_result(*POINT, *EXCITATION[:3], dt * 1e3, EXCITATION[4])
-               for dt in grid]
+    singles = [compute.response_result(CASE.replace(dt=dt * 1e3)) for dt in grid]
     for name in compute.DRIVE_PARTS:
         highest = max(r.outputs[name].max() for r in singles)
         lowest = min(r.outputs[name].min() for r in singles)
@@ -73,8 +73,7 @@ def test_worst_case_bounds_every_single_response_and_keeps_the_response_tabs_his
         assert lowest - worst.min[name] <= 0.01 * scale, name
     # the Δt and time of the max reproduce it in a single response
     name = "ID1.driving_shaft.torque"
-    again = compute.response_result(*POINT, *EXCITATION[:3], worst.phase_of_max[name] * 1e3,
-                                    EXCITATION[4])
+    again = compute.response_result(CASE.replace(dt=worst.phase_of_max[name] * 1e3))
     k = round(worst.time_of_max[name] * compute.RESPONSE_FS)
     assert again.outputs[name][k] == pytest.approx(worst.max[name],
                                                    abs=1e-6 * abs(worst.max[name]))
@@ -84,20 +83,20 @@ def test_worst_case_bounds_every_single_response_and_keeps_the_response_tabs_his
     # plots: the whole horizon (stable point), decimated with every extreme kept
     t, upper, lower, at_dt = worst.plot[name]
     assert worst.plot_cut is None
-    assert t[-1] == pytest.approx(EXCITATION[4])
+    assert t[-1] == pytest.approx(CASE.t_end)
     assert float(upper.max()) == pytest.approx(worst.max[name], rel=1e-6)
     assert float(lower.min()) == pytest.approx(worst.min[name], rel=1e-6)
     assert float(at_dt.max()) == pytest.approx(worst.at_dt_max[name], rel=1e-6)
-    assert compute.worst_case_result(*POINT, *EXCITATION) is worst  # cached
+    assert compute.worst_case_result(CASE) is worst  # cached
 
 
 def test_spectra_of_the_linear_and_the_nonlinear_history():
-    linear = compute.spectra_result(*POINT, *EXCITATION, None)
-    nonlinear_key = (*POINT, *EXCITATION, (False, 0.1, 0.3, 10.0))
+    linear = compute.spectra_result(CASE, None)
+    nonlinear_key = (CASE, (False, 0.1, 0.3, 10.0))
     nonlinear = compute.spectra_result(*nonlinear_key)
     assert linear.history == compute.LINEAR_HISTORY
     assert nonlinear.history == "nonlinear creep, anti-slip off"
-    for result, history in ((linear, compute.response_result(*POINT, *EXCITATION)),
+    for result, history in ((linear, compute.response_result(CASE)),
                             (nonlinear, compute.nonlinear_histories(*nonlinear_key).response)):
         assert set(result.spectra) == set(compute.DRIVE_PARTS)
         for name, spectrum in result.spectra.items():
@@ -165,15 +164,13 @@ def test_the_tab_shows_the_worst_case_and_the_spectrum_at_the_point(dash):
     assert "tab=design-loads" in dash.share_query()
     view = dash.design_loads
     state = dash.state()
-    expected = compute.worst_case_result(*state.point, state.M0, state.f, state.D, state.dt,
-                                         state.t_end)
+    expected = compute.worst_case_result(state)
     assert view.worst is expected
     for name in compute.DRIVE_PARTS:
         assert format_load(expected.max[name]) in view.worst_table.object
         assert format_load(expected.min[name]) in view.worst_table.object
         assert f"{expected.phase_of_max[name]:.6f}" in view.worst_table.object
-    spectra = compute.spectra_result(*state.point, state.M0, state.f, state.D, state.dt,
-                                     state.t_end, None)
+    spectra = compute.spectra_result(state, None)
     assert view.spectra is spectra
     assert "linear creep" in view.spectra_note.object
     for name, spectrum in spectra.spectra.items():
@@ -198,7 +195,7 @@ def test_the_worst_case_follows_the_sliders(dash):
     before = view.worst
     dash.M0 = 80.0
     assert view.worst is not before
-    assert view.worst.key[6] == 80.0
+    assert view.worst.case.M0 == 80.0
     assert view.worst.max["ID1.driving_shaft.torque"] > before.max["ID1.driving_shaft.torque"]
     dash.M0 = 50.0
 
@@ -251,9 +248,9 @@ def test_a_grid_envelope_from_the_tab_equals_the_models(dash):
     assert tab == "response"
     first = reference.outputs[0]  # the first row's max
     assert values["s0"] == pytest.approx(first.max_at["s0"])
-    again = compute.response_result("", values.get("rail", "calibrated"), values["s0"],
-                                    values["v"], values["N0"], values["b_M"], values["M0"],
-                                    values["f"], values["D"], values["dt"], values["t_end"])
+    again = compute.response_result(Case(rail=values.get("rail", "calibrated"),
+                                         **{name: values[name] for name in Case.names()
+                                            if name != "rail"}))
     k = round(first.max_at["time_s"] * study.fs)
     assert again.outputs[first.name][k] == pytest.approx(first.max, abs=1e-6 * abs(first.max))
     # the heat map of another output and of the min
@@ -430,8 +427,8 @@ def test_peaks_csv_and_report_describe_the_nonlinear_history(dash):
     assert "nonlinear creep, anti-slip off" in dash.peaks.object
     m = compute.model("", "calibrated")
     state = dash.state()  # the primitives the dashboard computes with (rounded)
-    op = compute.operating_point(*state.point)
-    r = nonlinear_response(m, op, compute.excitation(state.M0, state.f, state.D, state.dt),
+    op = state.operating_point()
+    r = nonlinear_response(m, op, state.short_circuit(),
                            state.t_end, compute.RESPONSE_FS,
                            outputs=list(compute.HISTORY_OUTPUTS))
     for name in compute.HISTORY_OUTPUTS:
@@ -476,9 +473,9 @@ def test_peaks_csv_and_report_describe_the_nonlinear_history(dash):
 def test_the_report_has_a_design_loads_section():
     from app.report.page import build_report
 
-    text = build_report(*POINT, *EXCITATION)
-    worst = compute.worst_case_result(*POINT, *EXCITATION)
-    spectra = compute.spectra_result(*POINT, *EXCITATION, None)
+    text = build_report(CASE)
+    worst = compute.worst_case_result(CASE)
+    spectra = compute.spectra_result(CASE, None)
     section = text[text.index("<h2>Design loads</h2>"):]
     assert "Worst case over every fault instant (linear creep, closed form)" in section
     for name in compute.DRIVE_PARTS:

@@ -9,8 +9,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.dashboard.nonlinear_view import REACTION_DELAYS, anti_slip_key, nonlinear_histories, reaction
+from app.dashboard.nonlinear_view import (
+    REACTION_DELAYS,
+    anti_slip_key,
+    nonlinear_histories,
+    reaction,
+    reaction_key,
+)
 from app.results import compute
+from app.results.case import Case
 from model.analysis.antislip import required_reaction_time
 from model.analysis.nonlinear import AntiSlip, NonlinearError, nonlinear_response
 from model.analysis.response import ShortCircuit
@@ -23,12 +30,16 @@ def test_anti_slip_key_validates():
             anti_slip_key(*bad)
 
 
+def _case(s0: float, t_end: float = 2.0) -> Case:
+    """The case at 120 km/h, N0 = 100 kN, b_M = 3000 N m s/rad, the default short circuit."""
+    return Case(s0=s0, v=120.0, N0=100.0, b_M=3000.0, M0=50.0, f=90.0, D=0.04, dt=None,
+                t_end=t_end)
+
+
 def test_histories_are_the_model_result():
-    key = ("", "calibrated", 0.014, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None, 1.0,
-           (True, 0.1, 0.3, 10.0))
-    shown = nonlinear_histories(*key)
+    shown = nonlinear_histories(_case(0.014, t_end=1.0), (True, 0.1, 0.3, 10.0))
     m = compute.model("", "calibrated")
-    op = compute.operating_point("", "calibrated", 0.014, 120.0, 100.0, 3000.0)
+    op = _case(0.014).operating_point()
     r = nonlinear_response(m, op, ShortCircuit(), 1.0, compute.RESPONSE_FS,
                            anti_slip=AntiSlip(True, 0.1, 0.3, 10.0))
     for name in compute.RESPONSE_OUTPUTS:
@@ -94,7 +105,7 @@ def test_unstable_point_shows_the_required_reaction_time(dash):
     status = dash.nonlinear.status.object
     assert "required anti-slip reaction time" in status
     m = compute.model("", "calibrated")
-    op = compute.operating_point("", "calibrated", 0.014, 120.0, dash.N0, dash.b_M)
+    op = dash.state().replace(s0=0.014, v=120.0).operating_point()
     expected = required_reaction_time(m, op, delays=REACTION_DELAYS, t_end=2.0,
                                       fs=compute.RESPONSE_FS / 2)
     shown = dash.nonlinear.reaction
@@ -107,7 +118,7 @@ def test_unstable_point_shows_the_required_reaction_time(dash):
 
 
 def test_reaction_is_cached_plain_data():
-    key = ("", "calibrated", 0.014, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None, 0.3, 10.0)
+    key = (_case(0.014), 0.3, 10.0)
     first = reaction(*key)
     assert reaction(*key) is first
     assert first.limit > 0
@@ -122,8 +133,7 @@ def test_a_reaction_search_no_session_wants_stops_at_once():
 
     start = time.perf_counter()
     with pytest.raises(ReactionSuperseded):
-        wanted_reaction("", "calibrated", 0.01371, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None,
-                        0.3, 10.0)
+        wanted_reaction(_case(0.01371), 0.3, 10.0)
     assert time.perf_counter() - start < 5.0  # no nonlinear run (each ≈ 0.5 s) was started
 
 
@@ -132,7 +142,8 @@ def test_a_reaction_search_stops_inside_a_run_once_its_view_moves_on():
     only between runs): a view whose sliders moved on stops it within one block."""
     from app.dashboard.nonlinear_view import _VIEWS, ReactionSuperseded, wanted_reaction
 
-    key = ("", "calibrated", 0.01372, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None, 0.3, 10.0)
+    arguments = (_case(0.01372), 0.3, 10.0)
+    key = reaction_key(*arguments)
 
     class MovingView:  # wants the search for its first three questions
         asked = 0
@@ -146,7 +157,7 @@ def test_a_reaction_search_stops_inside_a_run_once_its_view_moves_on():
     _VIEWS.add(view)
     try:
         with pytest.raises(ReactionSuperseded):
-            wanted_reaction(*key)
+            wanted_reaction(*arguments)
     finally:
         _VIEWS.discard(view)
     # asked before the search and before each block of the first run (2 s at 5 kHz: 5 blocks);

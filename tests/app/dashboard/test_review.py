@@ -16,7 +16,9 @@ import pytest
 from conftest import assert_self_contained_html
 
 from app.results import compute, locus_geometry
+from app.results.case import Case
 from app.results.eigenvalue_sweep import fig6_series
+from model.mechanics.operating_point import OperatingPoint
 
 # --- root locus: grid, jumps, broken lines -------------------------------------------------------
 
@@ -106,16 +108,16 @@ def test_dense_locus_is_the_models_eigenvalues():
     assert compute.LOCUS_LAMBDA_FLOOR <= 1.0
     from model import eigen_analysis
 
-    key = ("", "calibrated", "s0", 120.0, 100.0, 3000.0)
-    coarse = compute.locus_result(*key)
-    dense = compute.dense_locus_result(*key)
+    key = Case(s0=0.005, v=120.0, N0=100.0, b_M=3000.0).sweep("s0")
+    coarse = compute.locus_result(key)
+    dense = compute.dense_locus_result(key)
     assert dense.dense
     assert not coarse.dense
     assert len(dense.values) == compute.LOCUS_DENSE_POINTS >= 200
     assert np.all(np.isin(coarse.values, dense.values))
     m = compute.model("", "calibrated")
     for i in (1, len(dense.values) // 2, len(dense.values) - 2):
-        op = compute.operating_point("", "calibrated", dense.values[i], 120.0, 100.0, 3000.0)
+        op = OperatingPoint.from_kmh(float(dense.values[i]), 120.0, 100e3, 3000.0)
         exact = eigen_analysis(m, op, vectors=False).eigenvalues
         for lam in dense.eigenvalues[i]:
             if abs(lam) < 1.5 * 2 * math.pi * compute.LOCUS_MAX_HZ:
@@ -200,7 +202,7 @@ def test_link_restores_the_state_and_the_controls():
     assert dash.sliders["s0"].value == 0.014
     assert dash.tab_names[dash.tabs.active] == "fig-6"
     assert dash.set_key == "|gear_ratio:4.5"
-    assert dash.point.key[0] == dash.set_key
+    assert dash.point.case.set_key == dash.set_key
     assert compute.parameters(dash.set_key, "dry")["gear_ratio"] == 4.5
     # the link of this session restores the same settings
     from urllib.parse import parse_qsl
@@ -237,7 +239,7 @@ def test_variant_editor_upload_and_comparison(dash):
     # the dashboard shows the variant's eigenvalues (the model of the changed set)
     varied = compute.parameters(dash.set_key, "calibrated")
     assert varied["gear_ratio"] == base_ratio * 1.15
-    op = compute.operating_point("", "calibrated", dash.s0, dash.v, dash.N0, dash.b_M)
+    op = dash.state().operating_point()
     expected = eigen_analysis(build_model(varied), op).complex_pairs[0]
     assert complex(dash.point.modes[0].eigenvalue) == pytest.approx(expected, rel=1e-9)
     # beside the baseline: both sides computed, the changed set differs in its loads
@@ -328,10 +330,11 @@ def test_report_of_a_variant_is_self_contained_and_complete():
 
     base = compute.parameters("", "calibrated")
     key = f"|gear_ratio:{base['gear_ratio'] * 1.1!r}"
-    text = build_report(key, "calibrated", 0.014, 120.0, 100.0, 3000.0, 50.0, 90.0, 0.04, None,
-                        0.5)
+    case = Case(set_key=key, s0=0.014, v=120.0, N0=100.0, b_M=3000.0, M0=50.0, f=90.0, D=0.04,
+                dt=None, t_end=0.5)
+    text = build_report(case)
     assert_self_contained_html(text)
-    point = compute.point_result(key, "calibrated", 0.014, 120.0, 100.0, 3000.0)
+    point = compute.point_result(case)
     verdict = "STABLE" if point.stable else "UNSTABLE"
     assert f'">{verdict}</span>' in text
     assert set_hash(parameters_of_key(key)) in text
@@ -363,8 +366,7 @@ def test_clicking_a_table_row_or_a_diamond_shows_that_mode(dash):
     assert "ν = 4" in click.detail.object
     # the energy shares are the model's (model.analysis.modes) for that mode
     m = build_model(compute.parameters("", "calibrated"))
-    result = eigen_analysis(m, compute.operating_point("", "calibrated", 0.005, 120.0, dash.N0,
-                                                       dash.b_M))
+    result = eigen_analysis(m, dash.state().replace(s0=0.005, v=120.0).operating_point())
     character = mode_character(m, result, int(result.complex_index[3]))
     top = max(character.kinetic, key=character.kinetic.get)
     assert mode.kinetic[top] == pytest.approx(character.kinetic[top], rel=1e-9)

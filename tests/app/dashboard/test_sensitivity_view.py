@@ -26,10 +26,10 @@ def dash():
 def test_tornado_shows_the_models_sensitivities_of_the_selected_mode(dash):
     view = dash.sensitivity
     assert view.data is not None, view.note.object
-    assert view.data.key == dash.state().point
+    assert view.data.key == dash.state().point()
     dash.mode = 3
     model = compute.model("", dash.rail)
-    op = compute.operating_point("", dash.rail, dash.s0, dash.v, dash.N0, dash.b_M)
+    op = dash.state().operating_point()
     expected = eigen_sensitivities(model, op)
     growth = expected.values * expected.derivatives[:, 2].real
     largest = expected.names[int(np.argmax(np.abs(growth)))]
@@ -54,8 +54,8 @@ def test_targets_and_a_new_point(dash):
     view.target.value = "damping"
     assert view.figure.xaxis.axis_label == "p · ∂ζ/∂p [-]"
     dash.s0 = 0.014  # unserved: recomputed synchronously on the change
-    assert view.data.key == dash.state().point
-    data = sensitivity_data(*dash.state().point)
+    assert view.data.key == dash.state().point()
+    data = sensitivity_data(dash.state())
     names, values, _ = ranked(data, "damping", dash.mode)
     assert list(view.source.data["name"]) == names
     np.testing.assert_array_equal(view.source.data["value"], values)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from app.results import compute, preview
+from app.results.case import Case
 from model import eigen_analysis
 from model.analysis.linear_system import dense_decompositions
 
@@ -21,19 +22,24 @@ def known():
     follow-ups are done: (N0 [kN], b_M [N m s/rad], locus key, s0*)."""
     p = compute.parameters(SET, RAIL)
     N0, b_M = round(p["wheel_force"] / 1e3, 3), round(p["motor_slope"], 3)
-    key = (SET, RAIL, "s0", V_KMH, N0, b_M)
+    key = _point(0.005, V_KMH, N0, b_M).sweep("s0")
     # computed here, not taken from the cache an earlier test module of this process filled: the
     # sweep's reduced model is kept for the last few sweeps only (model.analysis.locus), and a
     # locus cached long ago may have lost it (the preview then says "not computed yet")
-    compute.locus_result.clear()
-    compute.dense_locus_result.clear()
-    compute.dense_locus_result(*key)
-    limit = compute.limit_result(SET, RAIL, V_KMH, N0, b_M)
+    compute.RESULTS.drop("locus")
+    compute.RESULTS.drop("dense locus")
+    compute.dense_locus_result(key)
+    limit = compute.limit_result(key.at(0.005))
     return N0, b_M, key, limit.s0_limit
 
 
-def _exact_stable(point: tuple) -> bool:
-    op = compute.operating_point(*point)
+def _point(s0: float, v: float, N0: float, b_M: float, rail: str = RAIL) -> Case:
+    """The operating point (s0 [-], v [km/h], N0 [kN], b_M [N m s/rad]) of the set in use."""
+    return Case(set_key=SET, rail=rail, s0=s0, v=v, N0=N0, b_M=b_M)
+
+
+def _exact_stable(point: Case) -> bool:
+    op = point.operating_point()
     return eigen_analysis(compute.model(SET, RAIL), op, vectors=False).stable
 
 
@@ -46,10 +52,10 @@ def test_the_verdict_across_the_limit_is_the_eigen_analysis_one(known):
     assert 0.005 < s0_limit < 0.012
     grid = np.round(np.arange(0.005, 0.012 + S0_STEP / 2, S0_STEP), 7)
     before = dense_decompositions()
-    previews = [preview.preview((SET, RAIL, float(s0), V_KMH, N0, b_M), key, "s0") for s0 in grid]
+    previews = [preview.preview(_point(float(s0), V_KMH, N0, b_M), key, "s0") for s0 in grid]
     assert dense_decompositions() == before
     for s0, result in zip(grid, previews, strict=True):
-        assert result.stable == _exact_stable((SET, RAIL, float(s0), V_KMH, N0, b_M)), s0
+        assert result.stable == _exact_stable(_point(float(s0), V_KMH, N0, b_M)), s0
         # (a point another test computed in this process is known exactly)
         assert result.source in ((preview.BELOW_LIMIT, preview.EXACT) if s0 < s0_limit
                                  else (preview.ABOVE_LIMIT, preview.LOCUS, preview.EXACT)), s0
@@ -69,11 +75,12 @@ def test_other_sliders_use_the_reduced_model_and_say_when_nothing_is_known(known
     error estimate, without a dense solve.  A point with no cached result and no kept sweep (another
     rail condition, never computed) is not guessed: verdict None.  A computed point is exact."""
     N0, b_M, key, _ = known
-    points = [(SET, RAIL, 0.005, 155.0, N0, b_M), (SET, RAIL, 0.005, V_KMH, 131.0, b_M),
-              (SET, RAIL, 0.005, V_KMH, N0, 7300.0), (SET, RAIL, 0.012, 95.0, N0, b_M)]
+    points = [_point(0.005, 155.0, N0, b_M), _point(0.005, V_KMH, 131.0, b_M),
+              _point(0.005, V_KMH, N0, 7300.0), _point(0.012, 95.0, N0, b_M)]
     before = dense_decompositions()
     results = [preview.preview(point, key, "v") for point in points]
-    unknown = preview.preview((SET, "wet", 0.005, V_KMH, N0, b_M), (SET, "wet", *key[2:]), "s0")
+    wet = _point(0.005, V_KMH, N0, b_M, rail="wet")
+    unknown = preview.preview(wet, wet.sweep("s0"), "s0")
     assert dense_decompositions() == before
     for point, result in zip(points, results, strict=True):
         assert result.source == preview.REDUCED, point
@@ -84,7 +91,7 @@ def test_other_sliders_use_the_reduced_model_and_say_when_nothing_is_known(known
     assert unknown.stable is None
     assert unknown.source == preview.NOT_COVERED
     assert "no computed result covers this point" in preview.describe(unknown, "s0")[-1]
-    exact_point = compute.point_result(*points[0])
+    exact_point = compute.point_result(points[0])
     again = preview.preview(points[0], key, "v")
     assert again.source == preview.EXACT
     assert again.stable == exact_point.stable
@@ -111,8 +118,8 @@ def test_the_limit_alone_decides_where_no_locus_covers_the_point(monkeypatch):
     monkeypatch.setattr(compute, "known_locus", lambda *args: None)
     monkeypatch.setattr(compute, "known_limit", lambda *args: compute.LimitResult(0.008, ""))
     monkeypatch.setattr(compute, "reduced_estimate", lambda *args: None)
-    below = preview.preview((SET, RAIL, 0.0079, V_KMH, 100.0, 1000.0), None, "s0")
-    above = preview.preview((SET, RAIL, 0.008, V_KMH, 100.0, 1000.0), None, "s0")
+    below = preview.preview(_point(0.0079, V_KMH, 100.0, 1000.0), None, "s0")
+    above = preview.preview(_point(0.008, V_KMH, 100.0, 1000.0), None, "s0")
     assert (below.stable, below.source) == (True, preview.BELOW_LIMIT)
     assert (above.stable, above.source) == (False, preview.ABOVE_LIMIT)
     assert below.leading is None

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from app.results import compute
+from app.results.case import Case
 from app.results.tables import peaks_html
 from model import eigen_analysis, load_parameters
 from model.analysis.response import short_circuit_response
@@ -19,13 +20,14 @@ from model.analysis.response import short_circuit_response
 M0_KNM, F_HZ, DECAY, T_END = 50.0, 90.0, 0.04, 2.0  # the dashboard's defaults
 
 
-def _point(s0: float) -> tuple:
+def _point(s0: float) -> Case:
     p = load_parameters()
-    return ("", "calibrated", s0, 120.0, p["wheel_force"] / 1e3, p["motor_slope"])
+    return Case(s0=s0, v=120.0, N0=p["wheel_force"] / 1e3, b_M=p["motor_slope"], M0=M0_KNM,
+                f=F_HZ, D=DECAY, dt=None, t_end=T_END)
 
 
 def _linear(s0: float) -> compute.ResponseView:
-    return compute.response_result(*_point(s0), M0_KNM, F_HZ, DECAY, None, T_END)
+    return compute.response_result(_point(s0))
 
 
 def _cells(table: str, name: str) -> list[str]:
@@ -45,8 +47,8 @@ def test_stable_case_shows_the_swing_of_id1_disc_clutch_at_its_time():
     table = peaks_html(response)
     # the model's history at the same point
     m = compute.model("", "calibrated")
-    op = compute.operating_point(*_point(0.005))
-    r = short_circuit_response(m, op, compute.excitation(M0_KNM, F_HZ, DECAY, None), T_END,
+    op = _point(0.005).operating_point()
+    r = short_circuit_response(m, op, _point(0.005).short_circuit(), T_END,
                                compute.sampling_rate(F_HZ), ["ID1.disc_clutch.torque"])
     name = "ID1.disc_clutch.torque"
     swing = r.perturbation(name)
@@ -76,15 +78,14 @@ def test_stable_case_shows_the_swing_of_id1_disc_clutch_at_its_time():
 def test_unstable_case_says_unbounded_with_the_growth_rate_beside_the_nonlinear_peaks():
     response = _linear(0.014)
     m = compute.model("", "calibrated")
-    op = compute.operating_point(*_point(0.014))
+    op = _point(0.014).operating_point()
     growth = eigen_analysis(m, op, vectors=False).max_real_part
     assert growth > 0
     waiting = peaks_html(response, None, "computing…")
     assert "unbounded with linear creep" in waiting
     assert f"σ = <b>{growth:+.4g} 1/s</b>" in waiting
     assert "nonlinear creep: computing…" in waiting
-    companion = compute.nonlinear_histories(*_point(0.014), M0_KNM, F_HZ, DECAY, None, T_END,
-                                            compute.ANTI_SLIP_OFF).response
+    companion = compute.nonlinear_histories(_point(0.014), compute.ANTI_SLIP_OFF).response
     table = peaks_html(response, companion)
     assert "the physical answer" in table
     name = "ID1.disc_clutch.torque"
@@ -92,7 +93,7 @@ def test_unstable_case_says_unbounded_with_the_growth_rate_beside_the_nonlinear_
     assert _number(pre) == pytest.approx(response.load_peaks.extremes[name].pre_fault / 1e3,
                                          abs=0.05)
     first = min(c.time for c in short_circuit_response(
-        m, op, compute.excitation(M0_KNM, F_HZ, DECAY, None), T_END, compute.sampling_rate(F_HZ),
+        m, op, _point(0.014).short_circuit(), T_END, compute.sampling_rate(F_HZ),
         [name]).limit_crossings if c.output == name)
     assert limit == "M_ad"
     assert float(passes) == pytest.approx(first, abs=0.6e-4)

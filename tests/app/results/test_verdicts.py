@@ -6,6 +6,7 @@ from __future__ import annotations
 import pytest
 
 from app.results import compute, verdicts
+from app.results.case import Case
 from model.analysis.response import ShortCircuit
 from model.mechanics.operating_point import KMH
 from model.studies.assessment import AssessmentOptions, assess
@@ -25,11 +26,13 @@ def _same(a, b) -> None:
 @pytest.mark.slow
 def test_dashboard_assessment_is_the_models_at_a_stable_point_and_after_a_step():
     parameters = compute.parameters("", "calibrated")
-    N0, b_M = parameters["wheel_force"], parameters["motor_slope"]
+    # the set's N0 and b_M as a case record keeps them (rounded: its decimals)
+    point = Case(**Case.defaults(parameters))
+    N0, b_M = point.N0 * 1e3, point.b_M
     excitation = ShortCircuit(M0=50e3, f=90.0, D=0.04)
     for s0 in (0.005, 0.0055):  # the second reuses the cached unstable case of the first
-        shown = verdicts.assessment_result("", "calibrated", s0, 120.0, N0 / 1e3, b_M, 50.0,
-                                           90.0, 0.04)
+        shown = verdicts.assessment_result(Case(s0=s0, v=120.0, N0=N0 / 1e3, b_M=b_M, M0=50.0,
+                                                f=90.0, D=0.04))
         expected = assess(parameters, AssessmentOptions(s0=(s0,), v=(120.0 * KMH,), N0=N0,
                                                         b_M=b_M, excitation=excitation))
         _same(shown, expected)
@@ -40,9 +43,10 @@ def test_dashboard_assessment_is_the_models_at_an_unstable_point():
     """Beyond the limit the unstable case is the operating point's own and the short circuit
     takes the default grid."""
     parameters = compute.parameters("", "calibrated")
-    N0, b_M = parameters["wheel_force"], parameters["motor_slope"]
-    shown = verdicts.assessment_result("", "calibrated", 0.012, 140.0, N0 / 1e3, b_M, 50.0,
-                                       90.0, 0.04)
+    point = Case(**Case.defaults(parameters))  # the set's N0 and b_M as a record keeps them
+    N0, b_M = point.N0 * 1e3, point.b_M
+    shown = verdicts.assessment_result(Case(s0=0.012, v=140.0, N0=N0 / 1e3, b_M=b_M, M0=50.0,
+                                            f=90.0, D=0.04))
     expected = assess(parameters, AssessmentOptions(
         N0=N0, b_M=b_M, excitation=ShortCircuit(M0=50e3, f=90.0, D=0.04), unstable_s0=0.012,
         unstable_v=140.0 * KMH))
