@@ -56,6 +56,8 @@ class Quantity:
     unit: str = "-"  # the record's and the dashboard's unit
     default: float | str | None = None  # default (None: see from_set / automatic)
     from_set: str = ""  # default: this value of the parameter set [SI] (the set's N0, b_M …)
+    optional: bool = False  # a record may leave it out: then ``default``, the value a set
+    # takes that leaves the parameter out (model.mechanics.parameters.OPTIONAL_DEFAULTS)
     automatic: str = ""  # None allowed, meaning this ("" : a value is needed)
     choices: tuple[str, ...] = ()  # a choice among these instead of a number
     low: float = -math.inf  # the dashboard's range [unit]
@@ -144,6 +146,14 @@ QUANTITIES: tuple[Quantity, ...] = (
              link="bm", outer_unit="N m s/rad", option="--bm",
              option_label="--bm (motor slope, N m s/rad)", option_interval="[0, 1e9]",
              files=("b_M", "motor_slope")),
+    Quantity("motor_bandwidth", "motor torque control f_c",
+             "torque-control bandwidth f_c of the healthy motor's converter: below it the "
+             "converter holds its torque, above it the slope b_M acts (0: no torque control)",
+             "override", "motor_bandwidth", "Hz", 0.0, from_set="motor_bandwidth", optional=True,
+             low=0.0,
+             high=50.0, step=0.5, format="0.0", digits=3, link="fc", outer_unit="Hz",
+             option="--motor-bandwidth", option_label="--motor-bandwidth (f_c, Hz)",
+             option_interval="[0, 1000]", files=("motor_bandwidth",)),
     Quantity("rail", "rail condition (creep law)",
              "creep law: the set's own (calibrated) or Polach's dry/wet preset", "set", "rail",
              "", "calibrated", choices=RAILS, link="rail", option="--rail", files=("rail",)),
@@ -324,12 +334,14 @@ class Sweep:
 
 def case_type(quantities: Iterable[Quantity], name: str = "Case") -> type:
     """The record of ``quantities``: a frozen dataclass with ``set_key`` and one keyword field
-    per quantity (a quantity whose default is the set's value has no default: give it)."""
+    per quantity (a quantity whose default is the set's value has no default, give it — unless
+    it declares one: the value a set takes that leaves the parameter out, such as no torque
+    control)."""
     quantities = tuple(quantities)
     fields = [("set_key", str, dataclasses.field(default=""))]
     for q in quantities:
         kind = str if q.choice else (float | None)
-        if q.from_set:
+        if q.from_set and not q.optional:
             spec = dataclasses.field(metadata={"quantity": q})
         else:
             spec = dataclasses.field(default=q.default, metadata={"quantity": q})
