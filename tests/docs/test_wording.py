@@ -107,9 +107,11 @@ COMMENT = re.compile(r"<!--.*?-->", re.S)
 
 
 def test_every_option_a_page_names_exists():
-    """An option a page names (``--something``) is one of ``bogie``'s, a script's, ``run.sh``'s,
-    or one of another program's the pages show (EXTERNAL)."""
-    sources = [*sorted((ROOT / "app" / "cli").glob("*.py")), *sorted((ROOT / "scripts").glob("*.py")),
+    """An option a page names (``--something``) is one of ``bogie``'s (its commands' own or a
+    case quantity's, declared in app/results/case.py), a script's, ``run.sh``'s, or one of
+    another program's the pages show (EXTERNAL)."""
+    sources = [*sorted((ROOT / "app" / "cli").glob("*.py")), ROOT / "app" / "results" / "case.py",
+               *sorted((ROOT / "scripts").glob("*.py")),
                ROOT / "run.sh", ROOT / "scripts" / "build_image.sh", ROOT / "app" / "server" / "serve.py"]
     known = set(EXTERNAL)
     for path in sources:
