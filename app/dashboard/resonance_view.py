@@ -167,12 +167,24 @@ class ResonanceView:
         elif kind == "campbell":
             self.campbell = result
             self.campbell_plot.update(result)
-            self.table.object = crossings_html(result)
+            self.show_crossings()
         else:
             self.ripple_view = result
         self._redraw()
         if all(self._shown.get(kind) == job.wanted for kind, job in self._jobs.items()):
             self.note.object = ""
+
+    def show_crossings(self) -> None:
+        """The crossings' table, with the ripple check each drives where the verdict on screen
+        is of the diagram's point (its creepage, wheel force, motor slope and set)."""
+        if self.campbell is None:
+            return
+        verdicts = self.dashboard.verdicts
+        checks = None
+        if verdicts.result is not None and self._state is not None \
+                and verdicts.shown_for.point().without("v") == self._state.point().without("v"):
+            checks = tuple(c for c in verdicts.result.checks if c.load_case == "ripple")
+        self.table.object = crossings_html(self.campbell, checks=checks)
 
     def _redraw(self) -> None:
         """The FRF and the forced response of the chosen output."""

@@ -66,6 +66,7 @@ class VerdictsView:
         self._job = ViewJob(SIDE_VIEW_POOL, dashboard.alive, "verdict")
         self.strength: tuple = ()  # uploaded strength data ((name, value), …)
         self.result = None  # the assessment on screen
+        self.shown_for = None  # its point and short circuit (a case record)
         self.rows: list[dict] = []
         self._waiting: tuple | None = None  # not served: the key to assess when the tab opens
         self._tab_open = False
@@ -140,6 +141,7 @@ class VerdictsView:
 
     def _show(self, key, result) -> None:
         self.result = result
+        self.shown_for = key[0]  # the point and short circuit of the result on screen
         self.rows = check_rows(result)
         self.indicator.object = indicator_html(result)
         self.table.value = self._frame(self.rows)
@@ -147,6 +149,7 @@ class VerdictsView:
             f"<li><b>{c.name}</b> ({'steady' if c.horizon is None else f'horizon {c.horizon:g} s'}"
             f"): {html.escape(c.description)}</li>" for c in result.cases) + "</ul>"
         self.chart.object = safety_factor_figure(result)
+        self.dashboard.resonances.show_crossings()
 
     # --- input --------------------------------------------------------------------------------
 
@@ -169,8 +172,9 @@ class VerdictsView:
 
     def _clicked(self, event) -> None:
         """A row: its load's history on the Response tab (its s0 and v; the nonlinear creep
-        model with anti-slip for the unstable_adhesion case).  The starting case's loads are
-        static: no history produced them."""
+        model with anti-slip for the unstable_adhesion case); a ripple row: the Resonances tab at
+        its worst speed with its section as the output.  The starting case's loads are static:
+        no history produced them."""
         if not 0 <= event.row < len(self.rows):
             return
         row = self.rows[event.row]
@@ -180,6 +184,11 @@ class VerdictsView:
         bounds = {name: dash.case_type.quantity(name).bounds for name in ("s0", "v")}
         dash.param.update(s0=min(max(row["s0"], bounds["s0"][0]), bounds["s0"][1]),
                           v=min(max(row["v_kmh"], bounds["v"][0]), bounds["v"][1]))
+        if row["load case"] == "ripple":
+            if row["output"] in dash.resonances.output.options:
+                dash.resonances.output.value = row["output"]
+            dash.tabs.active = dash.view_tabs.names.index("resonances")
+            return
         nonlinear = row["load case"] == "unstable_adhesion"
         dash.nonlinear.creep.value = "nonlinear" if nonlinear else "linear"
         if nonlinear:

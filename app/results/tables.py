@@ -10,6 +10,7 @@ import math
 
 from app.results import compute
 from app.results.resonance import CampbellView
+from model.analysis.assessment import KIND_NAMES
 from model.analysis.load_peaks import LIMITED
 from model.analysis.response import QUASI_STATIC_HZ
 
@@ -258,17 +259,42 @@ def spectra_html(spectra: compute.SpectraView) -> str:
 CROSSINGS_LISTED = 8  # rows of the crossings table
 
 
-def crossings_html(view: CampbellView, listed: int = CROSSINGS_LISTED) -> str:
-    """The crossings with the largest severity as an HTML table."""
+CROSSING_SPEED_RTOL = 0.02  # a ripple check is driven by a crossing within 2 % of its speed
+
+
+def driven_check(crossing, checks) -> str:
+    """The ripple check a crossing drives: of the checks under the converters' ripple (``checks``,
+    those with an alternating load) whose worst speed lies within :data:`CROSSING_SPEED_RTOL` of
+    the crossing's and whose orders include the crossing's, the one with the least margin, as
+    "component, check: S = safety factor"; "—" if none."""
+    driven = [c for c in checks if abs(c.v_kmh - crossing.v_kmh) <= CROSSING_SPEED_RTOL * crossing.v_kmh
+              and any(o["order"] == crossing.order for o in c.orders)]
+    if not driven:
+        return "—"
+    c = max(driven, key=lambda c: c.utilisation)
+    return f"{c.component}, {KIND_NAMES[c.kind]}: S = {c.safety_factor:.3g}"
+
+
+def crossings_html(view: CampbellView, listed: int = CROSSINGS_LISTED,
+                   checks: tuple | None = None) -> str:
+    """The crossings with the largest severity as an HTML table; with ``checks`` (the verdict's
+    checks under the ripple, :func:`model.studies.assessment.ripple_case`) the check each drives
+    and its safety factor."""
     if not view.crossings:
         return "<i>no order line meets a mode in the speed range</i>"
+    if checks is None:
+        drives = ["(when the verdict is computed)"] * len(view.crossings)
+    else:
+        drives = [driven_check(c, checks) for c in view.crossings]
     rows = "".join(
         f"<tr><td>{c.v_kmh:.1f}</td><td>{c.f_hz:.2f}</td><td class='text'>{html.escape(c.label)}"
         f"</td><td>{c.zeta:.4f}</td><td><b>{c.severity:.3g}</b></td>"
         f"<td class='text'>{html.escape(c.worst_output)}</td>"
-        f"<td class='text'>{html.escape(c.mode)}</td></tr>" for c in view.crossings[:listed])
+        f"<td class='text'>{html.escape(c.mode)}</td><td class='text'>{html.escape(d)}</td></tr>"
+        for c, d in zip(view.crossings[:listed], drives, strict=False))
     return (f"<b>Crossings</b> ({len(view.crossings)}, the {min(listed, len(view.crossings))} "
             f"most severe; severity = torque amplitude per N m of {html.escape(view.input)} at "
-            "that order)<table class='bogie'><tr><th>v [km/h]</th><th>f [Hz]</th>"
-            "<th class='text'>order</th><th>ζ [-]</th><th>N m/N m</th>"
-            "<th class='text'>in</th><th class='text'>mode</th></tr>" + rows + "</table>")
+            "that order; the verdict's ripple check each drives)<table class='bogie'><tr>"
+            "<th>v [km/h]</th><th>f [Hz]</th><th class='text'>order</th><th>ζ [-]</th>"
+            "<th>N m/N m</th><th class='text'>in</th><th class='text'>mode</th>"
+            "<th class='text'>drives</th></tr>" + rows + "</table>")

@@ -27,12 +27,14 @@ from model.studies.assessment import (
     LoadCase,
     assessed_outputs,
     assessment_of,
+    ripple_case,
     short_circuit_case,
     starting_case,
     unstable_adhesion_case,
 )
 
-CASE_COLOURS = {"short_circuit": "#1f77b4", "unstable_adhesion": "#d62728", "starting": "#2ca02c"}
+CASE_COLOURS = {"short_circuit": "#1f77b4", "unstable_adhesion": "#d62728", "starting": "#2ca02c",
+                "ripple": "#9467bd"}
 
 
 def _parameters(case: CaseBase, strength: tuple):
@@ -67,9 +69,26 @@ def assessment_result(case: CaseBase, strength: tuple = ()):
         outputs = assessed_outputs(parameters)
         unstable = unstable_case(key.replace(s0=options.unstable_s0,
                                              v=round(options.unstable_v / KMH, 9)), strength)
+        ripple = ripple_load_case(key, strength, options.s0)
         return assessment_of(parameters, [short_circuit_case(parameters, outputs, options),
-                                          unstable, starting_case(parameters, outputs, options)])
+                                          unstable, starting_case(parameters, outputs, options),
+                                          ripple])
     return compute.cached("assessment", key, compute_assessment, strength)
+
+
+def ripple_load_case(case: CaseBase, strength: tuple, s0_values: tuple) -> LoadCase:
+    """The ripple case (:func:`model.studies.assessment.ripple_case`) at the case's set, wheel
+    force and motor slope and the creepages ``s0_values`` [-] over the whole speed range: a step
+    of the speed slider leaves it as it was."""
+    key = case.without("dt", "t_end", "v", "M0", "f", "D", "s0")
+    strength = tuple(strength)
+
+    def compute_case() -> LoadCase:
+        parameters = _parameters(key, strength)
+        op = key.replace(s0=s0_values[0], v=120.0).operating_point()
+        options = AssessmentOptions(s0=tuple(s0_values), N0=op.N0, b_M=op.b_M)
+        return ripple_case(parameters, assessed_outputs(parameters), options)
+    return compute.cached("ripple case", key, compute_case, strength, tuple(s0_values))
 
 
 def unstable_case(case: CaseBase, strength: tuple = ()) -> LoadCase:
@@ -110,7 +129,10 @@ def check_rows(result: Assessment) -> list[dict]:
     rows = []
     for c in sorted(result.checks, key=lambda c: -c.utilisation):
         where = "steady" if math.isnan(c.time) else f"t = {c.time:.4g} s"
-        if "v_kmh" in c.scenario:
+        if not math.isnan(c.alternating):  # under the ripple: its worst speed, mean ± amplitude
+            where = (f"{c.v_kmh:.4g} km/h, mean {c.mean / 1e3:.1f} ± {c.alternating / 1e3:.3g} "
+                     f"kN m ({', '.join(o['order'] for o in c.orders)})")
+        elif "v_kmh" in c.scenario:
             where += f", s0 = {c.scenario['s0']:.4g}, {c.scenario['v_kmh']:g} km/h"
         rows.append({"component": c.component, "check": KIND_NAMES[c.kind],
                      "load case": c.load_case, "load [kN m]": round(c.load / 1e3, 2),
