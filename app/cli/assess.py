@@ -1,10 +1,13 @@
 """``bogie assess``: from loads to verdicts — every press fit, shaft section and coupling of both
-drives checked in the three load cases, with safety factors and the governing check.
+drives checked in the four load cases, with safety factors and the governing check; with
+``--samples`` the verdict under uncertainty.
 
     bogie assess [--s0 LIST] [--v LIST] [--n0 N] [--bm B] [--rail calibrated|dry|wet]
                  [--m0 M --f F --decay D] [--t-end T] [--fs FS]
                  [--unstable-s0 S --unstable-v V] [--anti-slip-delay T --anti-slip-threshold W
-                 --anti-slip-rate R --anti-slip-floor F] [--starting-v V] [--params FILE]
+                 --anti-slip-rate R --anti-slip-floor F] [--starting-v V]
+                 [--ripple ORDER=AMPLITUDE,… --ripple-v LIST] [--params FILE]
+                 [--samples N [--seed S] [--indices] [--ranges FILE] [--write-samples DIR]]
                  [--scheduler tcp://HOST:PORT | --workers N | --serial] [--json]
 
 A LIST is ``A,B,C`` or ``A:B:N``, increasing; speeds in km/h.  ``--s0``/``--v`` are the short-circuit
@@ -12,7 +15,14 @@ case's grid (stable creepages only), as ``bogie envelope --phase all`` takes the
 ``--t-end`` its horizon covers the settling to the static response of the vehicle's
 deceleration.  That grid runs on the study engine as
 the envelope does (a local Dask cluster by default, ``--scheduler`` a running one, ``--serial`` in
-this process); the other two cases are single runs in this process.  ``--json`` prints
+this process); the other cases are single runs in this process.  The ripple case takes the set's
+ripple amplitudes or ``--ripple`` (as ``bogie ripple``), over ``--ripple-v`` (default 10:200:20
+km/h, refined at every resonance).  ``--samples N`` (a power of two) runs the assessment for N
+scrambled Sobol' samples of the unknowns' prior ranges (model.studies.verdict_priors; ``--ranges``
+a TOML file of others) on the study engine, every sample a work item, and prints each check's
+5/50/95 % band and probability of falling below its required factor; ``--indices`` adds the
+Sobol indices (N (d + 2) dynamics runs), ``--write-samples DIR`` each sample's complete parameter
+set as TOML.  ``--json`` prints
 ``{"load_cases": [...], "checks": [...], "governing": {...}}``
 (model.studies.assessment.Assessment.as_dict, with the creep law ``rail``).  Bad input (an
 unstable grid point, unphysical strength data in ``--params``): one line on stderr, exit status 2;
@@ -70,6 +80,26 @@ def register(subparsers) -> None:
     add_anti_slip_arguments(unstable)
     p.add_argument("--starting-v", type=bounded("--starting-v (speed, km/h)", "[1, 500]", "km/h"),
                    default=5.0, help="starting: speed [km/h] (default %(default)s)")
+    ripple = p.add_argument_group("ripple (both converters' torque ripple, steady forced response)")
+    ripple.add_argument("--ripple", default=None, metavar="ORDER=AMPLITUDE,…",
+                        help="each converter's ripple [N m] per order, e.g. el:6=256,el:12=128 "
+                             "or fixed:450=50 (default: the set's ripple_el6_amplitude and "
+                             "ripple_el12_amplitude)")
+    ripple.add_argument("--ripple-v", default="10:200:20", metavar="LIST",
+                        help="speeds [km/h] before the refinement at the resonances "
+                             "(default %(default)s)")
+    samples = p.add_argument_group("the verdict under uncertainty")
+    samples.add_argument("--samples", type=int, default=None, metavar="N",
+                         help="N scrambled Sobol' samples (a power of two) of the unknowns' "
+                              "prior ranges, each a whole assessment")
+    samples.add_argument("--seed", type=int, default=12, help="the scrambling's seed "
+                                                             "(default %(default)s)")
+    samples.add_argument("--indices", action="store_true",
+                         help="first-order and total Sobol indices (N (d + 2) dynamics runs)")
+    samples.add_argument("--ranges", default=None, metavar="FILE",
+                         help="TOML file of prior ranges: name = { low = …, high = … }")
+    samples.add_argument("--write-samples", default=None, metavar="DIR",
+                         help="write each sample's complete parameter set as TOML into DIR")
     p.add_argument("--params", default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set; strength data it "
                         "lacks are the default set's)")
@@ -81,6 +111,7 @@ def register(subparsers) -> None:
 
 def options_from_args(args: argparse.Namespace):
     """(parameters, :class:`model.studies.assessment.AssessmentOptions`) from the options."""
+    from model.mechanics.excitation import parse_amplitudes
     from model.mechanics.operating_point import KMH
     from model.mechanics.parameters import load_parameters
     from model.studies.assessment import AssessmentOptions
@@ -97,11 +128,13 @@ def options_from_args(args: argparse.Namespace):
     if args.fs < MIN_SAMPLES_PER_PERIOD * args.f:
         raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the excitation at f = "
                          f"{args.f:g} Hz: must be at least {MIN_SAMPLES_PER_PERIOD * args.f:g} Hz")
+    ripple = None if args.ripple is None else parse_amplitudes(args.ripple)
+    ripple_v = [x * KMH for x in quantity_values(args.ripple_v, "v", increasing=True)]
     options = AssessmentOptions(
         s0=tuple(s0), v=tuple(v), N0=args.n0, b_M=args.bm, excitation=short_circuit_from(args),
         t_end=args.t_end, fs=args.fs, unstable_s0=args.unstable_s0,
         unstable_v=args.unstable_v * KMH, anti_slip=anti_slip_from(args),
-        starting_v=args.starting_v * KMH)
+        starting_v=args.starting_v * KMH, ripple=ripple, ripple_v=tuple(ripple_v))
     return parameters, options
 
 
@@ -113,17 +146,20 @@ def assessment_table(result) -> str:
     for case in result.cases:
         horizon = "steady" if case.horizon is None else f"horizon {case.horizon:g} s"
         lines.append(f"{case.name} ({horizon}): {case.description}")
-    lines += ["", f"{'component':<20} {'check':<16} {'load case':<18} {'load [N m]':>11} "
+    lines += ["", f"{'component':<20} {'check':<26} {'load case':<18} {'load [N m]':>11} "
                   f"{'capacity [N m]':>14} {'safety factor':>13} {'required':>8}  "
                   f"{'verdict':<12}  at"]
     notes = list(dict.fromkeys(c.note for c in result.checks if c.note))  # numbered in order
     for c in result.checks:
         at = "steady" if math.isnan(c.time) else f"t = {c.time:.4g} s"
-        if "v_kmh" in c.scenario:
+        if not math.isnan(c.alternating):  # under the ripple: its worst speed, mean ± amplitude
+            at = (f"{c.v_kmh:.4g} km/h, mean {c.mean:.4g} ± {c.alternating:.4g} N m "
+                  f"({', '.join(o['order'] for o in c.orders)})")
+        elif "v_kmh" in c.scenario:
             at += f", s0 = {c.scenario['s0']:.4g}, {c.scenario['v_kmh']:g} km/h"
         if c.note:
             at += f" [{notes.index(c.note) + 1}]"
-        lines.append(f"{c.component:<20} {KIND_NAMES[c.kind]:<16} {c.load_case:<18} "
+        lines.append(f"{c.component:<20} {KIND_NAMES[c.kind]:<26} {c.load_case:<18} "
                      f"{c.load:>11.4g} {c.capacity:>14.4g} {c.safety_factor:>13.3g} "
                      f"{c.required:>8.3g}  {VERDICT_WORDS[verdict_colour(c)]:<12}  {at}")
     lines += [f"[{k}] {note}" for k, note in enumerate(notes, start=1)]
@@ -145,9 +181,53 @@ def cmd_assess(args: argparse.Namespace) -> None:
 
     parameters, options = options_from_args(args)
     short_circuit_points(parameters, options)  # an unstable grid point: refused before any work
+    if args.samples is not None:
+        return assess_under_uncertainty(args, parameters, options)
+    for name in ("indices", "ranges", "write_samples"):
+        if getattr(args, name):
+            raise UsageError(f"--{name.replace('_', '-')} needs --samples")
     with study_engine(args, "assess") as (mapper, where):
         print(f"assess: short_circuit ({len(options.s0) * len(options.v)} point(s) on {where}), "
               "unstable_adhesion, starting …", file=sys.stderr)
         result = assess(parameters, options, mapper, ProgressBar("assess: short_circuit",
                                                                  unit="points"))
     emit(args, {**result.as_dict(), "rail": args.rail}, assessment_table(result))
+
+
+def assess_under_uncertainty(args: argparse.Namespace, parameters, options) -> None:
+    """``--samples N``: the verdict under uncertainty (model.studies.verdict_uncertainty) on the
+    study engine, a progress bar per dynamics run."""
+    from pathlib import Path
+
+    from model.studies.verdict_priors import (
+        check_ranges,
+        default_ranges,
+        load_ranges,
+        merge_ranges,
+        relevant_ranges,
+    )
+    from model.studies.verdict_uncertainty import run_verdict_uncertainty, save_sample_parameters
+
+    n = args.samples
+    if n < 2 or n & (n - 1):
+        raise UsageError(f"--samples = {n} is not allowed: must be a power of 2 >= 2 (the "
+                         "balance of the Sobol' points)")
+    ranges = None if args.ranges is None else merge_ranges(load_ranges(args.ranges))
+    check_ranges(parameters, relevant_ranges(default_ranges() if ranges is None else ranges,
+                                             options)[0])  # refused before any work
+    if args.write_samples is not None:
+        out = Path(args.write_samples)
+        if out.exists() and not out.is_dir():
+            raise UsageError(f"--write-samples {out}: not a directory")
+    with study_engine(args, "assess") as (mapper, where):
+        print(f"assess: {args.samples} samples{' with indices' if args.indices else ''} on "
+              f"{where} …", file=sys.stderr)
+        result = run_verdict_uncertainty(
+            parameters, args.samples, seed=args.seed, indices=args.indices, options=options,
+            ranges=ranges, map_unordered=mapper,
+            progress=ProgressBar("assess: samples", unit="dynamics runs"))
+    if args.write_samples is not None:
+        written = save_sample_parameters(parameters, result, args.write_samples)
+        print(f"assess: wrote {len(written)} parameter sets to {args.write_samples}",
+              file=sys.stderr)
+    emit(args, {**result.as_dict(), "rail": args.rail}, result.summary())

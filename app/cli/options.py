@@ -42,6 +42,7 @@ def input_errors() -> tuple[type[BaseException], ...]:
     from app.results.variants import VariantError
     from app.services.settings import SettingsError
     from model.analysis.campbell import CampbellError
+    from model.analysis.fatigue import FatigueError
     from model.analysis.frequency_response import FrequencyResponseError
     from model.analysis.load_spectrum import SpectrumError
     from model.analysis.response import ResponseError
@@ -53,12 +54,13 @@ def input_errors() -> tuple[type[BaseException], ...]:
     from model.studies.posterior import PosteriorError
     from model.studies.store import StoreMismatch
     from model.studies.uncertainty import UncertaintyError
+    from model.studies.verdict_priors import VerdictUncertaintyError
 
     # ResponseError covers the nonlinear solver's, the design loads' and the assessment's
     return (UsageError, ParameterError, OperatingPointError, NoStabilityLimit, ResponseError,
             ExcitationError, FrequencyResponseError, CampbellError, SensitivityError,
             SpectrumError, UncertaintyError, PosteriorError, StoreMismatch, VariantError,
-            SettingsError)
+            SettingsError, VerdictUncertaintyError, FatigueError)
 
 
 class BogieParser(argparse.ArgumentParser):

@@ -14,6 +14,7 @@ from app.cli.main import main
 from model.mechanics.parameters import dumps_parameters, load_parameters
 
 GRID = ["--s0", "0.003,0.005", "--v", "120,200", "--t-end", "3", "--fs", "2500"]
+RIPPLE = ["--ripple-v", "40:120:5"]  # the ripple case's coarse grid (refined at the resonances)
 
 
 @pytest.fixture(scope="module")
@@ -24,7 +25,7 @@ def assessed():
 
     out = io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
-        code = main(["assess", *GRID, "--serial", "--json"])
+        code = main(["assess", *GRID, *RIPPLE, "--serial", "--json"])
     assert code == 0
     return json.loads(out.getvalue())
 
@@ -33,16 +34,26 @@ def assessed():
 def test_json_contract(assessed):
     data = assessed
     assert [c["name"] for c in data["load_cases"]] == ["short_circuit", "unstable_adhesion",
-                                                       "starting"]
+                                                       "starting", "ripple"]
     assert all(isinstance(c["description"], str) and c["description"] for c in data["load_cases"])
     horizons = {c["name"]: c["horizon_s"] for c in data["load_cases"]}
-    assert horizons == {"short_circuit": 3.0, "unstable_adhesion": 2.0, "starting": None}
+    assert horizons == {"short_circuit": 3.0, "unstable_adhesion": 2.0, "starting": None,
+                        "ripple": None}
     checks = data["checks"]
-    assert len(checks) == 16 * 3  # every press fit, shaft and coupling of both drives, 3 cases
+    assert len(checks) == 16 * 4  # every press fit, shaft and coupling of both drives, 4 cases
     for c in checks:
         assert {"component", "kind", "output", "load_case", "load", "capacity", "safety_factor",
-                "required", "ok", "inputs"} <= set(c)
+                "required", "ok", "inputs", "note", "mean", "alternating", "v_kmh",
+                "orders"} <= set(c)
+        if c["load_case"] == "ripple":  # under alternating load: recomputable from bogie export
+            assert c["kind"] in ("press_fit_slip", "torsional_fatigue", "coupling_vibratory")
+            assert c["alternating"] >= 0.0
+            assert 40.0 <= c["v_kmh"] <= 120.0
+            assert c["orders"]
+            assert {"order", "f_hz", "amplitude"} <= set(c["orders"][0])
+            continue
         assert c["kind"] in ("press_fit_slip", "torsional_shear", "coupling")
+        assert c["mean"] is None and c["alternating"] is None
         assert c["safety_factor"] == pytest.approx(c["capacity"] / c["load"], rel=1e-12)
         assert c["ok"] is (c["safety_factor"] >= c["required"])
         if c["kind"] == "press_fit_slip":
@@ -85,7 +96,7 @@ def test_the_short_circuit_grid_on_a_local_cluster_equals_serial(assessed):
     """The envelope's engine options: ``--workers 2`` (a local cluster of worker processes, the
     default engine) gives the serial run's checks; a wet rail and the protection's options reach
     the load cases."""
-    cluster = run_process(["assess", *GRID, "--workers", "2", "--json"])
+    cluster = run_process(["assess", *GRID, *RIPPLE, "--workers", "2", "--json"])
     assert cluster.returncode == 0, cluster.stderr
     assert "local cluster of 2 worker process(es)" in cluster.stderr
     data = json.loads(cluster.stdout)
@@ -95,7 +106,7 @@ def test_the_short_circuit_grid_on_a_local_cluster_equals_serial(assessed):
 
 @pytest.mark.slow
 def test_rail_and_anti_slip_options_reach_the_load_cases(assessed, capsys):
-    code, out, err = run(["assess", *GRID, "--serial", "--json", "--rail", "wet",
+    code, out, err = run(["assess", *GRID, *RIPPLE, "--serial", "--json", "--rail", "wet",
                           "--anti-slip-delay", "0.25", "--anti-slip-rate", "5"], capsys)
     assert code == 0, err
     data = json.loads(out)
@@ -117,6 +128,14 @@ def bad_set(tmp_path_factory):
     return str(path)
 
 
+@pytest.fixture(scope="module")
+def bad_ranges(tmp_path_factory):
+    """A ranges file with a negative friction coefficient."""
+    path = tmp_path_factory.mktemp("ranges") / "ranges.toml"
+    path.write_text("gear_seat_friction_min = { low = -0.1, high = 0.2 }\n", encoding="utf-8")
+    return str(path)
+
+
 @pytest.mark.parametrize(("argv", "message"), [
     (["--s0", "0.014", "--v", "120"], "--s0 0.014 at --v 120 km/h is not stable"),
     (["--s0", "0.005,0.003"], "--s0 must increase"),
@@ -127,11 +146,41 @@ def bad_set(tmp_path_factory):
     (["--rail", "icy"], "invalid choice: 'icy'"),
     (["--workers", "0"], "--workers = 0 is not allowed"),
     (["--anti-slip-rate", "-1"], "--anti-slip-rate (1/s)"),
+    (["--ripple", "el:6=-5"], "the amplitude must be in [0, 1e7] N m"),
+    (["--ripple", "el:x=5"], "the order must be a number"),
+    (["--ripple-v", "200,100"], "must increase"),
+    (["--samples", "3", "--serial"], "must be a power of 2"),
+    (["--indices"], "--indices needs --samples"),
+    (["--samples", "4", "--serial", "--ranges", "RANGES"], "gear_seat_friction_min"),
 ])
-def test_bad_input_is_one_line_with_exit_status_2(argv, message, bad_set, capsys):
-    argv = [bad_set if a == "BAD" else a for a in argv]
+def test_bad_input_is_one_line_with_exit_status_2(argv, message, bad_set, bad_ranges, capsys):
+    argv = [{"BAD": bad_set, "RANGES": bad_ranges}.get(a, a) for a in argv]
     code, out, err = run(["assess", *argv], capsys)
     assert_one_line_error(code, out, err)
     assert err.startswith("bogie assess: error:")
     assert message in err
     assert out == ""
+
+
+@pytest.mark.slow
+def test_a_sample_of_the_verdict_under_uncertainty_reruns_from_its_file(tmp_path, capsys):
+    """``--samples`` lists each sample's governing check and safety factor and writes its
+    complete parameter set (``--write-samples``); ``bogie assess --params`` on that file with the
+    same options gives the recorded governing safety factor (to 1e-9)."""
+    options = ["--s0", "0.005", "--v", "120", "--t-end", "3", "--fs", "2500", *RIPPLE, "--serial"]
+    code, out, err = run(["assess", *options, "--samples", "2", "--seed", "3",
+                          "--write-samples", str(tmp_path), "--json"], capsys)
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["n"] == 2
+    assert len(data["samples"]) == 2
+    sample = data["samples"][1]
+    assert sample["values"]  # what this sample changed
+    files = sorted(tmp_path.glob("*.toml"))
+    assert len(files) == 2
+    code, out, err = run(["assess", *options, "--params", str(files[1]), "--json"], capsys)
+    assert code == 0, err
+    again = json.loads(out)["governing"]
+    assert again["component"] == sample["governing"]["component"]
+    assert again["load_case"] == sample["governing"]["load_case"]
+    assert again["safety_factor"] == pytest.approx(sample["governing"]["safety_factor"], rel=1e-9)
