@@ -271,6 +271,44 @@ def soak(url: str, pid: int | None, minutes: float, interval: float = 1.0,
             "growth_second_half_mb_per_min": slope, "samples": samples}
 
 
+def distinct_points(url: str, pid: int, base_points: int, points: int, settle: float = 3.0,
+                    speeds_kmh: tuple[float, ...] = (80.0, 100.0, 120.0, 140.0, 160.0, 180.0)
+                    ) -> dict:
+    """One session visiting ``base_points`` and then ``points`` more distinct operating points
+    (creepages on the s0 slider's steps × ``speeds_kmh``, none visited twice), waiting for each
+    first answer and ``settle`` s more for the slower stages (root locus, s0*(v), verdict): the
+    server's memory [MB] after the base points and after each further one (``pid``: the
+    server process).  With a results cache bounded in bytes the memory levels off."""
+    from bokeh.client import pull_session
+
+    _register_panel_models()
+    session = pull_session(url=f"{url}/app")
+    doc = session.document
+    s0, v = _control(doc, "ctl-s0"), _control(doc, "ctl-v")
+    fast = [doc.get_model_by_name("locus_current")]
+    visits = [(round(0.0035 + 0.0005 * (k // len(speeds_kmh)), 6), speeds_kmh[k % len(speeds_kmh)])
+              for k in range(base_points + points)]
+    samples: list[float] = []
+    timeouts = 0
+    t0 = time.monotonic()
+    try:
+        for k, (value, speed) in enumerate(visits):
+            try:
+                _wait_change(session, fast, lambda value=value, speed=speed: (
+                    _release(v, speed), _release(s0, value)), timeout=120)
+            except TimeoutError:
+                timeouts += 1
+            _pause(session, settle)
+            if k >= base_points - 1:
+                samples.append(rss_mb(pid))
+    finally:
+        session.close()
+    return {"base_points": base_points, "points": points, "timeouts": timeouts,
+            "rss_base_mb": samples[0], "rss_end_mb": samples[-1], "rss_max_mb": max(samples),
+            "growth_mb": max(samples) - samples[0], "samples_mb": samples,
+            "seconds": time.monotonic() - t0}
+
+
 # --- 3. fuzz -------------------------------------------------------------------------------------
 
 BAD_NUMBERS = ["nan", "NaN", "inf", "-inf", "1e308", "1e999", "-1", "0", "", " ", "abc", "0x10",
