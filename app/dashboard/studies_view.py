@@ -151,7 +151,7 @@ class StudiesView(QueuedStudyControls, pn.viewable.Viewer):
                                              css_classes=["study-s0-points"], width=110)
         v_low, v_high = Case.quantity("v").bounds  # the dashboard's speeds
         self.v_range = pn.widgets.RangeSlider(label="speed v [km/h]", start=v_low, end=v_high,
-                                              value=(40.0, 250.0), step=5.0, format="0",
+                                              value=(40.0, v_high), step=5.0, format="0",
                                               css_classes=["study-v"])
         self.v_points = pn.widgets.IntInput(label="v points", value=20, start=1,
                                             end=settings.max_study_points,
