@@ -3,6 +3,7 @@ variants, memory over a soak, and a fuzz of query strings, control values and up
 
     .venv/bin/python scripts/reliability_app.py [--sessions 20] [--soak-minutes 10]
                                                 [--fuzz 50] [--json FILE]
+    .venv/bin/python scripts/reliability_app.py --distinct-points 30 [--cache-mb 100]
 
 Starts ``bogie serve`` on a free port (a separate process, as users run it) and talks to it with
 Bokeh's protocol client (``bokeh.client``: the same messages a browser sends, no rendering):
@@ -21,6 +22,11 @@ Bokeh's protocol client (``bokeh.client``: the same messages a browser sends, no
    strings) and bad uploads (malformed, not UTF-8, oversized, NaN, wrong types) sent through a
    session must leave it working (a valid change afterwards still gives new results) and the
    server alive (liveness 200).
+
+4. ``--distinct-points N`` (alone): a server with ``--cache-mb``, one session visiting six
+   distinct operating points and then N more, each with its slower stages; the server's memory
+   after the six and after each further point (the results cache is bounded in bytes: the
+   memory levels off).
 
 The functions are also used by ``tests/app/server/test_reliability.py`` with short settings.
 """
@@ -51,8 +57,8 @@ def log(message: str) -> None:
     print(f"reliability_app: {time.strftime('%H:%M:%S')} {message}", file=sys.stderr, flush=True)
 
 
-def start_server(port: int):
-    return served_app.start_server(port, "reliability_app")
+def start_server(port: int, *options: str):
+    return served_app.start_server(port, "reliability_app", *options)
 
 
 def rss_mb(pid: int) -> float:
@@ -416,9 +422,28 @@ def main() -> None:
     parser.add_argument("--soak-minutes", type=float, default=10.0)
     parser.add_argument("--fuzz", type=int, default=50)
     parser.add_argument("--json", default=None, help="write the results here")
+    parser.add_argument("--distinct-points", type=int, default=None, metavar="N",
+                        help="instead of the runs above: a server with --cache-mb (below), one "
+                             "session visiting 6 distinct points and then N more; its memory")
+    parser.add_argument("--cache-mb", type=int, default=100)
     args = parser.parse_args()
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     port = free_port()
+    if args.distinct_points is not None:
+        server = start_server(port, "--cache-mb", str(args.cache_mb))
+        try:
+            result = distinct_points(f"http://127.0.0.1:{port}", server.pid, 6,
+                                     args.distinct_points)
+        finally:
+            server.terminate()
+            server.wait(timeout=30)
+        if args.json:
+            Path(args.json).write_text(json.dumps(result, indent=1))
+        print(f"--cache-mb {args.cache_mb}: server RSS {result['rss_base_mb']:.0f} MB after 6 "
+              f"points, {result['rss_end_mb']:.0f} MB after {args.distinct_points} more (max "
+              f"{result['rss_max_mb']:.0f}, growth {result['growth_mb']:.0f} MB), "
+              f"{result['timeouts']} timeouts, {result['seconds']:.0f} s")
+        return
     server = start_server(port)
     url = f"http://127.0.0.1:{port}"
     results = {}
