@@ -6,7 +6,8 @@ Starts ``bogie serve`` on a free port (a separate process, as users run it), the
 
 1. single session: keyboard steps (PageUp: 0.0005) on the s0 slider handle (each a new value, so no cache
    hit); latency = key press → the browser holds new eigenvalues (root-locus current point)
-   *and* new time histories (both must have changed; the status is sent with the eigenvalues).
+   *and* new time histories (both must have changed); and key press → the stability status
+   shows the new point (its text changed: the browser's own clock from the key event).
    The steps follow each other at once (the next key press as soon as the previous result is
    in: a held arrow key); ``--isolated`` more steps are each taken after the session is idle
    (1 b: a reviewer moves a slider and looks);
@@ -111,9 +112,25 @@ async def open_page(browser, url: str):
     return page
 
 
+# JS: the page's clock at the last key press and at the first change of the stability status's
+# numbers after it (the largest Re λ, the flutter and divergence counts: every new point changes
+# them; the STABLE/UNSTABLE box itself changes only across the limit)
+WATCH_PRESS = """() => { if (window.__press_watched) { window.__status_at = null; return; }
+  window.__press_watched = true; window.__status_at = null;
+  document.addEventListener('keydown', () => { window.__press_at = performance.now();
+    window.__status_at = null; }, true);
+  const status = [...Bokeh.documents[0].all_models]
+    .find(m => (m.css_classes || []).includes('stability-details'));
+  status.properties.text.change.connect(() => {
+    if (window.__status_at === null) window.__status_at = performance.now(); }); }"""
+STATUS_TIMES: list[float] = []  # [s] key press → status changed, of every step() measured
+
+
 async def step(page, control: str, key: str, probe: str, timeout: float = 120_000) -> float:
-    """Seconds from a key press on a slider handle until ``probe`` changed in the browser."""
+    """Seconds from a key press on a slider handle until ``probe`` changed in the browser (the
+    time until the stability status changed is appended to STATUS_TIMES)."""
     before = (await page.evaluate(probe)).split("|")
+    await page.evaluate(WATCH_PRESS)
     handle = page.locator(f".{control} .noUi-handle")
     await handle.focus()
     t0 = time.perf_counter()
@@ -123,7 +140,12 @@ async def step(page, control: str, key: str, probe: str, timeout: float = 120_00
     await page.wait_for_function(
         f"() => {{ const now = ({probe})().split('|'); const before = {json.dumps(before)};"
         " return now.every((part, i) => part !== before[i]); }", polling=5, timeout=timeout)
-    return time.perf_counter() - t0
+    elapsed = time.perf_counter() - t0
+    status = await page.evaluate("() => window.__status_at === null ? null : "
+                                 "(window.__status_at - window.__press_at) / 1e3")
+    if status is not None:
+        STATUS_TIMES.append(status)
+    return elapsed
 
 
 async def speed_step(page) -> tuple[float, float]:
@@ -406,7 +428,9 @@ async def run(args) -> dict:
             await settle_n0(page, 1)
             await wait_settled(page)
             log("single session: s0 steps, then speed steps")  # own N0 = 99 kN: nothing cached from earlier runs
+            STATUS_TIMES.clear()
             fast = [await step(page, "ctl-s0", S0_KEY, FAST) for _ in range(args.presses)]
+            results["single_status_s"] = list(STATUS_TIMES)
             # the same steps one at a time: each after the previous one's work is done (its
             # s0*, locus, ranges and drawing), as a reviewer moves a slider and looks
             isolated = []
@@ -545,6 +569,11 @@ def main() -> None:
     locus = statistics.median(results["locus_refresh_s"])
     print(f"slider change -> eigenvalues, status, time histories: median {single * 1e3:.0f} ms "
           f"(n = {len(results['single_fast_s'])}, max {max(results['single_fast_s']) * 1e3:.0f})")
+    if results.get("single_status_s"):
+        status = results["single_status_s"]
+        print(f"slider change -> stability status on screen: median "
+              f"{statistics.median(status) * 1e3:.0f} ms (n = {len(status)}, "
+              f"max {max(status) * 1e3:.0f})")
     print(f"root-locus refresh (new speed): median {locus * 1e3:.0f} ms "
           f"(n = {len(results['locus_refresh_s'])}, max {max(results['locus_refresh_s']) * 1e3:.0f})")
     dense = results["dense_locus_s"]

@@ -36,7 +36,10 @@ CREEP = {  # the creep model's controls: (command-line option [unit], in files: 
 def elsewhere(q) -> tuple[str, str]:
     """(command-line option [unit], in files) of a quantity."""
     option = f"`{q.option}`" + (COMMANDS.get(q.name, "") if q.choice else f" [{q.outer_unit}]")
-    return option, FILES[q.name]
+    # a quantity not listed in FILES: its declared file keys in the files' (the outer) unit
+    files = FILES.get(q.name) or ", ".join(
+        f"`{key}`" + ("" if q.choice or k else f" [{q.outer_unit}]") for k, key in enumerate(q.files))
+    return option, files or "—"
 
 
 def _number(x: float) -> str:

@@ -68,6 +68,8 @@ STEPS = (
          "docs/results/parameters.json (the parameter file's schema, docs/own-bogie.md)"),
     Step("dashboard", (_python("dashboard_controls.py"),),
          "docs/results/dashboard.json (the dashboard's controls, README.md)"),
+    Step("memory", (_python("memory_model.py"),),
+         "docs/results/memory.json (the results cache's entries, docs/memory.md)"),
     Step("validation", (_python("validation_table.py"),),
          "docs/results/validation.json (Table 1 by rank, targets, real eigenvalues)"),
     Step("response", (_python("figures_response.py"),),

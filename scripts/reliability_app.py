@@ -3,6 +3,7 @@ variants, memory over a soak, and a fuzz of query strings, control values and up
 
     .venv/bin/python scripts/reliability_app.py [--sessions 20] [--soak-minutes 10]
                                                 [--fuzz 50] [--json FILE]
+    .venv/bin/python scripts/reliability_app.py --distinct-points 30 [--cache-mb 100]
 
 Starts ``bogie serve`` on a free port (a separate process, as users run it) and talks to it with
 Bokeh's protocol client (``bokeh.client``: the same messages a browser sends, no rendering):
@@ -21,6 +22,11 @@ Bokeh's protocol client (``bokeh.client``: the same messages a browser sends, no
    strings) and bad uploads (malformed, not UTF-8, oversized, NaN, wrong types) sent through a
    session must leave it working (a valid change afterwards still gives new results) and the
    server alive (liveness 200).
+
+4. ``--distinct-points N`` (alone): a server with ``--cache-mb``, one session visiting six
+   distinct operating points and then N more, each with its slower stages; the server's memory
+   after the six and after each further point (the results cache is bounded in bytes: the
+   memory levels off).
 
 The functions are also used by ``tests/app/server/test_reliability.py`` with short settings.
 """
@@ -51,8 +57,8 @@ def log(message: str) -> None:
     print(f"reliability_app: {time.strftime('%H:%M:%S')} {message}", file=sys.stderr, flush=True)
 
 
-def start_server(port: int):
-    return served_app.start_server(port, "reliability_app")
+def start_server(port: int, *options: str):
+    return served_app.start_server(port, "reliability_app", *options)
 
 
 def rss_mb(pid: int) -> float:
@@ -271,6 +277,44 @@ def soak(url: str, pid: int | None, minutes: float, interval: float = 1.0,
             "growth_second_half_mb_per_min": slope, "samples": samples}
 
 
+def distinct_points(url: str, pid: int, base_points: int, points: int, settle: float = 3.0,
+                    speeds_kmh: tuple[float, ...] = (80.0, 100.0, 120.0, 140.0, 160.0, 180.0)
+                    ) -> dict:
+    """One session visiting ``base_points`` and then ``points`` more distinct operating points
+    (creepages on the s0 slider's steps × ``speeds_kmh``, none visited twice), waiting for each
+    first answer and ``settle`` s more for the slower stages (root locus, s0*(v), verdict): the
+    server's memory [MB] after the base points and after each further one (``pid``: the
+    server process).  With a results cache bounded in bytes the memory levels off."""
+    from bokeh.client import pull_session
+
+    _register_panel_models()
+    session = pull_session(url=f"{url}/app")
+    doc = session.document
+    s0, v = _control(doc, "ctl-s0"), _control(doc, "ctl-v")
+    fast = [doc.get_model_by_name("locus_current")]
+    visits = [(round(0.0035 + 0.0005 * (k // len(speeds_kmh)), 6), speeds_kmh[k % len(speeds_kmh)])
+              for k in range(base_points + points)]
+    samples: list[float] = []
+    timeouts = 0
+    t0 = time.monotonic()
+    try:
+        for k, (value, speed) in enumerate(visits):
+            try:
+                _wait_change(session, fast, lambda value=value, speed=speed: (
+                    _release(v, speed), _release(s0, value)), timeout=120)
+            except TimeoutError:
+                timeouts += 1
+            _pause(session, settle)
+            if k >= base_points - 1:
+                samples.append(rss_mb(pid))
+    finally:
+        session.close()
+    return {"base_points": base_points, "points": points, "timeouts": timeouts,
+            "rss_base_mb": samples[0], "rss_end_mb": samples[-1], "rss_max_mb": max(samples),
+            "growth_mb": max(samples) - samples[0], "samples_mb": samples,
+            "seconds": time.monotonic() - t0}
+
+
 # --- 3. fuzz -------------------------------------------------------------------------------------
 
 BAD_NUMBERS = ["nan", "NaN", "inf", "-inf", "1e308", "1e999", "-1", "0", "", " ", "abc", "0x10",
@@ -378,9 +422,28 @@ def main() -> None:
     parser.add_argument("--soak-minutes", type=float, default=10.0)
     parser.add_argument("--fuzz", type=int, default=50)
     parser.add_argument("--json", default=None, help="write the results here")
+    parser.add_argument("--distinct-points", type=int, default=None, metavar="N",
+                        help="instead of the runs above: a server with --cache-mb (below), one "
+                             "session visiting 6 distinct points and then N more; its memory")
+    parser.add_argument("--cache-mb", type=int, default=100)
     args = parser.parse_args()
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     port = free_port()
+    if args.distinct_points is not None:
+        server = start_server(port, "--cache-mb", str(args.cache_mb))
+        try:
+            result = distinct_points(f"http://127.0.0.1:{port}", server.pid, 6,
+                                     args.distinct_points)
+        finally:
+            server.terminate()
+            server.wait(timeout=30)
+        if args.json:
+            Path(args.json).write_text(json.dumps(result, indent=1))
+        print(f"--cache-mb {args.cache_mb}: server RSS {result['rss_base_mb']:.0f} MB after 6 "
+              f"points, {result['rss_end_mb']:.0f} MB after {args.distinct_points} more (max "
+              f"{result['rss_max_mb']:.0f}, growth {result['growth_mb']:.0f} MB), "
+              f"{result['timeouts']} timeouts, {result['seconds']:.0f} s")
+        return
     server = start_server(port)
     url = f"http://127.0.0.1:{port}"
     results = {}

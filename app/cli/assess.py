@@ -48,6 +48,7 @@ from app.cli.options import (
     anti_slip_from,
     bounded,
     check_samples,
+    load_parameters_from,
     quantity_values,
     short_circuit_from,
 )
@@ -113,11 +114,10 @@ def options_from_args(args: argparse.Namespace):
     """(parameters, :class:`model.studies.assessment.AssessmentOptions`) from the options."""
     from model.mechanics.excitation import parse_amplitudes
     from model.mechanics.operating_point import KMH
-    from model.mechanics.parameters import load_parameters
     from model.studies.assessment import AssessmentOptions
     from model.studies.envelope import rail_parameters
 
-    parameters = rail_parameters(load_parameters(args.params), args.rail)
+    parameters = rail_parameters(load_parameters_from(args), args.rail)
     s0 = quantity_values(args.s0, "s0", increasing=True)
     v = [x * KMH for x in quantity_values(args.v, "v", increasing=True)]
     if args.t_end is not None:

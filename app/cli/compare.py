@@ -14,7 +14,14 @@ from __future__ import annotations
 
 import argparse
 
-from app.cli.options import UsageError, add_operating_point, add_short_circuit, add_time_grid, short_circuit_from
+from app.cli.options import (
+    UsageError,
+    add_operating_point,
+    add_short_circuit,
+    add_time_grid,
+    overrides_from,
+    short_circuit_from,
+)
 from app.cli.output import emit
 
 
@@ -71,7 +78,10 @@ def cmd_compare(args: argparse.Namespace) -> None:
         raise UsageError("give the two sets as BASE.toml VARIANT.toml, not --params")
     if args.s0 is None:
         raise UsageError("--s0 is required")
-    base, variant = load_parameters(args.base), load_parameters(args.variant)
+    # the operating point's quantities that change a set's values apply to both sets
+    changes = overrides_from(args)
+    base, variant = (load_parameters(path).replace(**changes)
+                     for path in (args.base, args.variant))
     result = compare_designs(base, variant, args.s0, args.v, args.n0, args.bm,
                              short_circuit_from(args), args.t_end,
                              progress=lambda text: print(f"bogie compare: {text}",

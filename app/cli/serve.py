@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import argparse
 
-from app.cli.options import non_negative_int, number, positive_int
+from app.cli.options import bounded, non_negative_int, number, positive_int
+from app.results.cache import DEFAULT_CACHE_MB
+from app.services.settings import MAX_CACHE_MB, MIN_CACHE_MB
 
 
 def register(subparsers) -> None:
@@ -44,6 +46,12 @@ def register(subparsers) -> None:
                    default=None, metavar="W",
                    help="studies waiting at most; more requests are refused with a notice "
                         "(environment: BOGIE_MAX_WAITING_STUDIES; default 16)")
+    p.add_argument("--cache-mb", type=bounded("--cache-mb", f"[{MIN_CACHE_MB}, {MAX_CACHE_MB}]",
+                                              "MB"),
+                   default=None, metavar="N",
+                   help="memory the results every session shares may hold [MB]; beyond it the "
+                        "least recently used go first (environment: BOGIE_CACHE_MB; default "
+                        f"{DEFAULT_CACHE_MB}; docs/memory.md)")
     p.set_defaults(func=cmd_serve)
 
 
@@ -54,6 +62,7 @@ def cmd_serve(args: argparse.Namespace) -> None:
     settings = ServerSettings.from_options(
         scheduler=args.scheduler, studies_dir=args.studies_dir,
         max_study_points=args.max_study_points, max_running_studies=args.max_running_studies,
-        max_waiting_studies=args.max_waiting_studies)
+        max_waiting_studies=args.max_waiting_studies,
+        cache_mb=None if args.cache_mb is None else int(args.cache_mb))
     serve(port=args.port, address=args.address, allow_websocket_origin=args.allow_websocket_origin,
           params=args.params, settings=settings)

@@ -152,7 +152,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self.status = layout.html_pane("", css_classes=["stability-status"])
         # a dragged operating-point slider's preview on the status and the markers
         self.drag_preview = DragPreview(self)
-        self.details = layout.html_pane("")
+        self.details = layout.html_pane("", css_classes=["stability-details"])
         self.notice = pn.pane.Alert("", alert_type="danger", visible=False,
                                     css_classes=["model-notice"], sizing_mode="stretch_width")
         # input that was not used (a bad link, file or value): stays until the next such notice
@@ -342,15 +342,26 @@ class BogieDashboard(pn.viewable.Viewer):
     def show_fast(self, state: CaseBase, fast) -> None:
         """Show the first answer ``(point result, response result)`` for ``state``."""
         point, response = fast
+        self.show_point(state, point)
+        self.show_response(state, response)
+
+    def show_point(self, state: CaseBase, point: compute.PointResult) -> None:
+        """Show the eigen-analysis of ``state``'s point: the status, the point on the root locus
+        and the creep characteristic, the tables and mode shapes (served, the short-circuit
+        history follows: :meth:`show_response`)."""
         self.drag_preview.end()
-        self.point, self.response, self.error = point, response, ""
+        self.point, self.error = point, ""
         self.notice.visible = False
         self.locus_plot.update_point(point)
         self.creep_plot.update_point(point)
-        self.response_plots.update(response)
         self._show_status()
         self.when_shown("modes", self._show_modes, point)
         self.locus_plot.zoom(self.zoom == "low")
+
+    def show_response(self, state: CaseBase, response: compute.ResponseView) -> None:
+        """Show the short-circuit history of ``state`` and start the views that follow it."""
+        self.response = response
+        self.response_plots.update(response)
         # the sensitivity tornado is computed when its tab is open, shown when ready
         self.when_shown("sensitivity", self.sensitivity.request, state)
         self.when_shown("design-loads", self.design_loads.request_worst_case, state)

@@ -34,6 +34,7 @@ import numpy as np
 import panel as pn
 
 from app.dashboard.queued_study import QueuedStudyControls
+from app.dashboard.session import served_document
 from app.dashboard.url_state import fit_phase, scenario_query
 from app.results import compute
 from app.results.case import Case
@@ -215,8 +216,8 @@ class EnvelopeGrid(QueuedStudyControls):
             pn.pane.Bokeh(self.plot.figure, sizing_mode="stretch_width"), self.map_note,
             self.table, sizing_mode="stretch_width", css_classes=["loads-grid"])
         self.refresh_list()
-        doc = pn.state.curdoc
-        if doc is not None and doc.session_context is not None:
+        doc = served_document()
+        if doc is not None:
             # a closed session's waiting study is dropped, its running one stops after its chunk
             doc.on_session_destroyed(lambda _context: self.queue.drop_owner(self.owner))
 

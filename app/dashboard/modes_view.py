@@ -4,7 +4,8 @@ energy shares per subsystem (kinetic: which parts move; strain: what deforms).
 
 A tapped current-point diamond or table row is the mode ν of the current operating point; a
 tapped point of the sweep is the mode nearest to that eigenvalue at *that* point of the sweep
-(:func:`app.results.compute.mode_near`, one eigen-analysis, cached).
+(:func:`app.results.compute.mode_near`, one eigen-analysis, kept; served, on a worker thread:
+:class:`app.dashboard.jobs.ViewJob`).
 """
 
 from __future__ import annotations
@@ -15,7 +16,9 @@ from typing import ClassVar
 
 import panel as pn
 
+from app.dashboard.jobs import ViewJob
 from app.results import compute
+from app.services.thread_pools import FIRST_ANSWER_POOL
 from model.analysis.modes import COMPONENT_LABELS, STRAIN_LABELS
 
 SHARE_SHOWN = 0.01  # energy shares below this are not listed [-]
@@ -97,6 +100,7 @@ class ModeClickThrough:
         self.table = ModeTable()
         self.detail = pn.pane.HTML("", sizing_mode="stretch_width", css_classes=["mode-detail"])
         self.shown: compute.Mode | None = None  # the mode in the detail view
+        self._job = ViewJob(FIRST_ANSWER_POOL, dashboard.alive, "tapped mode")
         plot = dashboard.locus_plot
         plot.current.selected.on_change("indices", self._on_current)
         plot.points.selected.on_change("indices", self._on_sweep)
@@ -146,13 +150,14 @@ class ModeClickThrough:
         value = float(data["value"][index])
         s0, v = (value, state.v) if locus.parameter == "s0" else (state.s0, value)
         re, im = float(data["x"][index]), float(data["y"][index]) * 2 * math.pi
-        try:
-            mode = compute.mode_near(state.replace(s0=s0, v=v), re, im)
-        except Exception as error:  # a model rejection: say so, keep the views
-            dashboard.warn(f"Mode at the tapped point not shown: {error}")
-            return
-        self.show_mode(mode, f"tapped on the root locus: s0 = {s0:.5g}, v = {v:.4g} km/h "
-                             f"(nearest mode to λ = {re:+.3f} + i {im / (2 * math.pi):.3f} Hz)")
+        case = state.replace(s0=s0, v=v)
+        where = (f"tapped on the root locus: s0 = {s0:.5g}, v = {v:.4g} km/h "
+                 f"(nearest mode to λ = {re:+.3f} + i {im / (2 * math.pi):.3f} Hz)")
+        # a model rejection: say so, keep the views
+        self._job.start((case, re, im), lambda: compute.mode_near(case, re, im),
+                        lambda _key, mode: self.show_mode(mode, where),
+                        lambda _key, error: dashboard.warn(
+                            f"Mode at the tapped point not shown: {error}"))
 
     def show_mode(self, mode: compute.Mode, where: str) -> None:
         """Show ``mode`` (picked anywhere: a locus point, a Campbell point) in the mode views;

@@ -16,6 +16,7 @@ import html
 
 import panel as pn
 
+from app.dashboard.session import served_document
 from app.services.study_queue import FAILED, WAITING, wait_until_ended
 
 POLL_MS = 500  # progress refresh of a served session [ms]
@@ -61,8 +62,8 @@ class QueuedStudyControls:
     def _follow(self) -> None:
         """Show the new ticket now and, when served, every POLL_MS until it ends."""
         self.poll()
-        doc = pn.state.curdoc
-        if doc is not None and doc.session_context is not None:
+        doc = served_document()
+        if doc is not None:
             self._poller = pn.state.add_periodic_callback(self.poll, period=POLL_MS)
 
     def stop(self) -> None:

@@ -25,7 +25,7 @@ from app.dashboard.jobs import ViewJob
 from app.results import compute, resonance
 from app.results.resonance_plots import CampbellPlot, FrfPlot, RipplePlot
 from app.results.tables import crossings_html
-from app.services.thread_pools import SIDE_VIEW_POOL
+from app.services.thread_pools import FIRST_ANSWER_POOL, SIDE_VIEW_POOL
 from model.analysis.campbell import MOTOR_INPUTS
 from model.mechanics.excitation import DEFAULT_ORDERS, parse_amplitudes, parse_orders
 
@@ -71,6 +71,7 @@ class ResonanceView:
         self._shown: dict[str, tuple] = {}  # kind -> key of the result on screen
         self._jobs = {kind: ViewJob(SIDE_VIEW_POOL, dashboard.alive, f"resonances ({kind})")
                       for kind in RESULTS}
+        self._tapped = ViewJob(FIRST_ANSWER_POOL, dashboard.alive, "tapped mode")
         for widget in (self.orders, self.fixed, self.ripple):
             widget.param.watch(self._on_text, "value")
         self.input.param.watch(lambda _e: self._recompute(), "value")
@@ -207,11 +208,10 @@ class ResonanceView:
         if state is None or not 0 <= index < len(data["v"]):
             return
         v, name = float(data["v"][index]), str(data["name"][index])
-        try:
-            mode = compute.mode_near(state.replace(v=v), float(data["re"][index]),
-                                     float(data["im"][index]))
-        except Exception as error:  # a model rejection: say so, keep the views
-            self.dashboard.warn(f"Mode at the tapped point not shown: {error}")
-            return
-        self.dashboard.show_mode(mode, f"tapped on the Campbell diagram: “{name}” at "
-                                       f"v = {v:.1f} km/h, s0 = {state.s0:g}")
+        case, re, im = state.replace(v=v), float(data["re"][index]), float(data["im"][index])
+        where = f"tapped on the Campbell diagram: “{name}” at v = {v:.1f} km/h, s0 = {state.s0:g}"
+        # a model rejection: say so, keep the views
+        self._tapped.start((case, re, im), lambda: compute.mode_near(case, re, im),
+                           lambda _key, mode: self.dashboard.show_mode(mode, where),
+                           lambda _key, error: self.dashboard.warn(
+                               f"Mode at the tapped point not shown: {error}"))

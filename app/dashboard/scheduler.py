@@ -61,7 +61,8 @@ class Scheduler:
     The dashboard provides ``state()`` (a case record), ``sweep()`` (the root locus on the
     controls), ``alive()``, ``shown_locus`` (the sweep and density on screen),
     ``nonlinear.prefetch(case)``, ``state_changed(case, settled)`` and the display methods
-    ``show_fast(case, (point, response))``, ``show_locus(sweep, locus)``,
+    ``show_fast(case, (point, response))`` (not served), ``show_point(case, point)`` and
+    ``show_response(case, response)`` (served: the status first), ``show_locus(sweep, locus)``,
     ``show_limit(case, limit)`` and ``reject(error)``.
     """
 
@@ -143,8 +144,13 @@ class Scheduler:
                 need_locus = dashboard.shown_locus != (sweep, True)
                 locus_future = (loop.run_in_executor(FIRST_ANSWER_POOL, stages.coarse_locus, sweep)
                                 if need_locus else None)
+                # the fast stage in two answers: the status first (the eigen-analysis), then the
+                # short-circuit history, which shares its decomposition
                 try:
-                    fast = await loop.run_in_executor(FIRST_ANSWER_POOL, stages.fast, case)
+                    point = await loop.run_in_executor(FIRST_ANSWER_POOL, stages.point, case)
+                    post(doc, dashboard.show_point, case, point)
+                    response = await loop.run_in_executor(FIRST_ANSWER_POOL, stages.response,
+                                                          case)
                 except MODEL_ERRORS as error:
                     post(doc, dashboard.reject, error)
                     if locus_future is not None:
@@ -154,7 +160,7 @@ class Scheduler:
                 # computed, not beside it: its step loop is mostly Python and shared the GIL
                 # with the fast stage (linear result 304 ms beside it, median of 12 steps)
                 dashboard.nonlinear.prefetch(case, doc)
-                post(doc, dashboard.show_fast, case, fast)
+                post(doc, dashboard.show_response, case, response)
                 if self._dirty:
                     if locus_future is not None:
                         ignore_outcome(locus_future)  # it still fills the cache

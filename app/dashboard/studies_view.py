@@ -31,6 +31,7 @@ from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
 from bokeh.palettes import RdBu10
 
 from app.dashboard.queued_study import QueuedStudyControls
+from app.dashboard.session import served_document
 from app.dashboard.uncertainty_band import BandLayer, UncertaintyBand, band_mismatch, read_band
 from app.results import compute
 from app.results.case import Case
@@ -151,7 +152,7 @@ class StudiesView(QueuedStudyControls, pn.viewable.Viewer):
                                              css_classes=["study-s0-points"], width=110)
         v_low, v_high = Case.quantity("v").bounds  # the dashboard's speeds
         self.v_range = pn.widgets.RangeSlider(label="speed v [km/h]", start=v_low, end=v_high,
-                                              value=(40.0, 250.0), step=5.0, format="0",
+                                              value=(40.0, v_high), step=5.0, format="0",
                                               css_classes=["study-v"])
         self.v_points = pn.widgets.IntInput(label="v points", value=20, start=1,
                                             end=settings.max_study_points,
@@ -199,8 +200,8 @@ class StudiesView(QueuedStudyControls, pn.viewable.Viewer):
             pn.pane.Bokeh(self.plot.figure, sizing_mode="stretch_width"),
             sizing_mode="stretch_width", css_classes=["studies-view"])
         self.refresh_lists()
-        doc = pn.state.curdoc
-        if doc is not None and doc.session_context is not None:
+        doc = served_document()
+        if doc is not None:
             # a closed session's waiting study is dropped, its running one stops after its chunk
             doc.on_session_destroyed(lambda _context: self.queue.drop_owner(self.owner))
 

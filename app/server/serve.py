@@ -1,9 +1,10 @@
 """``bogie serve``: run the dashboard with ``panel serve`` semantics (liveness endpoint on).
 
 Each browser session gets a fresh :class:`app.dashboard.dashboard.BogieDashboard`.  Sessions share the
-read-only result caches of :mod:`app.results.compute`, the worker threads of :mod:`app.services.thread_pools` and the
-study queue of :mod:`app.services.study_queue`, whose engine, folder and limits are the operator's
-settings (:mod:`app.services.settings`, docs/security.md).
+read-only results cache of :mod:`app.results.cache` (bounded in bytes: ``--cache-mb``), the worker
+threads of :mod:`app.services.thread_pools` and the study queue of :mod:`app.services.study_queue`,
+whose engine, folder and limits are the operator's settings (:mod:`app.services.settings`,
+docs/security.md; the memory: docs/memory.md).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ def create_app(params: str | None = None):
         # sessions of a server share (a browser page then asked the CDN for loading.css: seen
         # with protocol clients beside a page, and possible with a container's health check)
         doc._template_variables.setdefault("dist_url", get_dist_path())
-    dashboard = BogieDashboard(params_path=params)
+    dashboard = BogieDashboard(base_key=params)
     header = pn.pane.Markdown(
         f"## {TITLE} — stability and short-circuit load of the wheelset drives\n"
         "Move the sliders (left): the status, root locus, creep characteristic and the torque "
@@ -56,6 +57,7 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
 
     import panel as pn
 
+    from app.results import cache
     from app.services.settings import ServerSettings, SettingsError, configure
     from app.services.study_queue import StudyQueue, replace_study_queue
 
@@ -68,11 +70,14 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
         raise SettingsError(f"--studies-dir {settings.studies_dir}: cannot be used "
                             f"({error.strerror or error})") from None
     configure(settings)
+    if settings.cache_mb is not None:
+        cache.configure(settings.cache_mb)
     replace_study_queue(StudyQueue(settings))
 
     # a fatal error in native code (SIGSEGV, SIGABRT...) leaves the Python stack of every thread
     # in the server's log instead of one line from the C library
     faulthandler.enable(all_threads=True)
+    limit_malloc_arenas()
     limit_blas_threads()
     port = int(port)  # the command line parses it as a number (float)
     origins = allow_websocket_origin or os.environ.get(
@@ -89,7 +94,8 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
           f"(liveness: /liveness?endpoint=/app); studies in {settings.studies_dir} on "
           f"{settings.scheduler or 'a local cluster (started on the first study)'}, at most "
           f"{settings.max_study_points} points, {settings.max_running_studies} running, "
-          f"{settings.max_waiting_studies} waiting", flush=True)
+          f"{settings.max_waiting_studies} waiting; results cache "
+          f"{cache.RESULTS.budget // cache.MB} MB", flush=True)
     try:
         pn.serve({"app": lambda: create_app(params)}, port=port, address=address,
                  websocket_origin=[o.strip() for o in origins if o.strip()], show=False,
@@ -97,6 +103,31 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
     except KeyboardInterrupt:  # Ctrl-C before Panel's handler was in place
         pass
     _stop_now()
+
+
+MALLOC_ARENAS = 2  # glibc malloc arenas of the server process (MALLOC_ARENA_MAX wins)
+
+
+def limit_malloc_arenas(arenas: int = MALLOC_ARENAS) -> None:
+    """At most ``arenas`` glibc malloc arenas in this process, set before the worker threads
+    start, unless the environment sets ``MALLOC_ARENA_MAX``.  glibc gives each thread that
+    allocates under contention an arena of its own (up to 8 per core); the server's dozen
+    worker threads each kept freed result memory in theirs: 30 distinct points after the first
+    six grew the server by 209–221 MB with a 100 MB results cache, 82 MB with two arenas
+    (docs/memory.md, BENCHMARKS.md).  Nothing on another C library."""
+    import ctypes
+    import ctypes.util
+
+    if os.environ.get("MALLOC_ARENA_MAX"):
+        return
+    name = ctypes.util.find_library("c")
+    try:
+        libc = ctypes.CDLL(name)
+        mallopt = libc.mallopt
+    except (OSError, AttributeError, TypeError):  # not glibc
+        return
+    M_ARENA_MAX = -8
+    mallopt(M_ARENA_MAX, int(arenas))
 
 
 def _stop_now(*_signal) -> None:

@@ -1,10 +1,11 @@
 """What the operator of a served dashboard decides, and no browser can change.
 
 The operator is whoever starts ``bogie serve`` (or the container): the Dask cluster studies run
-on, the folder studies are written to and opened from, and the limits of the study work every
-review session shares.  Each setting is a ``bogie serve`` option with an environment variable of
-the same meaning (the container's way to set it); the option wins over the variable.  A browser
-only *asks* within these settings (docs/security.md).
+on, the folder studies are written to and opened from, the limits of the study work every
+review session shares, and the memory the results cache may hold (docs/memory.md).  Each
+setting is a ``bogie serve`` option with an environment variable of the same meaning (the
+container's way to set it); the option wins over the variable.  A browser only *asks* within
+these settings (docs/security.md).
 """
 
 from __future__ import annotations
@@ -20,11 +21,14 @@ ENVIRONMENT = {
     "max_study_points": "BOGIE_MAX_STUDY_POINTS",
     "max_running_studies": "BOGIE_MAX_RUNNING_STUDIES",
     "max_waiting_studies": "BOGIE_MAX_WAITING_STUDIES",
+    "cache_mb": "BOGIE_CACHE_MB",
 }
 DEFAULT_MAX_STUDY_POINTS = 10_000  # s0 × v points of one map: the 100 × 100 map (≈ 25 s on 2 workers)
 DEFAULT_MAX_RUNNING_STUDIES = 1
 DEFAULT_MAX_WAITING_STUDIES = 16  # more requests are refused (a notice), never queued without end
 UPPER_STUDY_POINTS = 4_000_000  # the largest study limit an operator may set (2000 × 2000)
+# what an operator may set as the results cache's budget [MB] (its default: app.results.cache)
+MIN_CACHE_MB, MAX_CACHE_MB = 32, 1_000_000
 
 
 class SettingsError(ValueError):
@@ -47,6 +51,7 @@ class ServerSettings:
     max_study_points: int = DEFAULT_MAX_STUDY_POINTS  # s0 points × v points of one study
     max_running_studies: int = DEFAULT_MAX_RUNNING_STUDIES  # studies running at once
     max_waiting_studies: int = DEFAULT_MAX_WAITING_STUDIES  # studies waiting in the queue
+    cache_mb: int | None = None  # the results cache's budget [MB]; None: its default (docs/memory.md)
 
     def __post_init__(self) -> None:
         if self.studies_dir is None:
@@ -56,8 +61,11 @@ class ServerSettings:
             object.__setattr__(self, "scheduler", None)
         for name, low, high in (("max_study_points", 1, UPPER_STUDY_POINTS),
                                 ("max_running_studies", 1, 64),
-                                ("max_waiting_studies", 0, 10_000)):
+                                ("max_waiting_studies", 0, 10_000),
+                                ("cache_mb", MIN_CACHE_MB, MAX_CACHE_MB)):
             value = getattr(self, name)
+            if name == "cache_mb" and value is None:
+                continue
             if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
                 raise SettingsError(f"--{name.replace('_', '-')} ({ENVIRONMENT[name]}) = {value!r} "
                                     f"is not allowed: must be an integer in [{low}, {high}]")
@@ -65,19 +73,19 @@ class ServerSettings:
     @classmethod
     def from_options(cls, scheduler: str | None = None, studies_dir: str | None = None,
                      max_study_points: int | None = None, max_running_studies: int | None = None,
-                     max_waiting_studies: int | None = None,
+                     max_waiting_studies: int | None = None, cache_mb: int | None = None,
                      environ: dict | None = None) -> ServerSettings:
         """The settings of command-line options (``None``: not given), else of the environment
         variables in :data:`ENVIRONMENT`, else the defaults (raises :class:`SettingsError`)."""
         environ = os.environ if environ is None else environ
         given = {"scheduler": scheduler, "studies_dir": studies_dir,
                  "max_study_points": max_study_points, "max_running_studies": max_running_studies,
-                 "max_waiting_studies": max_waiting_studies}
+                 "max_waiting_studies": max_waiting_studies, "cache_mb": cache_mb}
         values = {}
         for name, value in given.items():
             if value is None and environ.get(ENVIRONMENT[name], "").strip():
                 value = environ[ENVIRONMENT[name]].strip()
-                if name.startswith("max_"):
+                if name.startswith("max_") or name == "cache_mb":
                     try:
                         value = int(value)
                     except ValueError:

@@ -45,9 +45,10 @@ from model.analysis.eigen import bogie_system, eigen_analysis
 from model.analysis.frequency_response import (
     DEFAULT_INPUT,
     MODEL_FREQUENCY_LIMIT_HZ,
+    golden_section_maximum,
     input_force,
     modal_transfer,
-    output_rows,
+    output_indices,
     solve_direct,
 )
 from model.analysis.locus import root_locus
@@ -378,7 +379,7 @@ def ripple_response(model: BogieModel, op: OperatingPoint, v_values,
     amplitudes = np.array([ripple[o] for o in orders], dtype=float)
     frequencies = np.array([o.frequency_hz(v, model.parameters, excitation) for o in orders])
     frequencies[(frequencies > MODEL_FREQUENCY_LIMIT_HZ) | (frequencies <= 0)] = np.nan
-    matrices, rows = output_rows(model, replace(op, v=float(v[0])), outputs)
+    matrices, rows = output_indices(model, replace(op, v=float(v[0])), outputs)
     by_order = np.full((len(orders), len(rows), len(v)), np.nan)
     for i, speed in enumerate(v):
         point = replace(op, v=float(speed))
@@ -443,21 +444,10 @@ def resonant_speeds(model: BogieModel, op: OperatingPoint, v: np.ndarray,
 
 def _golden_maximum(function, low: float, high: float) -> float:
     """The argument of the largest value of ``function`` on [low, high] (unimodal there), to a
-    relative width of :data:`REFINE_RTOL`, by golden-section search."""
-    ratio = (math.sqrt(5.0) - 1.0) / 2.0
-    a, b = low, high
-    c, d = b - ratio * (b - a), a + ratio * (b - a)
-    fc, fd = function(c), function(d)
-    while b - a > REFINE_RTOL * b:
-        if fc > fd:
-            b, d, fd = d, c, fc
-            c = b - ratio * (b - a)
-            fc = function(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + ratio * (b - a)
-            fd = function(d)
-    return c if fc > fd else d
+    relative width of :data:`REFINE_RTOL` (:func:`golden_section_maximum`)."""
+    best, _ = golden_section_maximum(lambda x: np.array([function(float(x[0]))]),
+                                     np.array([low]), np.array([high]), REFINE_RTOL)
+    return float(best[0])
 
 
 def speeds_kmh(start: float, stop: float, count: int) -> np.ndarray:

@@ -170,9 +170,12 @@ def modal_transfer(system: LinearSystem, C: np.ndarray, b: np.ndarray) -> ModalT
     return ModalTransfer(lam, residues, np.asarray(drift, dtype=complex), magnitudes, cond)
 
 
-def output_rows(model: BogieModel, op: OperatingPoint,
-                outputs: list[str] | None = None) -> tuple[OutputMatrices, np.ndarray]:
-    """(the output matrices, indices of the chosen outputs in them; None: all of them)."""
+def output_indices(model: BogieModel, op: OperatingPoint,
+                   outputs: list[str] | None = None) -> tuple[OutputMatrices, np.ndarray]:
+    """(the output matrices, indices of the chosen named outputs in them; None: all of them):
+    the rows of ``C_q``/``C_v`` the frequency response and the forced response evaluate at any
+    speed.  (:func:`model.analysis.response.output_rows` gives a history's state-output rows,
+    DOF names included.)"""
     matrices = output_matrices(model, op)
     if outputs is None:
         return matrices, np.arange(len(matrices.names))
@@ -189,7 +192,7 @@ def transfer(model: BogieModel, op: OperatingPoint, input: str = DEFAULT_INPUT,
     """(the modal form of H from ``input`` to the chosen outputs, the output matrices, the chosen
     rows) at ``op``; the eigendecomposition is the cached one of :func:`bogie_system`."""
     force, _ = input_force(model, input)
-    matrices, rows = output_rows(model, op, outputs)
+    matrices, rows = output_indices(model, op, outputs)
     system = bogie_system(model, op)
     C = system.state_output(matrices.C_q[rows], matrices.C_v[rows])
     return modal_transfer(system, C, system.input_map(force)), matrices, rows
@@ -205,7 +208,7 @@ def direct_response(model: BogieModel, op: OperatingPoint, f_hz, input: str = DE
     if np.any(f_hz <= 0) or not np.all(np.isfinite(f_hz)):
         raise FrequencyResponseError("direct solves need frequencies > 0 Hz")
     force, _ = input_force(model, input)
-    matrices, rows = output_rows(model, op, outputs)
+    matrices, rows = output_indices(model, op, outputs)
     return solve_direct(model, damping_matrix(model, op), force, matrices.C_q[rows],
                    matrices.C_v[rows], f_hz)
 
@@ -354,9 +357,9 @@ def _peaks(model_transfer: ModalTransfer, grid: np.ndarray, H_grid: np.ndarray,
         rows += [p] * len(interior)
         centres += list(interior)
     rows_a, centres_a = np.array(rows, dtype=int), np.array(centres, dtype=int)
-    f_peak, h_peak = _golden_maximum(model_transfer, rows_a, grid[centres_a - 1],
-                                     grid[centres_a + 1], grid[centres_a],
-                                     magnitude[rows_a, centres_a])
+    f_peak, h_peak = _peak_maximum(model_transfer, rows_a, grid[centres_a - 1],
+                                   grid[centres_a + 1], grid[centres_a],
+                                   magnitude[rows_a, centres_a])
     out: list[list[Peak]] = [[] for _ in range(magnitude.shape[0])]
     for p, f, h in zip(rows_a, f_peak, h_peak, strict=True):
         if h < min_peak * largest[p]:
@@ -370,11 +373,36 @@ def _peaks(model_transfer: ModalTransfer, grid: np.ndarray, H_grid: np.ndarray,
     return tuple(tuple(sorted(row, key=lambda peak: peak.f_hz)) for row in out)
 
 
-def _golden_maximum(model_transfer: ModalTransfer, rows: np.ndarray, low: np.ndarray,
-                    high: np.ndarray, start_f: np.ndarray, start_h: np.ndarray):
-    """Golden-section search for the maximum of |H_row(f)| in [low, high] for every row at once
-    (H unimodal there: the bracket holds one grid maximum); the best of the search and the grid
-    point (start_f, start_h) is returned: (f [Hz], |H|)."""
+def golden_section_maximum(evaluate, low, high, rtol: float, max_steps: int | None = None):
+    """Golden-section search for the maximum of a function on brackets [low, high] where it is
+    unimodal, every bracket of the arrays ``low``, ``high`` at once (one evaluation per step:
+    ``evaluate(x)`` gives the values at the points ``x``, one per bracket), until every bracket
+    is at most ``rtol`` times its upper end wide or after ``max_steps`` steps: (the argument, the
+    value) of the better of the last two interior points of each bracket.  The one search of
+    the frequency response's peaks and the Campbell diagram's crossings."""
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = np.array(low, dtype=float), np.array(high, dtype=float)
+    c, d = b - ratio * (b - a), a + ratio * (b - a)
+    hc, hd = evaluate(c), evaluate(d)
+    steps = 0
+    while not np.all(b - a <= rtol * b) and (max_steps is None or steps < max_steps):
+        left = hc > hd  # the maximum lies in [a, d]
+        b = np.where(left, d, b)
+        a = np.where(left, a, c)
+        new_c = np.where(left, b - ratio * (b - a), d)
+        new_d = np.where(left, c, a + ratio * (b - a))
+        h_new = evaluate(np.where(left, new_c, new_d))
+        hc, hd = np.where(left, h_new, hd), np.where(left, hc, h_new)
+        c, d = new_c, new_d
+        steps += 1
+    return np.where(hc > hd, c, d), np.maximum(hc, hd)
+
+
+def _peak_maximum(model_transfer: ModalTransfer, rows: np.ndarray, low: np.ndarray,
+                  high: np.ndarray, start_f: np.ndarray, start_h: np.ndarray):
+    """The maximum of |H_row(f)| in [low, high] for every row at once
+    (:func:`golden_section_maximum`; H unimodal there: the bracket holds one grid maximum); the
+    best of the search and the grid point (start_f, start_h) is returned: (f [Hz], |H|)."""
     if not len(rows):
         return np.zeros(0), np.zeros(0)
     residues = model_transfer.residues[rows]
@@ -386,22 +414,6 @@ def _golden_maximum(model_transfer: ModalTransfer, rows: np.ndarray, low: np.nda
         return np.abs(np.einsum("pj,pj->p", residues, 1.0 / (s[:, None] - lam[None, :]))
                       + drift / s)
 
-    ratio = (math.sqrt(5.0) - 1.0) / 2.0
-    a, b = low.copy(), high.copy()
-    c, d = b - ratio * (b - a), a + ratio * (b - a)
-    hc, hd = evaluate(c), evaluate(d)
-    for _ in range(GOLDEN_ITERATIONS):
-        left = hc > hd  # the maximum lies in [a, d]
-        b = np.where(left, d, b)
-        a = np.where(left, a, c)
-        new_c = np.where(left, b - ratio * (b - a), d)
-        new_d = np.where(left, c, a + ratio * (b - a))
-        h_new = evaluate(np.where(left, new_c, new_d))
-        hc, hd = np.where(left, h_new, hd), np.where(left, hc, h_new)
-        c, d = new_c, new_d
-        if np.all(b - a <= 1e-12 * b):
-            break
-    f_best = np.where(hc > hd, c, d)
-    h_best = np.maximum(hc, hd)
+    f_best, h_best = golden_section_maximum(evaluate, low, high, 1e-12, GOLDEN_ITERATIONS)
     better = h_best >= start_h
     return np.where(better, f_best, start_f), np.where(better, h_best, start_h)

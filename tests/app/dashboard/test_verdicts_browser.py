@@ -47,3 +47,33 @@ def test_verdict_indicator_and_view(app_server, chromium):
     rows.filter(has_text="short_circuit").first.click()  # a starting row has no history
     page.locator(".bk-tab.bk-active", has_text="Response").wait_for(timeout=30_000)
     assert page.errors == []
+
+
+def test_the_verdict_is_answered_when_the_root_locus_is_rejected(app_server, chromium,
+                                                                 monkeypatch):
+    """The verdict starts from the state change, not from another view's answer: when the
+    model rejects the coarse root locus of a state (its follow-ups never run), the indicator
+    still gets its verdict instead of saying "computing…" until the next change."""
+    from app.dashboard import stages
+    from model import OperatingPointError
+
+    coarse = stages.coarse_locus
+
+    def rejected_at_145(sweep):
+        if sweep.case.v == 145.0:
+            raise OperatingPointError("the root locus at 145 km/h is rejected (test)")
+        return coarse(sweep)
+
+    monkeypatch.setattr(stages, "coarse_locus", rejected_at_145)
+    page = chromium.new_page(viewport={"width": 1600, "height": 1000})
+    try:
+        page.goto(f"{app_server}/app?v=145", timeout=120_000)
+        page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0",
+                               timeout=120_000)
+        notice = page.locator(".model-notice", has_text="rejected (test)")
+        notice.wait_for(timeout=120_000)
+        box = page.locator(".verdict-status [data-verdict]")
+        box.wait_for(timeout=180_000)
+        assert box.get_attribute("data-verdict") in ("green", "amber", "red")
+    finally:
+        page.close()

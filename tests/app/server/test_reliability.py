@@ -73,6 +73,29 @@ def test_short_soak_memory(own_server, reliability):
     assert growth < 50, result["samples"]
 
 
+def test_a_bounded_results_cache_bounds_the_servers_memory(tmp_path, reliability):
+    """``bogie serve --cache-mb 100``: after six operating points, eighteen more distinct ones —
+    more than the budget holds beside the model (docs/results/memory.json) — each with its root
+    locus, s0*(v) and verdict: the server's memory grows by less than the budget (without a
+    bound it grew by about 5.5 MB a point; docs/memory.md)."""
+    import json
+
+    from conftest import start_bogie_serve, stop_process
+
+    budget = 100
+    url, process = start_bogie_serve(tmp_path, "--cache-mb", str(budget))
+    try:
+        result = in_thread(reliability.distinct_points, url, process.pid, base_points=6,
+                           points=18, settle=2.0)
+    finally:
+        stop_process(process)
+    memory = json.loads((ROOT / "docs" / "results" / "memory.json").read_text(encoding="utf-8"))
+    held = (budget - memory["model_mb"]) / memory["linear_point_mb"]  # points beside the model
+    assert result["base_points"] + result["points"] > held
+    assert result["timeouts"] == 0
+    assert result["growth_mb"] < budget, result["samples_mb"]
+
+
 def test_sigterm_stops_the_server_at_once(tmp_path):
     """``docker stop`` sends SIGTERM: the server ends within seconds, with exit status 0 and a
     line in its log, also while a session's computations run (a KeyboardInterrupt raised by the
