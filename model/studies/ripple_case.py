@@ -104,7 +104,7 @@ def ripple_sweep(model: BogieModel, points: list[OperatingPoint],
     {order: amplitude [N m]}, the motor's pole pairs and the pinion's teeth ``drive``.  An
     unstable point of the grid is refused (:class:`RippleCaseError`)."""
     from model.analysis.eigen import bogie_system
-    from model.analysis.frequency_response import MODEL_FREQUENCY_LIMIT_HZ, input_force, output_rows
+    from model.analysis.frequency_response import MODEL_FREQUENCY_LIMIT_HZ, input_force, output_indices
     from model.mechanics.operating_point import damping_matrix
     from model.mechanics.outputs import static_deflection
 
@@ -132,7 +132,7 @@ def ripple_sweep(model: BogieModel, points: list[OperatingPoint],
     for a, op in enumerate(points):
         for i, speed in enumerate(v):
             point = replace(op, v=float(speed))
-            matrices, rows = output_rows(model, point, outputs)
+            matrices, rows = output_indices(model, point, outputs)
             mean[a, :, i] = (matrices.C_q @ static_deflection(model, point))[rows]
             damping = damping_matrix(model, point)
             for k in np.flatnonzero(np.isfinite(frequencies[:, i])):
