@@ -32,6 +32,7 @@ Ctrl-C: exit status 130.
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import sys
 
@@ -101,6 +102,9 @@ def register(subparsers) -> None:
                          help="TOML file of prior ranges: name = { low = …, high = … }")
     samples.add_argument("--write-samples", default=None, metavar="DIR",
                          help="write each sample's complete parameter set as TOML into DIR")
+    samples.add_argument("--out", default=None, metavar="FILE.json",
+                         help="write the result as JSON (into the server's studies folder: the "
+                              "Verdicts tab shows its bands)")
     p.add_argument("--params", default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set; strength data it "
                         "lacks are the default set's)")
@@ -183,7 +187,7 @@ def cmd_assess(args: argparse.Namespace) -> None:
     short_circuit_points(parameters, options)  # an unstable grid point: refused before any work
     if args.samples is not None:
         return assess_under_uncertainty(args, parameters, options)
-    for name in ("indices", "ranges", "write_samples"):
+    for name in ("indices", "ranges", "write_samples", "out"):
         if getattr(args, name):
             raise UsageError(f"--{name.replace('_', '-')} needs --samples")
     with study_engine(args, "assess") as (mapper, where):
@@ -219,6 +223,10 @@ def assess_under_uncertainty(args: argparse.Namespace, parameters, options) -> N
         out = Path(args.write_samples)
         if out.exists() and not out.is_dir():
             raise UsageError(f"--write-samples {out}: not a directory")
+    if args.out is not None:
+        out = Path(args.out)
+        if out.suffix != ".json" or not out.parent.is_dir():
+            raise UsageError(f"--out {out}: a .json file in an existing directory")
     with study_engine(args, "assess") as (mapper, where):
         print(f"assess: {args.samples} samples{' with indices' if args.indices else ''} on "
               f"{where} …", file=sys.stderr)
@@ -226,6 +234,10 @@ def assess_under_uncertainty(args: argparse.Namespace, parameters, options) -> N
             parameters, args.samples, seed=args.seed, indices=args.indices, options=options,
             ranges=ranges, map_unordered=mapper,
             progress=ProgressBar("assess: samples", unit="dynamics runs"))
+    if args.out is not None:
+        Path(args.out).write_text(json.dumps({**result.as_dict(), "rail": args.rail}, indent=1,
+                                             allow_nan=False) + "\n", encoding="utf-8")
+        print(f"assess: wrote {args.out}", file=sys.stderr)
     if args.write_samples is not None:
         written = save_sample_parameters(parameters, result, args.write_samples)
         print(f"assess: wrote {len(written)} parameter sets to {args.write_samples}",

@@ -14,6 +14,8 @@ ripple case's speed sweep), so the indicator says "computing" meanwhile.
 from __future__ import annotations
 
 import html
+import json
+import logging
 
 import panel as pn
 
@@ -30,8 +32,11 @@ from app.results.verdicts import (
 from app.services.thread_pools import SIDE_VIEW_POOL
 from model.mechanics.parameters import ASSESSMENT_SCHEMA, ParameterError, parse_entries
 
+log = logging.getLogger(__name__)
+
 MAX_STRENGTH_BYTES = 50_000
 COLUMNS = ("component", "check", "load case", "load [kN m]", "capacity [kN m]", "safety factor",
+           "band 5–95 %",
            "required", "verdict", "where", "note")
 
 
@@ -81,6 +86,19 @@ class VerdictsView:
         self.chart = pn.pane.Bokeh(sizing_mode="stretch_width", css_classes=["verdict-chart"])
         self.upload = pn.widgets.FileInput(accept=".toml", css_classes=["verdict-strength"])
         self.upload.param.watch(self._uploaded, "value")
+        # a result of the verdict under uncertainty (bogie assess --samples … --out) of the
+        # server's studies folder, picked by name from its list
+        self.uncertainty = None
+        self.uncertainty_select = pn.widgets.Select(
+            label="verdict under uncertainty (bogie assess --samples … --out, in the folder)",
+            options=[], width=380, css_classes=["verdict-uncertainty"])
+        self.uncertainty_open = pn.widgets.Button(label="Show bands", width=110,
+                                                  css_classes=["verdict-open-uncertainty"])
+        self.uncertainty_refresh = pn.widgets.Button(label="↻", width=40,
+                                                     css_classes=["verdict-refresh-uncertainty"])
+        self.uncertainty_open.on_click(lambda _e: self.open_uncertainty(
+            self.uncertainty_select.value))
+        self.uncertainty_refresh.on_click(lambda _e: self.refresh_results())
         self.notice = pn.pane.Alert("", alert_type="warning", visible=False,
                                     css_classes=["verdict-notice"], sizing_mode="stretch_width")
         self.layout = pn.Column(
@@ -92,6 +110,7 @@ class VerdictsView:
                 "`wheel_seat_friction_min = { value = 0.1, unit = \"1\" }`) replace the set's; "
                 "docs/assessment.md."),
             pn.Row(pn.pane.Markdown("**strength data (TOML):**"), self.upload),
+            pn.Row(self.uncertainty_select, self.uncertainty_open, self.uncertainty_refresh),
             self.notice, self.cases, self.table, self.chart, sizing_mode="stretch_width")
 
     @staticmethod
@@ -132,6 +151,8 @@ class VerdictsView:
         """The Verdicts tab opened (``shown``) or closed; not served, the assessment waiting
         for it is computed now."""
         self._tab_open = shown
+        if shown:
+            self.refresh_results()
         if shown and self._waiting is not None:
             key, self._waiting = self._waiting, None
             self._show(key, assessment_result(*key))
@@ -142,14 +163,68 @@ class VerdictsView:
     def _show(self, key, result) -> None:
         self.result = result
         self.shown_for = key[0]  # the point and short circuit of the result on screen
-        self.rows = check_rows(result)
-        self.indicator.object = indicator_html(result)
+        uncertainty = self._matching_uncertainty()
+        self.rows = check_rows(result, uncertainty)
+        self.indicator.object = indicator_html(result, uncertainty=uncertainty)
         self.table.value = self._frame(self.rows)
         self.cases.object = "<ul>" + "".join(
             f"<li><b>{c.name}</b> ({'steady' if c.horizon is None else f'horizon {c.horizon:g} s'}"
             f"): {html.escape(c.description)}</li>" for c in result.cases) + "</ul>"
         self.chart.object = safety_factor_figure(result)
         self.dashboard.resonances.show_crossings()
+
+    # --- the verdict under uncertainty --------------------------------------------------------
+
+    def _folder(self):
+        return self.dashboard.studies.queue.folder
+
+    def refresh_results(self) -> None:
+        """The verdict results of the server's studies folder, newest first."""
+        try:
+            self.uncertainty_select.options = self._folder().names("verdict")
+        except OSError as error:
+            log.error("the studies folder cannot be listed: %s", error)
+
+    def open_uncertainty(self, name) -> None:
+        """Show the bands of a verdict result of the folder's list beside the checks; a name not
+        in the list, a file that is not such a result, or one of another parameter set or
+        strength data: a notice, the previous bands kept."""
+        from app.services.studies_folder import StudyNameRefused
+        from model.studies.verdict_result import VerdictUncertainty
+
+        try:
+            path = self._folder().path(name, "verdict")
+            result = VerdictUncertainty.from_dict(json.loads(path.read_text(encoding="utf-8")))
+        except StudyNameRefused as error:
+            return self._warn(str(error))
+        except (OSError, ValueError, KeyError, TypeError):
+            return self._warn("that file is not a result of bogie assess --samples")
+        if self.result is not None and self._matching_uncertainty(result) is None:
+            return self._warn("that result is of another parameter set or other strength data "
+                              "than the checks shown: its bands are not shown (the previous "
+                              "ones are kept)")
+        self.uncertainty = result
+        self.notice.visible = False
+        if self.result is not None:
+            self._show((self.shown_for,), self.result)
+
+    def _warn(self, message: str) -> None:
+        self.notice.object = message
+        self.notice.visible = True
+
+    def _matching_uncertainty(self, candidate=None):
+        """The opened verdict result (or ``candidate``) if it is of the set and strength data on
+        screen, else None."""
+        from app.results import compute
+        from model.studies.verdict_uncertainty import set_hash
+
+        uncertainty = self.uncertainty if candidate is None else candidate
+        if uncertainty is None or self.shown_for is None:
+            return None
+        parameters = compute.parameters_for(self.shown_for)
+        if self.strength:
+            parameters = parameters.replace(**dict(self.strength))
+        return uncertainty if uncertainty.set_hash == set_hash(parameters) else None
 
     # --- input --------------------------------------------------------------------------------
 

@@ -110,22 +110,49 @@ def unstable_case(case: CaseBase, strength: tuple = ()) -> LoadCase:
     return compute.cached("unstable case", key, compute_case, strength)
 
 
-def indicator_html(result: Assessment | None, note: str = "") -> str:
+def failure_words(uncertainty) -> str:
+    """The governing check's probability of falling below its required factor, with its sampling
+    error, from a result of the verdict under uncertainty (plain text: a tooltip)."""
+    p = uncertainty.governing.failure
+    low, high = p.interval
+    return (f"probability of the governing check below its required factor: {p.value:.2f} ± "
+            f"{p.standard_error:.2f} (95 %: {low:.2f}–{high:.2f}; {uncertainty.n} samples over "
+            "the prior ranges of the unknowns — not a service failure rate)")
+
+
+def indicator_html(result: Assessment | None, note: str = "", uncertainty=None) -> str:
     """The verdict box: the governing safety factor against its required factor, green / amber /
-    red (:func:`model.analysis.assessment.verdict_colour`)."""
+    red (:func:`model.analysis.assessment.verdict_colour`); with ``uncertainty`` (a result of the
+    verdict under uncertainty of the same set) its probability of failure as the tooltip."""
     if result is None:
         return f'<div class="status-box verdict-box pending">VERDICT: {html.escape(note)}</div>'
     g = result.governing
     colour = verdict_colour(g)
-    return (f'<div class="status-box verdict-box {colour}" data-verdict="{colour}">'
+    title = "" if uncertainty is None else f' title="{html.escape(failure_words(uncertainty))}"'
+    return (f'<div class="status-box verdict-box {colour}" data-verdict="{colour}"{title}>'
             f"{VERDICT_WORDS[colour].upper()}</div>"
             f"<div class='verdict-detail' style='font-size:13px'>governing safety factor "
             f"<b>{g.safety_factor:.3g}</b> (required {g.required:.3g}): "
             f"{html.escape(g.component)}, {KIND_NAMES[g.kind]}, {g.load_case}</div>")
 
 
-def check_rows(result: Assessment) -> list[dict]:
-    """One row per check, the worst margin first (what the Verdicts table and the report list)."""
+def band_words(uncertainty, check) -> str:
+    """A check's 5–95 % safety-factor band and probability of failure from a result of the
+    verdict under uncertainty ("" when the result has no such check)."""
+    if uncertainty is None:
+        return ""
+    try:
+        band = uncertainty.band(check.component, check.kind, check.load_case)
+    except KeyError:
+        return ""
+    return (f"{band.quantiles[0]:.3g}–{band.quantiles[2]:.3g} "
+            f"(P = {band.failure.value:.2f})")
+
+
+def check_rows(result: Assessment, uncertainty=None) -> list[dict]:
+    """One row per check, the worst margin first (what the Verdicts table and the report list);
+    with ``uncertainty`` each check's 5–95 % band of its safety factor and its probability of
+    falling below the required factor."""
     rows = []
     for c in sorted(result.checks, key=lambda c: -c.utilisation):
         where = "steady" if math.isnan(c.time) else f"t = {c.time:.4g} s"
@@ -137,7 +164,8 @@ def check_rows(result: Assessment) -> list[dict]:
         rows.append({"component": c.component, "check": KIND_NAMES[c.kind],
                      "load case": c.load_case, "load [kN m]": round(c.load / 1e3, 2),
                      "capacity [kN m]": round(c.capacity / 1e3, 2),
-                     "safety factor": round(c.safety_factor, 3), "required": c.required,
+                     "safety factor": round(c.safety_factor, 3),
+                     "band 5–95 %": band_words(uncertainty, c), "required": c.required,
                      "verdict": VERDICT_WORDS[verdict_colour(c)], "colour": verdict_colour(c),
                      "where": where, "note": c.note, "output": c.output,
                      "s0": c.scenario.get("s0"), "v_kmh": c.scenario.get("v_kmh")})

@@ -24,7 +24,9 @@ KINDS = {
     "map": (".zarr", "a stability-map store"),
     "envelope": (".zarr", "a design-load envelope store"),
     "uncertainty": (".json", "an uncertainty result"),
+    "verdict": (".json", "a result of the verdict under uncertainty"),
 }
+VERDICT_FORMAT = b'"format": "bogie-verdict-uncertainty-1"'  # what a verdict result starts with
 MAX_RESULT_BYTES = 50_000_000  # an uncertainty result larger than this is not listed (not read)
 MAX_INDEX_BYTES = 1_000_000  # a store's zarr.json larger than this is not read (not listed)
 
@@ -87,6 +89,18 @@ def _store_study(path: Path) -> str | None:
     return study if isinstance(study, str) else None
 
 
+def _starts_as_verdict(path: Path) -> bool:
+    """Whether the JSON file at ``path`` (a regular file) is a result of the verdict under
+    uncertainty (``bogie assess --samples … --out``): its first bytes name the format."""
+    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError:
+        return False
+    with os.fdopen(fd, "rb") as handle:
+        return VERDICT_FORMAT in handle.read(256)
+
+
 class StudiesFolder:
     """The operator's studies folder (created if missing)."""
 
@@ -126,6 +140,8 @@ class StudiesFolder:
             if (_store_study(path) == "envelope") != (kind == "envelope") or _has_link(path):
                 return None
         elif not stat.S_ISREG(mode) or os.lstat(path).st_size > MAX_RESULT_BYTES:
+            return None
+        elif (kind == "verdict") != _starts_as_verdict(path):  # the two kinds of result files
             return None
         if path.resolve(strict=True).parent != root:
             return None
