@@ -14,12 +14,32 @@ import sys
 from pathlib import Path
 
 from model import load_parameters
-from model.studies.assessment import assess
+from model.studies.assessment import (
+    AssessmentOptions,
+    assess,
+    assessed_outputs,
+    assessment_of,
+    ripple_case,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "scripts"))
 
 from docs_numbers import write_results  # noqa: E402
+
+BANDWIDTHS_HZ = (0.0, 10.0, 50.0)  # the converter's torque control: none, a slow and a fast one
+
+
+def ripple_summary(result) -> dict:
+    """The ripple case's checks by key (component and kind: its worst speed, mean, amplitude and
+    safety factor) and its check of least margin."""
+    checks = [c for c in result.checks if c.load_case == "ripple"]
+    worst = max(checks, key=lambda c: c.utilisation)
+    return {"checks": {f"{c.component.replace(' ', '_')}.{c.kind}": {
+        "v_kmh": c.v_kmh, "mean": c.mean, "alternating": c.alternating,
+        "safety_factor": c.safety_factor, "required": c.required} for c in checks},
+        "least_margin": {"component": worst.component, "kind": worst.kind,
+                         "v_kmh": worst.v_kmh, "safety_factor": worst.safety_factor}}
 
 
 def main() -> None:
@@ -38,6 +58,12 @@ def main() -> None:
     g = result.governing
     data["governing_summary"] = {"component": g.component, "load_case": g.load_case,
                                  "safety_factor": g.safety_factor, "required": g.required}
+    data["ripple"] = ripple_summary(result)
+    data["ripple_bandwidth"] = {f"{f_c:g}": ripple_summary(assessment_of(
+        parameters.replace(motor_bandwidth=f_c),
+        [ripple_case(parameters.replace(motor_bandwidth=f_c), assessed_outputs(parameters),
+                     AssessmentOptions())]))
+        for f_c in BANDWIDTHS_HZ}
     print(f"governing: {g.component} in {g.load_case}: {g.safety_factor:.3g} (required "
           f"{g.required:.3g}); horizons {data['horizon_s']}")
     print(f"wrote {write_results('assessment', data, 'scripts/example_assessment.py')}")
