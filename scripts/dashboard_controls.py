@@ -19,7 +19,7 @@ sys.path.insert(0, str(ROOT / "scripts"))
 # in the files: name [unit] of each quantity (the case's quantities take their command-line
 # option from their declaration, app.results.case) and of the creep model's controls
 FILES = {"s0": "`s0` [-]", "v": "`v` [m/s], `v_kmh`", "N0": "`N0` [N], `wheel_force`",
-         "b_M": "`b_M` [N m s/rad], `motor_slope`", "motor_bandwidth": "`motor_bandwidth` [Hz]",
+         "b_M": "`b_M` [N m s/rad], `motor_slope`",
          "rail": "`rail`", "M0": "`M0` [N m]",
          "f": "`f` [Hz]", "D": "`D` [-]", "dt": "`phase_s` [s]", "t_end": "`t` [s]"}
 # the commands a choice's option belongs to (a number's: every command with the operating point)
