@@ -52,7 +52,7 @@ def main() -> None:
     args = parser.parse_args()
     limit_blas_threads()
     p = compute.parameters(SET, RAIL)
-    base = Case(set_key=SET, rail=RAIL, **{**Case.defaults(p), "v": V_KMH})
+    base = Case(**{**Case.defaults(p), "set_key": SET, "rail": RAIL, "v": V_KMH})
     N0, b_M = base.N0, base.b_M
     key = base.sweep("s0")
     m = compute.model(SET, RAIL)

@@ -10,9 +10,10 @@ server do not queue behind each other); each result is shown on the session's ne
 lock (:func:`app.dashboard.session.post`), if it still belongs to the parameters on screen.  Per
 change (a case record, :meth:`BogieDashboard.state`, and the root locus's sweep):
 
-1. the state's views are asked for their results at once (the verdict: its computation waits
-   until the state's follow-ups have ended, whatever their outcome — rejected, superseded or
-   shown —, so that it does not share the cores with the dense root locus);
+1. the state's views are asked for their results with its first answer, or with its rejection
+   (the verdict: its computation waits until the state's follow-ups have ended, whatever their
+   outcome — rejected, superseded or shown —, so that it does not share the cores with the dense
+   root locus);
 2. the coarse root locus starts beside the fast stage (:mod:`app.dashboard.stages`) and is
    shown when both are done (nothing to do if the dense locus of the same sweep is on screen);
 3. follow-ups (:class:`app.dashboard.jobs.ViewJob`), not waited for: the dense root locus
@@ -127,16 +128,18 @@ class Scheduler:
         dashboard = self.dashboard
         loop = asyncio.get_running_loop()
         settled: Future = Future()
+        handed = False  # settled is opened by the state's s0*(v) when it has ended
         try:
             while self._dirty and dashboard.alive():
                 self._dirty = False
-                _open(settled)  # the previous state's: superseded
+                if not handed:
+                    _open(settled)  # the previous state's: rejected or superseded
+                handed = False
                 case, sweep = dashboard.state(), dashboard.sweep()
                 # the results of another sweep or speed that arrive from now on are not shown
                 self._dense.want(sweep)
                 self._limit.want(case.limit_key())
                 settled = Future()  # open when this state's follow-ups have ended
-                post(doc, dashboard.state_changed, case, settled)
                 # the coarse root locus (≈ 0.3 s on two threads when not kept) starts at once,
                 # beside the fast stage (one thread), and is shown when both are done; then the
                 # dense one replaces it when ready.  Nothing to do if the dense locus of this
@@ -146,9 +149,17 @@ class Scheduler:
                                 if need_locus else None)
                 # the fast stage in two answers: the status first (the eigen-analysis), then the
                 # short-circuit history, which shares its decomposition
+                # (the state's views are asked for their results with the first answer, in one
+                # message to the browser: state_changed)
                 try:
                     point = await loop.run_in_executor(FIRST_ANSWER_POOL, stages.point, case)
-                    post(doc, dashboard.show_point, case, point)
+                except MODEL_ERRORS as error:
+                    post(doc, self._rejected_state, case, settled, error)
+                    if locus_future is not None:
+                        ignore_outcome(locus_future)
+                    continue
+                post(doc, self._first_answer, case, settled, point)
+                try:
                     response = await loop.run_in_executor(FIRST_ANSWER_POOL, stages.response,
                                                           case)
                 except MODEL_ERRORS as error:
@@ -167,6 +178,7 @@ class Scheduler:
                     continue
                 if locus_future is None:
                     self._start_limit(doc, case, settled)
+                    handed = True
                     continue
                 try:
                     locus = await locus_future
@@ -182,13 +194,23 @@ class Scheduler:
                 dense = self._dense.start(sweep, lambda s=sweep: stages.dense_locus(s),
                                           self._show_locus, self._rejected, doc=doc)
                 self._start_limit(doc, case, settled, after=dense)
+                handed = True
         except Exception as error:  # keep the server and the session alive, say what happened
             log.exception("dashboard computation failed")
             post(doc, dashboard.reject, error)
         finally:
-            _open(settled)
+            if not handed:
+                _open(settled)
             self._running = False
             post(doc, self._hide_busy)
+
+    def _first_answer(self, case: CaseBase, settled: Future, point) -> None:
+        self.dashboard.state_changed(case, settled)
+        self.dashboard.show_point(case, point)
+
+    def _rejected_state(self, case: CaseBase, settled: Future, error: BaseException) -> None:
+        self.dashboard.state_changed(case, settled)
+        self.dashboard.reject(error)
 
     def _show_busy(self) -> None:
         if self._running:
