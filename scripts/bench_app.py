@@ -40,6 +40,7 @@ import asyncio
 import json
 import os
 import random
+import re
 import statistics
 import subprocess
 import sys
@@ -390,7 +391,8 @@ async def screenshots(browser, url: str) -> None:
         await page.wait_for_function(f"() => !({LOCUS_TITLE})().includes('computing')",
                                      polling=100, timeout=300_000)  # the dense locus is shown
         if case == "unstable":  # the required anti-slip reaction time (≈ 20 nonlinear runs)
-            await page.locator(".reaction-status", has_text="after detection").wait_for(
+            await page.locator(".reaction-status", has_text=re.compile(
+                r"after detection|any delay|none suffices")).wait_for(
                 timeout=300_000)
         await wait_idle(page)
         await page.screenshot(path=str(out / f"{case}.png"), full_page=True)

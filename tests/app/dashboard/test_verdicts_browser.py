@@ -40,7 +40,8 @@ def test_verdict_indicator_and_view(app_server, chromium):
     rows.first.wait_for(timeout=60_000)
     assert rows.count() >= 10  # the table is virtual: the first rows are rendered
     first = rows.first.inner_text()
-    assert "short_circuit" in first or "starting" in first or "unstable_adhesion" in first
+    assert any(case in first for case in ("short_circuit", "starting", "unstable_adhesion",
+                                          "ripple"))
     page.wait_for_function(
         "() => [...Bokeh.documents[0].all_models].some(m => m.name === 'verdict-bars')",
         timeout=60_000)
