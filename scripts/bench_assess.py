@@ -30,6 +30,15 @@ COMMANDS = {
     "envelope": [BOGIE, "envelope", "--s0", "0.005", "--v", "120", "--phase", "all", "--json"],
     "envelope --serial": [BOGIE, "envelope", "--s0", "0.005", "--v", "120", "--phase", "all",
                           "--serial", "--json"],
+    "assess() four cases": [sys.executable, "-c",
+                            "from model import load_parameters; "
+                            "from model.studies.assessment import assess; "
+                            "assess(load_parameters())"],
+    "assess() without ripple": [sys.executable, "-c",
+                                "from model import load_parameters; "
+                                "from model.studies.assessment import AssessmentOptions, assess; "
+                                "assess(load_parameters(), AssessmentOptions(cases=("
+                                "'short_circuit', 'unstable_adhesion', 'starting')))"],
 }
 
 
