@@ -46,9 +46,12 @@ def assessment_result(case: CaseBase, strength: tuple = ()):
     """The assessment at the case's point and short circuit (its Δt and horizon do not count:
     every fault instant, the horizons of the load cases), with the strength data ``strength``
     ((name, value) pairs) replacing the set's.  The same as
-    :func:`model.studies.assessment.assess` with these options; its unstable case is kept
-    apart (:func:`unstable_case`): at a stable point it is the default one, which a step of
-    the creepage or the speed leaves as it was."""
+    :func:`model.studies.assessment.assess` with these options, except that the unstable and the
+    ripple cases are kept apart (:func:`unstable_case`, :func:`ripple_load_case`): at a stable
+    point the unstable case is the default one, and the ripple case, steady running over every
+    speed, is always at the assessment's default creepages (``AssessmentOptions().s0``, as
+    ``bogie assess`` takes them); a step of the creepage or the speed leaves both as they
+    were."""
     key = case.without("dt", "t_end")
     strength = tuple(strength)
 
@@ -69,26 +72,28 @@ def assessment_result(case: CaseBase, strength: tuple = ()):
         outputs = assessed_outputs(parameters)
         unstable = unstable_case(key.replace(s0=options.unstable_s0,
                                              v=round(options.unstable_v / KMH, 9)), strength)
-        ripple = ripple_load_case(key, strength, options.s0)
+        ripple = ripple_load_case(key, strength)
         return assessment_of(parameters, [short_circuit_case(parameters, outputs, options),
                                           unstable, starting_case(parameters, outputs, options),
                                           ripple])
     return compute.cached("assessment", key, compute_assessment, strength)
 
 
-def ripple_load_case(case: CaseBase, strength: tuple, s0_values: tuple) -> LoadCase:
+def ripple_load_case(case: CaseBase, strength: tuple = ()) -> LoadCase:
     """The ripple case (:func:`model.studies.assessment.ripple_case`) at the case's set, wheel
-    force and motor slope and the creepages ``s0_values`` [-] over the whole speed range: a step
-    of the speed slider leaves it as it was."""
+    force, motor slope and bandwidth, at the assessment's default creepages over the whole speed
+    range (``bogie assess``'s): a step of the creepage or the speed slider leaves it as it
+    was."""
     key = case.without("dt", "t_end", "v", "M0", "f", "D", "s0")
     strength = tuple(strength)
 
     def compute_case() -> LoadCase:
         parameters = _parameters(key, strength)
+        s0_values = AssessmentOptions().s0
         op = key.replace(s0=s0_values[0], v=120.0).operating_point()
-        options = AssessmentOptions(s0=tuple(s0_values), N0=op.N0, b_M=op.b_M)
+        options = AssessmentOptions(s0=s0_values, N0=op.N0, b_M=op.b_M)
         return ripple_case(parameters, assessed_outputs(parameters), options)
-    return compute.cached("ripple case", key, compute_case, strength, tuple(s0_values))
+    return compute.cached("ripple case", key, compute_case, strength)
 
 
 def unstable_case(case: CaseBase, strength: tuple = ()) -> LoadCase:

@@ -1,7 +1,10 @@
-"""The dashboard's assessment (:func:`app.results.verdicts.assessment_result`, its unstable case
-cached apart) is :func:`model.studies.assessment.assess` with the same options, check by check."""
+"""The dashboard's assessment (:func:`app.results.verdicts.assessment_result`, its unstable and
+ripple cases cached apart) is :func:`model.studies.assessment.assess` with the same options, check
+by check; its ripple case is always at the assessment's default creepages."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import pytest
 
@@ -9,7 +12,17 @@ from app.results import compute, verdicts
 from app.results.case import Case
 from model.analysis.response import ShortCircuit
 from model.mechanics.operating_point import KMH
-from model.studies.assessment import AssessmentOptions, assess
+from model.studies.assessment import AssessmentOptions, assess, assessment_of
+
+WITHOUT_RIPPLE = ("short_circuit", "unstable_adhesion", "starting")
+
+
+def _expected(parameters, options: AssessmentOptions):
+    """``assess`` with ``options``, its ripple case at the default creepages."""
+    cases = assess(parameters, replace(options, cases=WITHOUT_RIPPLE)).cases
+    ripple = assess(parameters, AssessmentOptions(N0=options.N0, b_M=options.b_M,
+                                                  cases=("ripple",))).cases
+    return assessment_of(parameters, cases + ripple)
 
 
 def _same(a, b) -> None:
@@ -33,8 +46,8 @@ def test_dashboard_assessment_is_the_models_at_a_stable_point_and_after_a_step()
     for s0 in (0.005, 0.0055):  # the second reuses the cached unstable case of the first
         shown = verdicts.assessment_result(Case(s0=s0, v=120.0, N0=N0 / 1e3, b_M=b_M, M0=50.0,
                                                 f=90.0, D=0.04))
-        expected = assess(parameters, AssessmentOptions(s0=(s0,), v=(120.0 * KMH,), N0=N0,
-                                                        b_M=b_M, excitation=excitation))
+        expected = _expected(parameters, AssessmentOptions(s0=(s0,), v=(120.0 * KMH,), N0=N0,
+                                                           b_M=b_M, excitation=excitation))
         _same(shown, expected)
 
 
@@ -47,7 +60,7 @@ def test_dashboard_assessment_is_the_models_at_an_unstable_point():
     N0, b_M = point.N0 * 1e3, point.b_M
     shown = verdicts.assessment_result(Case(s0=0.012, v=140.0, N0=N0 / 1e3, b_M=b_M, M0=50.0,
                                             f=90.0, D=0.04))
-    expected = assess(parameters, AssessmentOptions(
+    expected = _expected(parameters, AssessmentOptions(
         N0=N0, b_M=b_M, excitation=ShortCircuit(M0=50e3, f=90.0, D=0.04), unstable_s0=0.012,
         unstable_v=140.0 * KMH))
     _same(shown, expected)
