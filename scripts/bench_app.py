@@ -172,12 +172,16 @@ async def wait_idle(page) -> None:
 
 
 async def wait_settled(page) -> None:
-    """Wait until the follow-ups of a change of speed, N0 or b_M are done: the dense root locus
-    and s0*(v) (else they run beside the steps measured next: steps 5-7 after an N0 change took
-    1.6-2.2 s instead of 0.7 s, the time of s0*'s search, not of the steps)."""
+    """Wait until the follow-ups of a change of speed, N0 or b_M are done: the dense root locus,
+    s0*(v) and the verdict (else they run beside the steps measured next: steps 5-7 after an N0
+    change took 1.6-2.2 s instead of 0.7 s, the time of s0*'s search, not of the steps; the
+    verdict at a new wheel force computes its unstable and ripple cases, about 2 CPU-s, which
+    later s0 steps keep)."""
     await page.wait_for_function(f"() => !({LOCUS_TITLE})().includes('computing')",
                                  timeout=300_000)
     await page.get_by_text("s0*(v): computing").first.wait_for(state="hidden", timeout=300_000)
+    await page.locator(".verdict-status", has_text="computing").wait_for(state="hidden",
+                                                                         timeout=300_000)
     await asyncio.sleep(1.0)
 
 
