@@ -18,7 +18,8 @@ change (a case record, :meth:`BogieDashboard.state`, and the root locus's sweep)
    shown when both are done (nothing to do if the dense locus of the same sweep is on screen);
 3. follow-ups (:class:`app.dashboard.jobs.ViewJob`), not waited for: the dense root locus
    replaces the coarse one, then s0*(v) starts; a follow-up superseded before it starts is
-   skipped.
+   skipped, an s0*(v) search whose speed (wheel force, motor slope) no session wants any more
+   stops before its next eigen-analysis.
 
 A static "computing…" notice appears when a change takes longer than :data:`BUSY_DELAY_MS`.
 """
@@ -27,6 +28,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import weakref
 from concurrent.futures import Future
 
 import panel as pn
@@ -37,6 +39,7 @@ from app.dashboard.jobs import ViewJob
 from app.dashboard.layout import CSS
 from app.dashboard.session import post
 from app.dashboard.stages import MODEL_ERRORS
+from app.results.cache import Superseded
 from app.results.case import CaseBase, Sweep
 from app.services.thread_pools import (
     FIRST_ANSWER_POOL,
@@ -48,6 +51,20 @@ from app.services.thread_pools import (
 log = logging.getLogger(__name__)
 BUSY_DELAY_MS = 400  # the "computing…" notice appears when a change takes longer [ms]
 BUSY_TEXT = '<div class="busy-text">⏳ computing…</div>'
+# the schedulers alive in this process: an s0*(v) search that no session wants any more (its
+# speed, wheel force or motor slope has moved on, or its session has ended) stops before its
+# next eigen-analysis instead of sharing the cores with the next state's root loci
+_SCHEDULERS: weakref.WeakSet = weakref.WeakSet()
+
+
+class LimitSuperseded(Superseded):
+    """An s0*(v) search stopped because no session wants it any more (a session waiting for the
+    same limit computes it itself)."""
+
+
+def _stop_unless_wanted(key) -> None:
+    if not any(s._limit.wanted == key and s.dashboard.alive() for s in list(_SCHEDULERS)):
+        raise LimitSuperseded(key)
 
 
 def _open(gate: Future) -> None:
@@ -74,6 +91,7 @@ class Scheduler:
         # the follow-ups (app.dashboard.jobs): dense locus, s0*(v)
         self._dense = ViewJob(FOLLOW_UP_POOL, dashboard.alive, "dense root locus")
         self._limit = ViewJob(SIDE_VIEW_POOL, dashboard.alive, "stability limit")
+        _SCHEDULERS.add(self)
         # a static notice of fixed size, shown only for changes longer than BUSY_DELAY_MS: an
         # overlay over the results made the browser re-lay out every plot (+300 ms per change),
         # and an animated spinner kept every waiting page busy (measured with ten sessions)
@@ -233,7 +251,10 @@ class Scheduler:
             if self._limit.wanted != key:  # superseded while the dense locus ran
                 _open(settled)
                 return
-            done = self._limit.start(key, lambda: stages.limit(case),
+            def work() -> object:
+                return stages.limit(case, lambda: _stop_unless_wanted(key))
+
+            done = self._limit.start(key, work,
                                      lambda _k, limit: self.dashboard.show_limit(case, limit),
                                      self._rejected, doc=doc)
             done.add_done_callback(lambda _f: _open(settled))

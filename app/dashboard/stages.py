@@ -37,9 +37,10 @@ def response(case: CaseBase) -> compute.ResponseView:
     return compute.response_result(case)
 
 
-def limit(case: CaseBase) -> compute.LimitResult:
-    """The stability limit s0*(v) at the case's speed."""
-    return compute.limit_result(case)
+def limit(case: CaseBase, before_each=None) -> compute.LimitResult:
+    """The stability limit s0*(v) at the case's speed (``before_each``: see
+    :func:`app.results.compute.limit_result`)."""
+    return compute.limit_result(case, before_each)
 
 
 def coarse_locus(sweep: Sweep) -> compute.LocusResult:

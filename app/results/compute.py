@@ -249,9 +249,10 @@ class LimitResult:
     message: str  # why there is none ("" otherwise)
 
 
-def limit_result(case: CaseBase) -> LimitResult:
+def limit_result(case: CaseBase, before_each=None) -> LimitResult:
     """The stability limit s0*(v) at the case's speed, wheel force, motor slope and set
-    (model.analysis.stability)."""
+    (model.analysis.stability; ``before_each()`` before each of its eigen-analyses, which may
+    stop the search by raising :class:`app.results.cache.Superseded`)."""
     key = case.limit_key()
 
     def compute() -> LimitResult:
@@ -268,7 +269,8 @@ def limit_result(case: CaseBase) -> LimitResult:
         op = key.replace(s0=LOCUS_S0[0]).operating_point()
         try:
             limit = stability_limit(m, op.v, op.N0, op.b_M, s0_low=LOCUS_S0[0] / 2,
-                                    xtol=LIMIT_XTOL, bracket=bracket)
+                                    xtol=LIMIT_XTOL, bracket=bracket,
+                                    before_each=before_each)
             return LimitResult(limit.s0_limit, "")
         except NoStabilityLimit as error:
             return LimitResult(None, str(error))

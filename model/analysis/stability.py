@@ -6,6 +6,7 @@ expanding bracket search; not by scanning a grid.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from scipy.optimize import brentq
@@ -33,7 +34,8 @@ def max_real_part(model: BogieModel, op: OperatingPoint) -> float:
 
 def stability_limit(model: BogieModel, v: float, N0: float, b_M: float, s0_low: float = 1e-4,
                     s0_high: float = 0.5, xtol: float = 1e-7,
-                    bracket: tuple[float, float] | None = None) -> StabilityLimit:
+                    bracket: tuple[float, float] | None = None,
+                    before_each: Callable[[], None] | None = None) -> StabilityLimit:
     """Smallest s0 in (s0_low, s0_high) where the largest real part crosses zero at speed v [m/s].
 
     The bracket starts at ``s0_low`` (must be stable) and doubles an upper creepage until the bogie
@@ -43,6 +45,9 @@ def stability_limit(model: BogieModel, v: float, N0: float, b_M: float, s0_low: 
     first crossing is (e.g. the neighbouring points of a root locus over s0 where its branches turn
     unstable; the caller vouches that smaller creepages are stable).  Both ends are checked by a
     full eigen-analysis; if either does not hold, the bracket is ignored and the search above runs.
+
+    ``before_each()`` is called before every eigen-analysis: a caller that no longer needs the
+    limit (an interactive view whose speed has moved on) stops the search by raising there.
 
     Example::
 
@@ -57,6 +62,8 @@ def stability_limit(model: BogieModel, v: float, N0: float, b_M: float, s0_low: 
 
     def growth(s0: float) -> float:
         nonlocal count
+        if before_each is not None:
+            before_each()
         count += 1
         return max_real_part(model, OperatingPoint(s0, v, N0, b_M))
 

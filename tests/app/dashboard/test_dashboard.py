@@ -62,6 +62,25 @@ def _verdict(dashboard) -> bool:
     return eigen_analysis(m, op, vectors=False).stable
 
 
+def test_an_s0_limit_search_stops_once_no_session_wants_its_speed(dash):
+    """Served, s0*(v) searches with a hook that stops it (LimitSuperseded, a Superseded: the
+    cache's waiters compute it themselves) once no live session's scheduler wants its key."""
+    from app.dashboard.scheduler import LimitSuperseded, _stop_unless_wanted
+    from app.results.cache import Superseded
+
+    wanted = dash.state().limit_key()
+    other = dash.state().replace(v=dash.v + 7.0).limit_key()
+    previous = dash.scheduler._limit.wanted
+    dash.scheduler._limit.want(wanted)
+    try:
+        _stop_unless_wanted(wanted)  # wanted: the search goes on
+        with pytest.raises(LimitSuperseded) as stopped:
+            _stop_unless_wanted(other)
+        assert isinstance(stopped.value, Superseded)
+    finally:
+        dash.scheduler._limit.want(previous)
+
+
 @pytest.mark.slow
 def test_status_follows_the_model_and_the_published_cases_flip(dash):
     for s0 in (0.005, 0.014, 0.005):
