@@ -11,7 +11,7 @@ or refuse it:
   wanted by the time its turn comes; its answer is posted to the session's next tick
   (:func:`app.dashboard.session.post`: the document's lock, one Bokeh hold) and shown only if its
   key is still the one wanted then.  ``after`` (a future) delays the start until it is done,
-  ``delay_ms`` until the key has been wanted that long;
+  ``delay_ms`` until the key has been wanted that long (after ``after``, if both);
 * not served (tests, scripts), it is computed and shown at once.
 
 The worker threads compare keys only: they never read the dashboard's parameters, which change
@@ -78,12 +78,16 @@ class ViewJob:
             future = self._requests.submit(run)
             future.add_done_callback(lambda f: self._done(doc, key, show, fail, f, ended))
 
+        def wait_then_submit() -> None:
+            if delay_ms and self.wanted == key:
+                doc.add_timeout_callback(submit, delay_ms)
+            else:
+                submit()
+
         if after is not None and not after.done():
-            after.add_done_callback(lambda _f: post(doc, submit))
-        elif delay_ms:
-            doc.add_timeout_callback(submit, delay_ms)
+            after.add_done_callback(lambda _f: post(doc, wait_then_submit))
         else:
-            submit()
+            wait_then_submit()
         return ended
 
     def want(self, key: Hashable | None) -> None:

@@ -7,8 +7,9 @@ refused with a notice; the previous data are kept).
 The assessment (:func:`app.results.verdicts.assessment_result`) runs on a worker thread for each
 state of the dashboard (:class:`app.dashboard.jobs.ViewJob`), asked for when the state changes
 and started once that state's follow-ups (dense root locus, s0*(v)) have ended, whatever their
-outcome; it takes a few seconds (the short-circuit case's grid over every fault instant, the
-ripple case's speed sweep), so the indicator says "computing" meanwhile.
+outcome, and the state has stayed for a moment (:data:`VERDICT_QUIET_MS`); it takes a few
+seconds (the short-circuit case's grid over every fault instant, the ripple case's speed sweep),
+so the indicator says "computing" meanwhile.
 """
 
 from __future__ import annotations
@@ -35,6 +36,10 @@ from model.mechanics.parameters import ASSESSMENT_SCHEMA, ParameterError, parse_
 log = logging.getLogger(__name__)
 
 MAX_STRENGTH_BYTES = 50_000
+# the assessment starts when its state has stayed this long after the state's follow-ups [ms]:
+# a sequence of slider steps asks for the verdict of its last state only (an assessment is
+# mostly Python and would share the interpreter with the next state's first answer and loci)
+VERDICT_QUIET_MS = 300
 COLUMNS = ("component", "check", "load case", "load [kN m]", "capacity [kN m]", "safety factor",
            "band 5–95 %",
            "required", "verdict", "where", "note")
@@ -129,10 +134,10 @@ class VerdictsView:
 
     def request(self, case: Case, after=None) -> None:
         """Assess ``case``'s operating point (served: on a worker thread, started once
-        ``after`` — a future: the state's follow-ups — is done; its short-circuit envelope,
-        mostly Python, would share the GIL with the dense root locus and delay it by about a
-        second after a speed step; not served, as in tests without a server: when the Verdicts
-        tab is opened)."""
+        ``after`` — a future: the state's follow-ups — is done and the state has stayed for
+        :data:`VERDICT_QUIET_MS`; its short-circuit envelope, mostly Python, would share the GIL
+        with the dense root locus and delay it by about a second after a speed step; not
+        served, as in tests without a server: when the Verdicts tab is opened)."""
         key = self._key(case)
         if served_document() is None:
             self._waiting = key
@@ -145,7 +150,7 @@ class VerdictsView:
             return  # asked for already (its answer, or the one on screen, stands)
         self.indicator.object = indicator_html(None, "computing…")
         self._job.start(key, lambda: assessment_result(*key), self._show, self._failed,
-                        after=after)
+                        after=after, delay_ms=VERDICT_QUIET_MS)
 
     def on_shown(self, shown: bool) -> None:
         """The Verdicts tab opened (``shown``) or closed; not served, the assessment waiting
