@@ -17,7 +17,9 @@ Starts ``bogie serve`` on a free port (a separate process, as users run it), the
 2. root-locus refresh: keyboard steps on the speed slider (new v → new s0*(v) and a new locus
    over s0); latency = key press → new (coarse, 25-point) locus branches in the browser, and
    key press → the dense 200-point locus has replaced it (its title no longer says
-   "computing");
+   "computing"). The steps follow each other once the dense locus is shown (the previous
+   speed's s0*(v) and verdict may still run); with ``--settled-speed-steps`` each waits until
+   they are done (a reviewer who looks at the new speed's results first);
 3. ``--sessions`` pages at once, each with its own wheel force N0 (so no session profits from
    another's cache), pressing s0 steps at random moments (0.3–1.5 s apart);
 4. the same number of sessions, but only one of them a Chromium page (measured as in 3) and the
@@ -444,7 +446,11 @@ async def run(args) -> dict:
                 await wait_idle(page)
                 isolated.append(await step(page, "ctl-s0", S0_KEY, FAST))
             results["single_isolated_s"] = isolated
-            speeds = [await speed_step(page) for _ in range(args.locus_presses)]
+            speeds = []
+            for _ in range(args.locus_presses):
+                if args.settled_speed_steps:
+                    await wait_settled(page)
+                speeds.append(await speed_step(page))
             results["single_fast_s"] = fast
             results["locus_refresh_s"] = [coarse for coarse, _ in speeds]
             results["dense_locus_s"] = [dense for _, dense in speeds]
@@ -541,6 +547,8 @@ def main() -> None:
     parser.add_argument("--isolated", type=int, default=5,
                         help="s0 steps each after the session is idle (1 b)")
     parser.add_argument("--locus-presses", type=int, default=5)
+    parser.add_argument("--settled-speed-steps", action="store_true",
+                        help="each speed step after the previous one's s0*(v) and verdict (2)")
     parser.add_argument("--drags", type=int, default=4,
                         help="mouse drags of s0 from 0.005 to 0.012 and back over 2 s each "
                              "(1 c: the previews while the handle is held)")
