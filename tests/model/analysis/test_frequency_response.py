@@ -50,15 +50,9 @@ def _long_time_response(system, C: np.ndarray, f_hz: float, t_long: float, steps
     F[N:, N:] = [[0.0, -w], [w, 0.0]]
     step = sla.expm(F * h)
     k = round(t_long / h)
-    z = np.zeros(N + 2)
-    z[N] = 1.0
-    power, remaining = step.copy(), k
-    while remaining:
-        if remaining & 1:
-            z = power @ z
-        remaining >>= 1
-        if remaining:
-            power = power @ power
+    start = np.zeros(N + 2)
+    start[N] = 1.0
+    z = np.linalg.matrix_power(step, k) @ start
     t = (k + np.arange(periods * steps)) * h
     y = np.empty((len(t), C.shape[0]))
     for j in range(len(t)):

@@ -79,13 +79,7 @@ def _steady_amplitudes(system, C: np.ndarray, inputs: list[tuple[np.ndarray, flo
         start[g, j] = 1.0
     step = sla.expm(F * h)
     count = round(t_long / h)
-    z, power, remaining = start, step.copy(), count
-    while remaining:
-        if remaining & 1:
-            z = power @ z
-        remaining >>= 1
-        if remaining:
-            power = power @ power
+    z = np.linalg.matrix_power(step, count) @ start
     samples = round(periods * f_high / f_low) * steps
     t = (count + np.arange(samples)) * h
     y = np.empty((samples, C.shape[0], k))
