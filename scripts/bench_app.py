@@ -302,15 +302,17 @@ def protocol_clients(url: str, count: int) -> None:
             locus = [doc.get_model_by_name("locus_points")]
             s0, n0 = control("s0"), control("N0")
             change(n0, 60.0 + index, locus)  # own wheel force [kN]: no shared cache hits
-            # settled as the single session (wait_settled): the dense root locus and s0*(v) of
-            # the new N0 shown, else the first clients' steps are measured beside the other
-            # clients' follow-ups (≈ 3 CPU-s each), not beside their steps
+            # settled as the single session (wait_settled): the dense root locus, s0*(v) and the
+            # verdict of the new N0 shown, else the first clients' steps are measured beside the
+            # other clients' follow-ups (≈ 3 CPU-s each, the verdict's unstable and ripple
+            # cases ≈ 2 CPU-s more), not beside their steps
             title = doc.get_model_by_name("root-locus").title
 
             def settled() -> bool:
-                texts = [getattr(m, "text", None) for m in doc.models]
+                texts = [t for t in (getattr(m, "text", None) for m in doc.models)
+                         if isinstance(t, str)]
                 return ("computing" not in title.text
-                        and not any(isinstance(t, str) and "s0*(v): computing" in t
+                        and not any("s0*(v): computing" in t or "VERDICT: computing" in t
                                     for t in texts))
             deadline = time.perf_counter() + 300.0
             session._connection._loop_until(

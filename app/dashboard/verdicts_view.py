@@ -38,8 +38,9 @@ log = logging.getLogger(__name__)
 MAX_STRENGTH_BYTES = 50_000
 # the assessment starts when its state has stayed this long after the state's follow-ups [ms]:
 # a sequence of slider steps asks for the verdict of its last state only (an assessment is
-# mostly Python and would share the interpreter with the next state's first answer and loci)
-VERDICT_QUIET_MS = 300
+# mostly Python and would share the interpreter with the next state's first answer and loci,
+# its own session's and every other session's on the server; as the reaction-time search)
+VERDICT_QUIET_MS = 1000
 COLUMNS = ("component", "check", "load case", "load [kN m]", "capacity [kN m]", "safety factor",
            "band 5–95 %",
            "required", "verdict", "where", "note")
