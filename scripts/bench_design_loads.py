@@ -48,6 +48,7 @@ from functools import partial
 import numpy as np
 import scipy
 import scipy.signal
+from bench_timing import load, timed  # the scripts' own helpers
 
 from model import KMH, load_parameters
 from model.analysis.eigen import bogie_system, forget_systems
@@ -58,16 +59,6 @@ from model.studies.engine import StudyEngine, serial_map_unordered
 from model.studies.envelope import EnvelopeStudy, resolve_outputs
 from model.studies.maps import cached_model
 from model.studies.store import MemoryWriter
-
-
-def load() -> str:
-    return " / ".join(f"{x:.2f}" for x in os.getloadavg())
-
-
-def timed(function) -> tuple[float, object]:
-    start = time.perf_counter()
-    value = function()
-    return time.perf_counter() - start, value
 
 
 def study_for(parameters, model, s0, v_kmh, **changes) -> EnvelopeStudy:

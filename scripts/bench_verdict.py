@@ -23,12 +23,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import statistics
-import time
 from pathlib import Path
 
 import numpy as np
+from bench_timing import load, timed  # the scripts' own helpers
 
 from model import load_parameters
 from model.studies.assessment import assess
@@ -36,16 +35,6 @@ from model.studies.engine import StudyEngine
 from model.studies.verdict_uncertainty import run_verdict_uncertainty
 
 PERTURBED = "rotor_inertia"  # a dynamics parameter nudged by 1e-9 so that a model is built cold
-
-
-def load() -> str:
-    return " / ".join(f"{x:.2f}" for x in os.getloadavg())
-
-
-def timed(function) -> tuple[float, object]:
-    start = time.perf_counter()
-    value = function()
-    return time.perf_counter() - start, value
 
 
 def nudged(parameters, k: int):
