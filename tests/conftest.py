@@ -304,6 +304,23 @@ def install_study_queue(folder: Path, engine_factory=InProcessEngine, **settings
     return queue, restore
 
 
+def dashboard_with_study_queue(folder: Path):
+    """A dashboard in a document of its own (not served), with a study queue on ``folder``: a
+    module fixture's body (``yield from``), the previous queue put back afterwards."""
+    from bokeh.document import Document
+
+    from app.dashboard.dashboard import BogieDashboard
+
+    _queue, restore = install_study_queue(folder)
+    try:
+        dashboard = BogieDashboard()
+        doc = Document()
+        doc.add_root(dashboard.layout.get_root(doc))
+        yield dashboard
+    finally:
+        restore()
+
+
 # --- shared test data and checks ------------------------------------------------------------------
 
 SPEEDS = (40.0, 120.0, 200.0)  # speeds of the small uncertainty results [km/h]

@@ -17,10 +17,8 @@ import json
 import numpy as np
 import param
 import pytest
-from bokeh.document import Document
-from conftest import ROOT, SPEEDS, install_study_queue, uncertainty_result_file
+from conftest import ROOT, SPEEDS, dashboard_with_study_queue, uncertainty_result_file
 
-from app.dashboard.dashboard import BogieDashboard
 from app.dashboard.studies_view import MapView
 from app.dashboard.uncertainty_band import band_mismatch, read_band
 from app.results import compute
@@ -32,12 +30,7 @@ B_M = compute.parameters("", "calibrated")["motor_slope"]  # the set's b_M [N m 
 
 @pytest.fixture(scope="module")
 def dash(tmp_path_factory):
-    _queue, restore = install_study_queue(tmp_path_factory.mktemp("studies"))
-    dashboard = BogieDashboard()
-    doc = Document()
-    doc.add_root(dashboard.layout.get_root(doc))
-    yield dashboard
-    restore()
+    yield from dashboard_with_study_queue(tmp_path_factory.mktemp("studies"))
 
 
 def _in_folder(view, name: str, parameters, **kwargs) -> str:

@@ -12,10 +12,8 @@ from __future__ import annotations
 import json
 
 import pytest
-from bokeh.document import Document
-from conftest import install_study_queue
+from conftest import dashboard_with_study_queue
 
-from app.dashboard.dashboard import BogieDashboard
 from app.results import compute
 from app.results.verdicts import band_words
 from app.services.studies_folder import refusal
@@ -27,13 +25,9 @@ pytestmark = pytest.mark.slow
 
 @pytest.fixture(scope="module")
 def dash(tmp_path_factory):
-    _queue, restore = install_study_queue(tmp_path_factory.mktemp("studies"))
-    dashboard = BogieDashboard()
-    doc = Document()
-    doc.add_root(dashboard.layout.get_root(doc))
-    dashboard.verdicts.on_shown(True)  # not served: the assessment is computed when the tab opens
-    yield dashboard
-    restore()
+    for dashboard in dashboard_with_study_queue(tmp_path_factory.mktemp("studies")):
+        dashboard.verdicts.on_shown(True)  # not served: computed when the tab opens
+        yield dashboard
 
 
 @pytest.fixture(scope="module")
