@@ -420,18 +420,31 @@ def ripple_case(parameters: Parameters, outputs: list[str], options: AssessmentO
     (``ripple_v``, refined at the resonances) and creepages (``s0``, each checked stable at every
     speed, else :class:`AssessmentError`), under the options' ripple (``ripple``; None: the set's)
     of both converters."""
+    return ripple_load_case(ripple_case_sweep(parameters, outputs, options), parameters, options)
+
+
+def ripple_of(parameters: Parameters, options: AssessmentOptions) -> dict[Order, float]:
+    """The ripple case's {order: amplitude [N m]} per converter: the options' or the set's
+    (:func:`model.studies.ripple_case.ripple_amplitudes`)."""
+    return options.ripple if options.ripple is not None else ripple_amplitudes(parameters)
+
+
+def ripple_case_sweep(parameters: Parameters, outputs: list[str], options: AssessmentOptions,
+                      ripple: dict[Order, float] | None = None) -> RippleSweep:
+    """The ripple case's sweep (:func:`model.studies.ripple_case.ripple_sweep`) over the options'
+    speeds and creepages at ``ripple`` {order: amplitude [N m]} (None: :func:`ripple_of`); a
+    creepage not stable at every speed raises :class:`AssessmentError`."""
     from model.mechanics.excitation import load_excitation
     from model.studies.maps import cached_model
 
     points = [operating_point(parameters, s0, options.ripple_v[0], options) for s0 in options.s0]
     drive = options.ripple_drive if options.ripple_drive is not None else load_excitation()
-    ripple = options.ripple if options.ripple is not None else ripple_amplitudes(parameters)
+    ripple = ripple_of(parameters, options) if ripple is None else ripple
     try:
-        sweep = ripple_sweep(cached_model(parameters), points, options.ripple_v, ripple, drive,
-                             outputs)
+        return ripple_sweep(cached_model(parameters), points, options.ripple_v, ripple, drive,
+                            outputs)
     except RippleCaseError as error:
         raise AssessmentError(str(error)) from None
-    return ripple_load_case(sweep, parameters, options)
 
 
 def ripple_load_case(sweep: RippleSweep, parameters: Parameters, options: AssessmentOptions

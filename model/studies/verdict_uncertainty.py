@@ -65,19 +65,19 @@ from model.mechanics.operating_point import KMH
 from model.mechanics.parameters import ALL_SCHEMA, Parameters, parameter_hash
 from model.studies.assessment import (
     Assessment,
-    AssessmentError,
     AssessmentOptions,
     LoadCase,
     assessed_outputs,
     assessment_of,
-    operating_point,
+    ripple_case_sweep,
     ripple_load_case,
+    ripple_of,
     short_circuit_case,
     starting_case,
     unstable_adhesion_case,
 )
 from model.studies.parameter_ranges import ParameterRange
-from model.studies.ripple_case import RippleCaseError, RippleSweep, ripple_amplitudes, ripple_sweep
+from model.studies.ripple_case import RippleSweep
 from model.studies.verdict_priors import (
     GROUPS,
     VerdictUncertaintyError,
@@ -156,9 +156,6 @@ def dynamics_cases(parameters: Parameters, options: AssessmentOptions
     starting cases of ``options.cases`` as :func:`~model.studies.assessment.assess` computes them
     (in this process), and for the ripple case its sweep at 1 N m per order of the options' or the
     set's ripple (:func:`scaled_sweep` gives any amplitudes).  Raises what the cases raise."""
-    from model.mechanics.excitation import load_excitation
-    from model.studies.maps import cached_model
-
     outputs = assessed_outputs(parameters)
     builders = {"short_circuit": short_circuit_case, "unstable_adhesion": unstable_adhesion_case,
                 "starting": starting_case}
@@ -166,15 +163,8 @@ def dynamics_cases(parameters: Parameters, options: AssessmentOptions
              for name in options.cases if name in builders}
     if "ripple" not in options.cases:
         return cases, None
-    points = [operating_point(parameters, s0, options.ripple_v[0], options) for s0 in options.s0]
-    drive = options.ripple_drive if options.ripple_drive is not None else load_excitation()
-    orders = options.ripple if options.ripple is not None else ripple_amplitudes(parameters)
-    try:
-        sweep = ripple_sweep(cached_model(parameters), points, options.ripple_v,
-                             dict.fromkeys(orders, 1.0), drive, outputs)
-    except RippleCaseError as error:
-        raise AssessmentError(str(error)) from None
-    return cases, sweep
+    unit = dict.fromkeys(ripple_of(parameters, options), 1.0)
+    return cases, ripple_case_sweep(parameters, outputs, options, unit)
 
 
 def scaled_sweep(unit: RippleSweep, ripple: dict) -> RippleSweep:
@@ -192,8 +182,8 @@ def verdict_on_loads(parameters: Parameters, options: AssessmentOptions,
     built = []
     for name in options.cases:
         if name == "ripple":
-            ripple = options.ripple if options.ripple is not None else ripple_amplitudes(parameters)
-            built.append(ripple_load_case(scaled_sweep(unit, ripple), parameters, options))
+            built.append(ripple_load_case(scaled_sweep(unit, ripple_of(parameters, options)),
+                                          parameters, options))
         else:
             built.append(cases[name])
     return assessment_of(parameters, built)
