@@ -192,7 +192,7 @@ def cmd_assess(args: argparse.Namespace) -> None:
             raise UsageError(f"--{name.replace('_', '-')} needs --samples")
     with study_engine(args, "assess") as (mapper, where):
         print(f"assess: short_circuit ({len(options.s0) * len(options.v)} point(s) on {where}), "
-              "unstable_adhesion, starting …", file=sys.stderr)
+              "unstable_adhesion, starting, ripple …", file=sys.stderr)
         result = assess(parameters, options, mapper, ProgressBar("assess: short_circuit",
                                                                  unit="points"))
     emit(args, {**result.as_dict(), "rail": args.rail}, assessment_table(result))
