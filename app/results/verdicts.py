@@ -19,7 +19,6 @@ from bokeh.plotting import figure
 from app.results import compute
 from app.results.case import CaseBase
 from model.analysis.assessment import KIND_NAMES, VERDICT_WORDS, verdict_colour
-from model.analysis.response import ShortCircuit
 from model.mechanics.operating_point import KMH
 from model.studies.assessment import (
     Assessment,
@@ -106,10 +105,7 @@ def unstable_case(case: CaseBase, strength: tuple = ()) -> LoadCase:
     def compute_case() -> LoadCase:
         parameters = _parameters(key, strength)
         op = key.operating_point()
-        excitation = key.short_circuit()
-        options = AssessmentOptions(N0=op.N0, b_M=op.b_M,
-                                    excitation=ShortCircuit(M0=excitation.M0, f=excitation.f,
-                                                            D=excitation.D),
+        options = AssessmentOptions(N0=op.N0, b_M=op.b_M, excitation=key.short_circuit(),
                                     unstable_s0=op.s0, unstable_v=op.v)
         return unstable_adhesion_case(parameters, assessed_outputs(parameters), options)
     return compute.cached("unstable case", key, compute_case, strength)
