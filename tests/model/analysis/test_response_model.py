@@ -173,7 +173,10 @@ def test_at_the_creep_maximum_the_spin_drift_is_parabolic_and_exact(bogie):
     for name in a.outputs:
         scale = np.abs(b.perturbation(name)).max()
         assert np.all(np.isfinite(a.outputs[name]))
-        assert np.abs(a.perturbation(name) - b.perturbation(name)).max() < TOLERANCE * scale
+        # ``<=``: the adhesion moment's perturbation is b11 · (…) with b11 = 0 at the maximum, so
+        # both methods give exactly zero there (a strict ``<`` against 0 · scale fails)
+        assert np.abs(a.perturbation(name) - b.perturbation(name)).max() <= TOLERANCE * scale
+    assert np.abs(b.perturbation("ID1.rotor.ry")).max() > 0.0  # the spin does drift
 
 
 def test_unstable_case_grows_without_nan_for_5_s_and_reports_limits(bogie):
