@@ -66,6 +66,7 @@ SERVED_MODULES = {
     "tests/app/dashboard/test_review_browser.py",
     "tests/app/dashboard/test_uncertainty_band_browser.py",
     "tests/app/dashboard/test_verdicts_browser.py",
+    "tests/app/dashboard/test_tables_browser.py",
 }
 OWN_SERVER_MODULES = {"tests/app/server/test_reliability.py"}
 GROUPS = {
@@ -250,9 +251,10 @@ def chromium():
         browser.close()
 
 
-def open_app(browser, url: str, timeout_ms: float = 120_000, viewport=(1600, 1000)):
-    """A new page with the app loaded and rendered; ``page.errors`` collects console errors
-    and uncaught page errors."""
+def open_app(browser, url: str, timeout_ms: float = 120_000, viewport=(1600, 1000),
+             query: str = ""):
+    """A new page with the app loaded (``/app?<query>``) and rendered; ``page.errors`` collects
+    console errors and uncaught page errors."""
     page = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
     errors: list[str] = []
     page.on("console", lambda m: errors.append(f"console: {m.text}") if m.type == "error" else None)
@@ -260,7 +262,7 @@ def open_app(browser, url: str, timeout_ms: float = 120_000, viewport=(1600, 100
     # which resource failed (the console message does not say)
     page.on("requestfailed", lambda r: errors.append(f"requestfailed: {r.url} ({r.failure})"))
     page.errors = errors
-    page.goto(f"{url}/app", timeout=timeout_ms)
+    page.goto(f"{url}/app" + (f"?{query}" if query else ""), timeout=timeout_ms)
     page.wait_for_function("() => window.Bokeh && Bokeh.documents.length > 0",
                            timeout=timeout_ms)
     page.wait_for_selector("canvas", timeout=timeout_ms)

@@ -160,7 +160,7 @@ class BogieDashboard(pn.viewable.Viewer):
                                           css_classes=["input-notice"],
                                           sizing_mode="stretch_width")
         self.peaks = layout.html_pane("", css_classes=["peak-table"])
-        self.eigen_table = layout.html_pane("")
+        self.eigen_table = layout.html_pane("", css_classes=["eigen-table"])
         self.mode_select = pn.widgets.Select(label="mode ν", options={}, width=420,
                                              css_classes=["ctl-mode"])
         self.mode_select.link(self, value="mode")

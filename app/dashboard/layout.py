@@ -48,6 +48,18 @@ html_pane = partial(pn.pane.HTML, sizing_mode="stretch_width", stylesheets=[CSS]
 bokeh_pane = partial(pn.pane.Bokeh, sizing_mode="stretch_width")
 
 
+def typed_frame(columns, rows):
+    """A table's pandas frame with every column's type declared: ``columns`` maps each column
+    to its dtype (``"object"`` for text, ``"float64"``, ``"int64"``), ``rows`` are dicts with
+    those keys.  A Panel Tabulator takes its columns' formatters from the first frame it is
+    given; a table made before its data (an empty frame: every column float) drew its text
+    columns as ``NaN`` ever after, and its integers as ``1.0``."""
+    import pandas as pd
+
+    return pd.DataFrame({name: pd.Series([row[name] for row in rows], dtype=dtype)
+                         for name, dtype in columns.items()}, columns=list(columns))
+
+
 def tab_name(title: str) -> str:
     """A view's name in the URL (``tab=``): its title in lower case, words joined by '-'."""
     return re.sub(r"[^a-z0-9]+", "-", str(title).lower()).strip("-")

@@ -16,6 +16,7 @@ from typing import ClassVar
 
 import panel as pn
 
+from app.dashboard import layout
 from app.dashboard.jobs import ViewJob
 from app.results import compute
 from app.services.thread_pools import FIRST_ANSWER_POOL
@@ -70,18 +71,14 @@ class ModeTable:
                         "re": {"type": "money", "precision": 4, "thousand": ""},
                         "zeta": {"type": "money", "precision": 4, "thousand": ""}})
 
-    @staticmethod
-    def _frame(modes):
-        import pandas as pd
+    TYPES: ClassVar[dict[str, str]] = {"nu": "int64", "im_hz": "float64", "re": "float64",
+                                       "zeta": "float64", "description": "object"}
 
-        # explicit column types: the table takes its columns' formatters from the first frame,
-        # which is empty (an empty column is float: ν shown as 1.0, the descriptions as NaN)
-        return pd.DataFrame({"nu": pd.Series([m.number for m in modes], dtype="int64"),
-                             "im_hz": pd.Series([m.im_hz for m in modes], dtype="float64"),
-                             "re": pd.Series([m.eigenvalue.real for m in modes], dtype="float64"),
-                             "zeta": pd.Series([m.damping_ratio for m in modes], dtype="float64"),
-                             "description": pd.Series([m.description for m in modes],
-                                                      dtype="object")})
+    @classmethod
+    def _frame(cls, modes):
+        return layout.typed_frame(cls.TYPES, [
+            {"nu": m.number, "im_hz": m.im_hz, "re": m.eigenvalue.real, "zeta": m.damping_ratio,
+             "description": m.description} for m in modes])
 
     @property
     def descriptions(self) -> list[str]:

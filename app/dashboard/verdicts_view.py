@@ -41,9 +41,11 @@ MAX_STRENGTH_BYTES = 50_000
 # mostly Python and would share the interpreter with the next state's first answer and loci,
 # its own session's and every other session's on the server; as the reaction-time search)
 VERDICT_QUIET_MS = 1000
-COLUMNS = ("component", "check", "load case", "load [kN m]", "capacity [kN m]", "safety factor",
-           "band 5–95 %",
-           "required", "verdict", "where", "note")
+TEXT, NUMBER = "object", "float64"
+# the table's columns and their types (text drawn as text, numbers with their decimals)
+COLUMNS = {"component": TEXT, "check": TEXT, "load case": TEXT, "load [kN m]": NUMBER,
+           "capacity [kN m]": NUMBER, "safety factor": NUMBER, "band 5–95 %": TEXT,
+           "required": NUMBER, "verdict": TEXT, "where": TEXT, "note": TEXT}
 
 
 def strength_from_toml(data: bytes, base) -> tuple:
@@ -110,8 +112,9 @@ class VerdictsView:
         self.layout = pn.Column(
             pn.pane.Markdown(
                 "Every press fit (slip, DIN 7190), shaft (torsional shear) and coupling (rating) "
-                "of both drives in three load cases; safety factor = capacity / load. Click a "
-                "row for the history that produced its load (the starting case's are static). "
+                "of both drives in every load case listed below; safety factor = capacity / load. "
+                "Click a row for the history that produced its load (the starting case's are "
+                "static; a ripple row opens the Resonances tab at its speed). "
                 "Strength data (TOML, entries as in the parameter file, e.g. "
                 "`wheel_seat_friction_min = { value = 0.1, unit = \"1\" }`) replace the set's; "
                 "docs/assessment.md."),
@@ -121,10 +124,7 @@ class VerdictsView:
 
     @staticmethod
     def _frame(rows):
-        import pandas as pd
-
-        return pd.DataFrame({name: [r[name] for r in rows] for name in COLUMNS},
-                            columns=list(COLUMNS))
+        return layout.typed_frame(COLUMNS, rows)
 
     # --- computing ----------------------------------------------------------------------------
 

@@ -276,7 +276,7 @@ steady amplitude over speed under the torque ripple {html.escape(ripple)} of
 reaches).</p>
 {resonance_div}"""
 def verdicts_section(results: ReportResults, chart_div: str) -> str:
-    """The checks of every press fit, shaft and coupling in the three load cases
+    """The checks of every press fit, shaft and coupling in every load case
     (docs/assessment.md): the governing one, the table and the bar chart."""
     if results.assessment is None:
         return ""

@@ -83,6 +83,22 @@ def test_design_loads_tab_in_the_browser(own_server, chromium):
         assert len(links) == 16  # max and min of 8 drive parts
         assert all("tab=response" in link and "s0=" in link for link in links)
         assert str(own_server[2]) not in table + _text(page, "loads-status")  # no server path
+        # the cells the browser drew are the store's envelope
+        from app.dashboard.envelope_grid import envelope_rows, read_envelope
+
+        stores = [p for p in own_server[2].iterdir() if (p / "zarr.json").is_file()]
+        assert len(stores) == 1, stores
+        envelope = envelope_rows(read_envelope(stores[0], stores[0].name))
+        drawn = [cells for cells in (tr.locator("td").all_inner_texts() for tr in
+                                     page.locator(".loads-envelope-table table tr").all())
+                 if cells]
+        assert len(drawn) == len(envelope.outputs)
+        for cells, output in zip(drawn, envelope.outputs, strict=True):
+            assert cells[0].endswith(f"[{output.unit}]")
+            for cell, value in ((cells[1], output.max), (cells[3], output.min)):
+                # printed as "1,234" (to 0.5) or "1.234e+07" (to 4 digits)
+                assert abs(float(cell.replace(",", "")) - value) <= max(0.51, 5e-4 * abs(value))
+            assert f"s0 = {output.max_at['s0']:.5g}" in cells[2]
         page.wait_for_timeout(1500)  # the heat map drawn
         page.screenshot(path=str(ARTIFACTS / "design_loads_tab.png"), full_page=True)
         assert errors == [], errors

@@ -136,6 +136,7 @@ def test_variant_upload_comparison_click_through_and_report(own_server, chromium
         timeout=60_000)
     page.locator(".variant-comparison td.changed").first.wait_for(timeout=240_000)
     assert "variant=silent_block_stiffness_z" in page.url
+    _compare_variant_tables(page, base)
 
     # the report: downloaded, opened offline, every figure drawn, nothing fetched
     with page.expect_download(timeout=240_000) as info:
@@ -157,4 +158,38 @@ def test_variant_upload_comparison_click_through_and_report(own_server, chromium
     context.close()
     assert page.errors == [], page.errors
     page.close()
+
+
+def _drawn_rows(page, selector: str) -> list[list[str]]:
+    """The body cells (``td``) of the table at ``selector`` as the browser drew them."""
+    return [cells for cells in (tr.locator("td").all_inner_texts()
+                                for tr in page.locator(f"{selector} tr").all()) if cells]
+
+
+def _compare_variant_tables(page, base) -> None:
+    """The Variant tab's tables as drawn: the comparison's baseline column is the baseline's
+    point (computed here for the page's default state), the variant differs where it is
+    highlighted; the calibration bounds are those of the baseline's fitted parameters."""
+    from app.results import compute
+    from app.results.case import Case
+    from model.studies.calibration_bounds import parameter_rows
+
+    point = compute.point_result(Case(**Case.defaults(base)))
+    rows = {cells[0]: cells[1:] for cells in _drawn_rows(page, ".variant-comparison table")}
+    assert abs(float(rows["largest Re λ [1/s]"][0]) - point.max_real_part) <= 0.51e-4
+    assert rows["verdict"][0] == ("STABLE" if point.stable else "UNSTABLE")
+    for mode in point.modes[:5]:
+        baseline, variant, delta = rows[f"ν = {mode.number}: Im [Hz]"]
+        assert abs(float(baseline) - mode.im_hz) <= 0.51e-3
+        assert abs(float(variant) - float(baseline) - float(delta)) <= 1.1e-3
+    page.get_by_text("Calibration bounds of the baseline").click()
+    drawn = _drawn_rows(page, ".variant-bounds table")
+    fitted = [row for row in parameter_rows(base) if row["lower"] is not None]
+    assert [cells[0] for cells in drawn] == [row["name"] for row in fitted]
+    for cells, row in zip(drawn, fitted, strict=True):
+        assert float(cells[1]) == pytest.approx(row["value"], rel=5e-4)
+        low, high = (float(x) for x in cells[2].split(" … "))
+        assert (low, high) == (pytest.approx(row["lower"], rel=5e-4),
+                               pytest.approx(row["upper"], rel=5e-4))
+        assert cells[3] == row["unit"]
 
