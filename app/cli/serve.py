@@ -9,7 +9,7 @@ import argparse
 
 from app.cli.options import bounded, non_negative_int, number, positive_int
 from app.results.cache import DEFAULT_CACHE_MB
-from app.services.settings import MAX_CACHE_MB, MIN_CACHE_MB
+from app.services.settings import DEFAULT_BACKGROUND_WORKERS, MAX_CACHE_MB, MIN_CACHE_MB
 
 
 def register(subparsers) -> None:
@@ -52,6 +52,13 @@ def register(subparsers) -> None:
                    help="memory the results every session shares may hold [MB]; beyond it the "
                         "least recently used go first (environment: BOGIE_CACHE_MB; default "
                         f"{DEFAULT_CACHE_MB}; docs/memory.md)")
+    p.add_argument("--background-workers", type=non_negative_int("--background-workers"),
+                   default=None, metavar="N",
+                   help="worker processes, at a lower priority than the server, of the work no "
+                        "slider waits for (the verdict's load cases, the reaction-time search); "
+                        "0: the server's own threads; with --scheduler that cluster runs it "
+                        "(environment: BOGIE_BACKGROUND_WORKERS; default "
+                        f"{DEFAULT_BACKGROUND_WORKERS}; docs/memory.md)")
     p.set_defaults(func=cmd_serve)
 
 
@@ -63,6 +70,7 @@ def cmd_serve(args: argparse.Namespace) -> None:
         scheduler=args.scheduler, studies_dir=args.studies_dir,
         max_study_points=args.max_study_points, max_running_studies=args.max_running_studies,
         max_waiting_studies=args.max_waiting_studies,
-        cache_mb=None if args.cache_mb is None else int(args.cache_mb))
+        cache_mb=None if args.cache_mb is None else int(args.cache_mb),
+        background_workers=args.background_workers)
     serve(port=args.port, address=args.address, allow_websocket_origin=args.allow_websocket_origin,
           params=args.params, settings=settings)

@@ -17,7 +17,9 @@ linear creep at an unstable point, the nonlinear history beside the unbounded li
 (``dashboard.show_companion``: the peak table's physical answer).  The
 nonlinear histories are computed by :func:`app.results.compute.nonlinear_histories` (the report
 uses them too); the reaction-time search here is kept in the results cache like them and
-returns plain read-only data.  Each computation is a :class:`app.dashboard.jobs.ViewJob`.
+returns plain read-only data; served, it runs in a background worker process
+(:mod:`app.services.background`), not on the server's interpreter.  Each computation is a
+:class:`app.dashboard.jobs.ViewJob`.
 """
 
 from __future__ import annotations
@@ -25,8 +27,8 @@ from __future__ import annotations
 import html
 import logging
 import weakref
-from contextvars import ContextVar
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 import panel as pn
@@ -38,6 +40,7 @@ from app.results.cache import Superseded
 from app.results.case import CaseBase
 from app.results.compute import HistoryKey, NonlinearHistories, nonlinear_histories
 from app.results.plots import SeriesSource
+from app.services import background
 from app.services.thread_pools import NONLINEAR_POOL, SEARCH_POOL
 from model.analysis.antislip import required_reaction_time
 from model.analysis.nonlinear import AntiSlip, NonlinearError
@@ -62,23 +65,20 @@ class ReactionSuperseded(Superseded):
     waiting for the same search computes it itself)."""
 
 
-_WATCHED: ContextVar[bool] = ContextVar("bogie_reaction_watched", default=False)
-
-
 def _stop_unless_wanted(key: tuple) -> None:
-    if _WATCHED.get() and not any(view.wants_reaction(key) for view in list(_VIEWS)):
+    if not any(view.wants_reaction(key) for view in list(_VIEWS)):
         raise ReactionSuperseded(key)
 
 
 def wanted_reaction(case: CaseBase, threshold: float, rate: float) -> Reaction:
-    """:func:`reaction` for the dashboard's views: it stops (ReactionSuperseded) as soon as no
-    live view wants it any more — checked before it starts and after every run of its delay
-    grid.  Called directly, :func:`reaction` always completes."""
-    token = _WATCHED.set(True)
-    try:
-        return reaction(case, threshold, rate)
-    finally:
-        _WATCHED.reset(token)
+    """:func:`reaction` for the dashboard's views, in a background worker process
+    (:mod:`app.services.background`): it stops (ReactionSuperseded) as soon as no live view
+    wants it any more — checked before it starts and between the blocks of every run of its
+    delay grid.  Called directly, :func:`reaction` always completes in the calling thread."""
+    key = reaction_key(case, threshold, rate)
+    _stop_unless_wanted(key)
+    return reaction(case, threshold, rate,
+                    runner=partial(background.run, stop=partial(_stop_unless_wanted, key)))
 
 
 @dataclass(frozen=True)
@@ -104,22 +104,31 @@ def reaction_key(case: CaseBase, threshold: float, rate: float) -> tuple:
     return (case.without("t_end"), float(threshold), float(rate))
 
 
-def reaction(case: CaseBase, threshold: float, rate: float) -> Reaction:
+def _in_this_thread(function, *args):
+    return function(*args)
+
+
+def reaction(case: CaseBase, threshold: float, rate: float, runner=_in_this_thread) -> Reaction:
     """Required reaction time against M_ad (model.analysis.antislip) on a coarse grid: 11 delays,
-    5 kHz, 2 s — about 20 nonlinear runs (kept in the results cache)."""
+    5 kHz, 2 s — about 20 nonlinear runs (kept in the results cache); ``runner(function,
+    *args)`` runs the search when the cache does not hold it."""
     key = reaction_key(case, threshold, rate)
     point = key[0]
+    return compute.cached("reaction", point, lambda: runner(_search, point, key[1], key[2]),
+                          key[1], key[2])
 
-    def search() -> Reaction:
-        _stop_unless_wanted(key)
-        result = required_reaction_time(
-            compute.model_for(point), point.operating_point(), point.short_circuit(),
-            anti_slip=AntiSlip(True, 0.1, threshold, rate),
-            delays=REACTION_DELAYS, t_end=2.0, fs=max(REACTION_FS, 20.0 * float(point.f)),
-            checkpoint=lambda: _stop_unless_wanted(key))  # between blocks of every run
-        return Reaction(result.required_delay, result.reason, result.detection_time,
-                        result.reaction_after_fault, result.limit)
-    return compute.cached("reaction", point, search, key[1], key[2])
+
+def _search(point: CaseBase, threshold: float, rate: float) -> Reaction:
+    """The search of :func:`reaction` (a background worker's task when served): it asks
+    :func:`app.services.background.checkpoint` between the blocks of every run."""
+    background.checkpoint()
+    result = required_reaction_time(
+        compute.model_for(point), point.operating_point(), point.short_circuit(),
+        anti_slip=AntiSlip(True, 0.1, threshold, rate),
+        delays=REACTION_DELAYS, t_end=2.0, fs=max(REACTION_FS, 20.0 * float(point.f)),
+        checkpoint=background.checkpoint)
+    return Reaction(result.required_delay, result.reason, result.detection_time,
+                    result.reaction_after_fault, result.limit)
 
 
 class NonlinearView:

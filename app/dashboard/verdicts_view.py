@@ -30,6 +30,7 @@ from app.results.verdicts import (
     indicator_html,
     safety_factor_figure,
 )
+from app.services import background
 from app.services.thread_pools import SIDE_VIEW_POOL
 from model.mechanics.parameters import ASSESSMENT_SCHEMA, ParameterError, parse_entries
 
@@ -150,8 +151,9 @@ class VerdictsView:
         if key == self._job.wanted:
             return  # asked for already (its answer, or the one on screen, stands)
         self.indicator.object = indicator_html(None, "computing…")
-        self._job.start(key, lambda: assessment_result(*key), self._show, self._failed,
-                        after=after, delay_ms=VERDICT_QUIET_MS)
+        # served: the assessment in a background worker process (app.services.background)
+        self._job.start(key, lambda: assessment_result(*key, runner=background.run), self._show,
+                        self._failed, after=after, delay_ms=VERDICT_QUIET_MS)
 
     def on_shown(self, shown: bool) -> None:
         """The Verdicts tab opened (``shown``) or closed; not served, the assessment waiting

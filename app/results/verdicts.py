@@ -41,7 +41,11 @@ def _parameters(case: CaseBase, strength: tuple):
     return parameters.replace(**dict(strength)) if strength else parameters
 
 
-def assessment_result(case: CaseBase, strength: tuple = ()):
+def _in_this_thread(function, *args):
+    return function(*args)
+
+
+def assessment_result(case: CaseBase, strength: tuple = (), runner=_in_this_thread):
     """The assessment at the case's point and short circuit (its Δt and horizon do not count:
     every fault instant, the horizons of the load cases), with the strength data ``strength``
     ((name, value) pairs) replacing the set's.  The same as
@@ -50,32 +54,37 @@ def assessment_result(case: CaseBase, strength: tuple = ()):
     point the unstable case is the default one, and the ripple case, steady running over every
     speed, is always at the assessment's default creepages (``AssessmentOptions().s0``, as
     ``bogie assess`` takes them); a step of the creepage or the speed leaves both as they
-    were."""
+    were.  ``runner(function, *args)`` computes it when the cache does not hold it (the served
+    dashboard: :func:`app.services.background.run`, a worker process)."""
     key = case.without("dt", "t_end")
     strength = tuple(strength)
+    return compute.cached("assessment", key, lambda: runner(_assessment, key, strength),
+                          strength)
 
-    def compute_assessment() -> Assessment:
-        from model.analysis.eigen import bogie_system
 
-        parameters = _parameters(key, strength)
-        op = key.operating_point()
-        stable = float(np.max(bogie_system(compute.model_of(parameters),
-                                           op).eigenvalues().real)) <= 1e-6
-        excitation = key.short_circuit()
-        if stable:
-            options = AssessmentOptions(s0=(op.s0,), v=(op.v,), N0=op.N0, b_M=op.b_M,
-                                        excitation=excitation)
-        else:
-            options = AssessmentOptions(N0=op.N0, b_M=op.b_M, excitation=excitation,
-                                        unstable_s0=op.s0, unstable_v=op.v)
-        outputs = assessed_outputs(parameters)
-        unstable = unstable_case(key.replace(s0=options.unstable_s0,
-                                             v=round(options.unstable_v / KMH, 9)), strength)
-        ripple = ripple_load_case(key, strength)
-        return assessment_of(parameters, [short_circuit_case(parameters, outputs, options),
-                                          unstable, starting_case(parameters, outputs, options),
-                                          ripple])
-    return compute.cached("assessment", key, compute_assessment, strength)
+def _assessment(key: CaseBase, strength: tuple) -> Assessment:
+    """The assessment of :func:`assessment_result` (in a background worker when served: its load
+    cases are cached in that worker)."""
+    from model.analysis.eigen import bogie_system
+
+    parameters = _parameters(key, strength)
+    op = key.operating_point()
+    stable = float(np.max(bogie_system(compute.model_of(parameters),
+                                       op).eigenvalues().real)) <= 1e-6
+    excitation = key.short_circuit()
+    if stable:
+        options = AssessmentOptions(s0=(op.s0,), v=(op.v,), N0=op.N0, b_M=op.b_M,
+                                    excitation=excitation)
+    else:
+        options = AssessmentOptions(N0=op.N0, b_M=op.b_M, excitation=excitation,
+                                    unstable_s0=op.s0, unstable_v=op.v)
+    outputs = assessed_outputs(parameters)
+    unstable = unstable_case(key.replace(s0=options.unstable_s0,
+                                         v=round(options.unstable_v / KMH, 9)), strength)
+    ripple = ripple_load_case(key, strength)
+    return assessment_of(parameters, [short_circuit_case(parameters, outputs, options),
+                                      unstable, starting_case(parameters, outputs, options),
+                                      ripple])
 
 
 def ripple_load_case(case: CaseBase, strength: tuple = ()) -> LoadCase:

@@ -73,6 +73,7 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
     if settings.cache_mb is not None:
         cache.configure(settings.cache_mb)
     replace_study_queue(StudyQueue(settings))
+    start_background_workers(settings)
 
     # a fatal error in native code (SIGSEGV, SIGABRT...) leaves the Python stack of every thread
     # in the server's log instead of one line from the C library
@@ -95,7 +96,8 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
           f"{settings.scheduler or 'a local cluster (started on the first study)'}, at most "
           f"{settings.max_study_points} points, {settings.max_running_studies} running, "
           f"{settings.max_waiting_studies} waiting; results cache "
-          f"{cache.RESULTS.budget // cache.MB} MB", flush=True)
+          f"{cache.RESULTS.budget // cache.MB} MB; background work (verdicts, reaction times) on "
+          f"{_background_description()}", flush=True)
     try:
         pn.serve({"app": lambda: create_app(params)}, port=port, address=address,
                  websocket_origin=[o.strip() for o in origins if o.strip()], show=False,
@@ -103,6 +105,45 @@ def serve(port: int = 5006, address: str = "127.0.0.1",
     except KeyboardInterrupt:  # Ctrl-C before Panel's handler was in place
         pass
     _stop_now()
+
+
+def start_background_workers(settings) -> None:
+    """The worker processes of the work no slider waits for (:mod:`app.services.background`):
+    the operator's cluster with ``--scheduler``, else ``--background-workers`` local processes
+    (started now, beside the server's start; 0: the server's own threads)."""
+    from functools import partial
+
+    from app.results import cache
+    from app.services import background
+
+    if settings.background_workers == 0:
+        workers = None
+    elif settings.scheduler:
+        workers = background.ClusterWorkers(settings.scheduler)
+    else:
+        workers = background.LocalWorkers(
+            settings.background_workers,
+            setup=partial(cache.configure, background.WORKER_CACHE_MB))
+    previous = background.configure(workers)
+    if previous is not None:
+        previous.close()
+    if workers is not None:
+        threading.Thread(target=_start_quietly, args=(workers,), name="bogie-background-start",
+                         daemon=True).start()
+
+
+def _background_description() -> str:
+    from app.services import background
+
+    workers = background.current()
+    return "the server's own threads" if workers is None else workers.description
+
+
+def _start_quietly(workers) -> None:
+    try:
+        workers.start()
+    except Exception as error:  # the first task starts them again and its view says why
+        print(f"bogie serve: the background workers did not start: {error}", flush=True)
 
 
 MALLOC_ARENAS = 2  # glibc malloc arenas of the server process (MALLOC_ARENA_MAX wins)
@@ -140,6 +181,11 @@ def _stop_now(*_signal) -> None:
     import sys
 
     _close_studies()
+    from app.services import background
+
+    workers = background.configure(None)
+    if workers is not None:
+        workers.close()
 
     try:
         print("bogie serve: stopped", file=sys.stderr, flush=True)

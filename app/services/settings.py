@@ -22,11 +22,15 @@ ENVIRONMENT = {
     "max_running_studies": "BOGIE_MAX_RUNNING_STUDIES",
     "max_waiting_studies": "BOGIE_MAX_WAITING_STUDIES",
     "cache_mb": "BOGIE_CACHE_MB",
+    "background_workers": "BOGIE_BACKGROUND_WORKERS",
 }
 DEFAULT_MAX_STUDY_POINTS = 10_000  # s0 × v points of one map: the 100 × 100 map (≈ 25 s on 2 workers)
 DEFAULT_MAX_RUNNING_STUDIES = 1
 DEFAULT_MAX_WAITING_STUDIES = 16  # more requests are refused (a notice), never queued without end
 UPPER_STUDY_POINTS = 4_000_000  # the largest study limit an operator may set (2000 × 2000)
+# worker processes of the work no slider waits for (app.services.background); 0: the server's
+# own threads (without a local cluster of its own: with --scheduler they run on that cluster)
+DEFAULT_BACKGROUND_WORKERS = 2
 # what an operator may set as the results cache's budget [MB] (its default: app.results.cache)
 MIN_CACHE_MB, MAX_CACHE_MB = 32, 1_000_000
 
@@ -52,6 +56,7 @@ class ServerSettings:
     max_running_studies: int = DEFAULT_MAX_RUNNING_STUDIES  # studies running at once
     max_waiting_studies: int = DEFAULT_MAX_WAITING_STUDIES  # studies waiting in the queue
     cache_mb: int | None = None  # the results cache's budget [MB]; None: its default (docs/memory.md)
+    background_workers: int = DEFAULT_BACKGROUND_WORKERS  # local processes of the verdicts, searches
 
     def __post_init__(self) -> None:
         if self.studies_dir is None:
@@ -62,7 +67,8 @@ class ServerSettings:
         for name, low, high in (("max_study_points", 1, UPPER_STUDY_POINTS),
                                 ("max_running_studies", 1, 64),
                                 ("max_waiting_studies", 0, 10_000),
-                                ("cache_mb", MIN_CACHE_MB, MAX_CACHE_MB)):
+                                ("cache_mb", MIN_CACHE_MB, MAX_CACHE_MB),
+                                ("background_workers", 0, 64)):
             value = getattr(self, name)
             if name == "cache_mb" and value is None:
                 continue
@@ -74,18 +80,20 @@ class ServerSettings:
     def from_options(cls, scheduler: str | None = None, studies_dir: str | None = None,
                      max_study_points: int | None = None, max_running_studies: int | None = None,
                      max_waiting_studies: int | None = None, cache_mb: int | None = None,
+                     background_workers: int | None = None,
                      environ: dict | None = None) -> ServerSettings:
         """The settings of command-line options (``None``: not given), else of the environment
         variables in :data:`ENVIRONMENT`, else the defaults (raises :class:`SettingsError`)."""
         environ = os.environ if environ is None else environ
         given = {"scheduler": scheduler, "studies_dir": studies_dir,
                  "max_study_points": max_study_points, "max_running_studies": max_running_studies,
-                 "max_waiting_studies": max_waiting_studies, "cache_mb": cache_mb}
+                 "max_waiting_studies": max_waiting_studies, "cache_mb": cache_mb,
+                 "background_workers": background_workers}
         values = {}
         for name, value in given.items():
             if value is None and environ.get(ENVIRONMENT[name], "").strip():
                 value = environ[ENVIRONMENT[name]].strip()
-                if name.startswith("max_") or name == "cache_mb":
+                if name.startswith("max_") or name in ("cache_mb", "background_workers"):
                     try:
                         value = int(value)
                     except ValueError:
