@@ -36,7 +36,7 @@ import threading
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
-from concurrent.futures.process import BrokenProcessPool  # noqa: F401 - re-exported: what run raises
+from concurrent.futures.process import BrokenProcessPool
 
 log = logging.getLogger(__name__)
 
