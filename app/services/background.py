@@ -37,6 +37,7 @@ from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
 from concurrent.futures.process import BrokenProcessPool
+from pathlib import Path
 
 log = logging.getLogger(__name__)
 
@@ -45,6 +46,7 @@ DEFAULT_WORKERS = 2  # local worker processes (one per core of the 2-core machin
 WORKER_CACHE_MB = 150  # each worker's results cache [MB]: a model (≈ 56 MB) and its cases
 POLL_S = 0.1  # how often a waiting thread asks whether the answer is still wanted [s]
 SLOTS = 64  # tasks that can run or wait at once (a slot: one stop flag in shared memory)
+PID_SLOTS = 256  # worker processes a server records over its life (started and replaced ones)
 
 
 class Stopped(Exception):
@@ -59,10 +61,16 @@ _in_thread_stop: contextvars.ContextVar[Callable | None] = contextvars.ContextVa
     "bogie_background_stop", default=None)
 
 
-def _start_worker(niceness: int, stops, setup: Callable | None) -> None:
-    """A worker process's start: lower priority, one BLAS thread, then ``setup()`` (the server's:
-    the worker's own results cache, :data:`WORKER_CACHE_MB`)."""
+def _start_worker(niceness: int, stops, started, setup: Callable | None) -> None:
+    """A worker process's start: its process id recorded in ``started`` (shared with the server),
+    lower priority, one BLAS thread, then ``setup()`` (the server's: the worker's own results
+    cache, :data:`WORKER_CACHE_MB`)."""
     global _stops
+    with started.get_lock():
+        for index in range(len(started)):
+            if started[index] == 0:
+                started[index] = os.getpid()
+                break
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         os.nice(niceness)
@@ -114,6 +122,7 @@ class LocalWorkers:
         self._context = multiprocessing.get_context("forkserver")
         self._context.set_forkserver_preload(["numpy", "scipy.linalg", "model"])
         self._stops = self._context.RawArray("b", SLOTS)
+        self._started = self._context.Array("i", PID_SLOTS)  # the workers' process ids
         self._free = list(range(SLOTS))
         self._lock = threading.Lock()
         self._slot_free = threading.Condition(self._lock)
@@ -128,7 +137,7 @@ class LocalWorkers:
             if self._pool is None:
                 self._pool = ProcessPoolExecutor(
                     self.workers, mp_context=self._context, initializer=_start_worker,
-                    initargs=(self.niceness, self._stops, self.setup))
+                    initargs=(self.niceness, self._stops, self._started, self.setup))
             return self._pool
 
     def start(self) -> None:
@@ -139,9 +148,11 @@ class LocalWorkers:
             future.result(timeout=120)
 
     def pids(self) -> list[int]:
-        """The worker processes' ids (for the memory and reliability checks)."""
-        pool = self._pool
-        return sorted(pool._processes) if pool is not None and pool._processes else []
+        """The ids of the worker processes that run now (for the memory and reliability
+        checks)."""
+        with self._started.get_lock():
+            recorded = [pid for pid in self._started if pid]
+        return sorted(pid for pid in recorded if _alive(pid))
 
     def _take_slot(self) -> int:
         with self._slot_free:
@@ -202,12 +213,25 @@ class LocalWorkers:
             pool, self._pool = self._pool, None
         if pool is None:
             return
-        for process in list((pool._processes or {}).values()):
+        for pid in self.pids():
             try:
-                process.kill()
-            except (OSError, AttributeError):
+                os.kill(pid, signal.SIGKILL)
+            except OSError:  # ended meanwhile
                 pass
         pool.shutdown(wait=False, cancel_futures=True)
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (a zombie, ended but not yet reaped, does not)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        try:
+            os.kill(pid, 0)  # no /proc (another OS): whether the process exists
+        except OSError:
+            return False
+        return True
+    return state != "Z"
 
 
 class ClusterWorkers:

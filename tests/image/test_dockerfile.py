@@ -129,14 +129,16 @@ def test_serve_origins_from_the_environment(monkeypatch, tmp_path):
     pn = pytest.importorskip("panel")
     import app.server.serve
     from app.server.serve import serve
+    from app.services import background, study_queue
     from app.services import settings as server_settings
-    from app.services import study_queue
 
     monkeypatch.setattr(app.server.serve, "limit_blas_threads", lambda: None)
+    # no worker processes here, and the process's background workers as they were
+    monkeypatch.setattr(background, "_workers", background._workers)
     # the process's settings and study queue as they were (serve() installs its own)
     monkeypatch.setattr(server_settings, "_current", server_settings._current)
     monkeypatch.setattr(study_queue, "_QUEUE", study_queue._QUEUE)
-    settings = server_settings.ServerSettings(studies_dir=tmp_path / "studies")
+    settings = server_settings.ServerSettings(studies_dir=tmp_path / "studies", background_workers=0)
 
     calls, handlers, stops = [], {}, []
     monkeypatch.setattr(pn, "serve", lambda *args, **kwargs: calls.append(kwargs))
