@@ -7,6 +7,10 @@ the numbers of docs/memory.md.
 Sizes are what :func:`app.results.cache.deep_size` counts (array data and the objects around
 them); the model's entry holds the decompositions of its last operating points
 (:data:`model.analysis.linear_system.CACHED_POINTS`), which this run fills.
+
+The background worker processes (app.services.background, as ``bogie serve`` starts them) are
+measured apart: their resident memory (the kernel's VmRSS) at start and after the verdicts of the
+same points and one anti-slip reaction search.
 """
 
 from __future__ import annotations
@@ -67,10 +71,53 @@ def measure() -> dict:
             "points": [f"{s0:g} at {v:g} km/h" for s0, v in POINTS]}
 
 
+def _resident_mb(pid: int) -> float:
+    """A process's resident memory (VmRSS) [MB]."""
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) * 1024 / MB
+    raise RuntimeError(f"no VmRSS for process {pid}")
+
+
+def measure_workers() -> dict:
+    """The background worker processes' resident memory [MB] at start and after the verdicts of
+    :data:`POINTS` and one reaction search, computed in them (each worker's own results cache of
+    :data:`app.services.background.WORKER_CACHE_MB` MB)."""
+    from functools import partial
+
+    from app.dashboard.nonlinear_view import reaction
+    from app.results import cache, compute
+    from app.results.case import Case
+    from app.results.verdicts import assessment_result
+    from app.services import background
+    from model.analysis.nonlinear import AntiSlip
+
+    workers = background.LocalWorkers(setup=partial(cache.configure, background.WORKER_CACHE_MB))
+    workers.start()
+    previous = background.configure(workers)
+    try:
+        at_start = [_resident_mb(pid) for pid in workers.pids()]
+        parameters = compute.parameters("", "calibrated")
+        case = Case.from_outer("", {}, parameters)
+        for s0, v in POINTS:
+            assessment_result(case.replace(s0=s0, v=v), runner=background.run)
+        protection = AntiSlip()
+        reaction(case.replace(s0=0.014), protection.threshold, protection.rate,
+                 runner=background.run)
+        after = [_resident_mb(pid) for pid in workers.pids()]
+    finally:
+        background.configure(previous)
+        workers.close()
+    return {"background_workers": workers.workers,
+            "worker_cache_mb": background.WORKER_CACHE_MB,
+            "worker_start_mb": round(max(at_start), 1),
+            "worker_after_mb": round(max(after), 1)}
+
+
 def main() -> None:
     from docs_numbers import write_results
 
-    data = measure()
+    data = measure() | measure_workers()
     print(json.dumps(data, indent=1))
     print(f"wrote {write_results('memory', data, 'scripts/memory_model.py')}")
 
