@@ -7,7 +7,7 @@
     bogie ripple --v 5:200:200 --s0 0.005 --ripple el:6=250,el:12=120 [--outputs A,B] [--json]
 
 Speeds in km/h, frequencies in Hz, amplitudes of H in output unit per N m of motor torque (per N
-of a creep disturbance).  Bad input: one line on stderr, exit status 2.
+of a creep disturbance, per m of a rail–wheel surface deviation).  Bad input: one line on stderr, exit status 2.
 """
 
 from __future__ import annotations
@@ -61,11 +61,13 @@ def register(subparsers) -> None:
     p.set_defaults(func=cmd_campbell)
 
     p = subparsers.add_parser("frf", help="frequency response from a motor torque (or a creep "
-                              "disturbance) to every output: magnitude, phase, peaks")
+                              "disturbance, or a wheel's surface deviation) to every output: "
+                              "magnitude, phase, peaks")
     add_operating_point(p)
     p.add_argument("--input", default=DEFAULT_INPUT, metavar="NAME",
                    help="ID1.motor.torque (the short-circuit torque's generalized force), "
-                        "ID2.motor.torque or IDk.rimN.creep_disturbance [N] (default %(default)s)")
+                        "ID2.motor.torque, IDk.rimN.creep_disturbance [N] or IDk.rimN.irregularity "
+                        "(the rail–wheel surface deviation [m]) (default %(default)s)")
     p.add_argument("--f", default=BAND, metavar="A:B:N",
                    help="N log-spaced frequencies from A to B Hz, refined across every "
                         "resonance; the static gain (0 Hz) comes first (default %(default)s)")

@@ -19,8 +19,14 @@ from functools import cached_property
 
 import numpy as np
 
-from model.analysis.linear_system import LinearSystem, SystemCache, inertial_inverse_mass
+from model.analysis.linear_system import (
+    LinearSystem,
+    SystemCache,
+    inertial_inverse_mass,
+    massless_coordinates,
+)
 from model.mechanics.assembly import BogieModel
+from model.mechanics.irregularity import irregularity_forces
 from model.mechanics.operating_point import OperatingPoint, damping_matrix
 
 # a real eigenvalue this close to zero (relative to the largest |λ|, ~3e5 1/s) is zero to
@@ -164,9 +170,30 @@ def bogie_system(model: BogieModel, op: OperatingPoint, cached: bool = True) -> 
     return cache.get(op, build)
 
 
+def running_system(model: BogieModel, op: OperatingPoint, cached: bool = True) -> LinearSystem:
+    """The running system at ``op``: the bogie of :func:`bogie_system` with the wheel-force
+    coupling (the creep force's share μ(s0) ΔN_j of the rims' vertical motion, non-symmetric;
+    :mod:`model.mechanics.irregularity`), the system the rail–wheel irregularities drive.  The
+    coupling has no rim-``z`` component along any rigid-body mode or the rolling velocity, so they
+    stay exact eigenpairs.  ``cached``: kept beside :func:`bogie_system`'s systems."""
+    def build() -> LinearSystem:
+        forces = irregularity_forces(model, op)
+        M = model.M + forces.M_c
+        inertial = np.setdiff1d(np.arange(model.n), massless_coordinates(M))
+        inverse = np.linalg.inv(M[np.ix_(inertial, inertial)])  # M + M_c is not symmetric
+        return LinearSystem(M, damping_matrix(model, op) + forces.B_c, model.K + forces.K_c,
+                            model.short_circuit_force, model.rigid_body_modes, inverse,
+                            model.rolling_mode[:, None])
+    if not cached:
+        return build()
+    cache = model.__dict__.setdefault("_running_systems", SystemCache())
+    return cache.get(op, build)
+
+
 def forget_systems(model: BogieModel) -> None:
     """Drop the cached per-operating-point systems of ``model`` (cold timings in benchmarks)."""
     model.__dict__.pop("_systems", None)
+    model.__dict__.pop("_running_systems", None)
 
 
 def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) -> EigenResult:

@@ -16,6 +16,13 @@ For an independent nonlinear integrator (the quantities :mod:`model.analysis.non
 ``f_m2`` (generalized force of a unit driving torque of ID2's motor), and the creep law at the
 operating speed ``creep_s`` [-], ``creep_mu`` [-] (4001 points, s from −0.1 to 0.1).  Identity:
 ``B == B_without_longitudinal_creep − G · diag(N0 μ'(s0)/v) · H``.
+
+The rail–wheel surface deviations Δ (one per wheel, ``irregularity_inputs``: ``IDk.rimNN.irregularity``
+[m]; :mod:`model.mechanics.irregularity`): the generalized force is ``G_irr_q Δ + G_irr_v Δ̇ +
+G_irr_a Δ̈`` (n x 4 each: the track's k_R, b_R, m_R on the rim's z and, times μ(s0, v), on the
+contact's longitudinal pattern), on the running system ``(M + M_irr_coupling) q̈ + (B +
+B_irr_coupling) q̇ + (K + K_irr_coupling) q`` (n x n each: the creep force's share μ(s0) ΔN of the
+rims' own vertical motion, the wheel-force coupling; zero but in the rims' z columns).
 """
 
 from __future__ import annotations
@@ -43,10 +50,12 @@ def export_system(model: BogieModel, op: OperatingPoint, path: str | Path) -> No
         damping_without_longitudinal_creep,
         motor2_force,
     )
+    from model.mechanics.irregularity import irregularity_forces
     from model.mechanics.operating_point import creep_law
 
     outputs = output_matrices(model, op)
     creep_s = np.linspace(-0.1, 0.1, 4001)
+    irregularity = irregularity_forces(model, op)
     np.savez(
         path,
         M=model.M, B=damping_matrix(model, op), K=model.K,
@@ -64,4 +73,8 @@ def export_system(model: BogieModel, op: OperatingPoint, path: str | Path) -> No
         creep_velocity_map=creep_velocity_map(model), creep_force_map=creep_force_map(model),
         contacts=np.array(contact_names(model), dtype=str), f_m2=motor2_force(model),
         creep_s=creep_s, creep_mu=np.asarray(creep_law(model.parameters, op.N0).mu(creep_s, op.v)),
+        G_irr_q=irregularity.G_q, G_irr_v=irregularity.G_v, G_irr_a=irregularity.G_a,
+        irregularity_inputs=np.array(irregularity.names, dtype=str),
+        M_irr_coupling=irregularity.M_c, B_irr_coupling=irregularity.B_c,
+        K_irr_coupling=irregularity.K_c,
     )

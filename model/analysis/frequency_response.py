@@ -1,5 +1,6 @@
 """Frequency response H(f) of the linearized bogie: from a motor's air-gap torque (or a creep-force
-disturbance at a wheel) to every named output, exact from the state space.
+disturbance at a wheel, or a rail–wheel surface deviation) to every named output, exact from the
+state space.
 
 The bogie at an operating point is ``M Δq̈ + B_total Δq̇ + K Δq = F u(t)``, outputs ``y = C_q Δq +
 C_v Δq̇`` (:mod:`model.mechanics.outputs`).  For ``u = Re(û e^(iωt))`` the steady state is ``y =
@@ -22,6 +23,14 @@ as the eigen-analysis it reuses (BENCHMARKS.md).  Rounding: ``ε · cond(Y) · �
 every value; a frequency whose estimate exceeds :data:`MODAL_TOLERANCE` of the largest |H| is
 solved directly instead.
 
+Irregularity inputs ``IDk.rimNN.irregularity`` [m] (:mod:`model.mechanics.irregularity`) drive
+the running system (:func:`model.analysis.eigen.running_system`: the bogie with the wheel-force
+coupling) through ``G_q Δ + G_v Δ̇ + G_a Δ̈``.  With the modal forms ``H_q``, ``H_v``, ``H_a`` of
+the three force patterns, ``H(s) = H_q + s H_v + s² H_a``; since ``s/(s − λ) = 1 + λ/(s − λ)`` and
+``s²/(s − λ) = s + λ + λ²/(s − λ)`` it is again a sum over the modes, residues ``R_q + λ R_v +
+λ² R_a``, plus the feed-through ``D0 + D1 s`` with the Markov parameters ``D1 = C b_a`` and
+``D0 = C b_v + C A b_a`` (the velocity a Δ̈ gives at once, the force a Δ̇ does).
+
 Direct form (the reference, and for a few frequencies).  ``(−ω² M + iω B_total + K) Q̂ = F`` and
 ``Ĥ = (C_q + iω C_v) Q̂``: one complex solve of the n x n dynamic stiffness per frequency.
 
@@ -39,9 +48,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from model.analysis.eigen import bogie_system, non_neutral
+from model.analysis.eigen import bogie_system, non_neutral, running_system
 from model.analysis.linear_system import LinearSystem
 from model.mechanics.assembly import DRIVES, RIM_NODES, BogieModel
+from model.mechanics.irregularity import UNIT as IRREGULARITY_UNIT
+from model.mechanics.irregularity import irregularity_forces, irregularity_inputs, is_irregularity
 from model.mechanics.operating_point import OperatingPoint, damping_matrix, longitudinal_creep_pattern
 from model.mechanics.outputs import OutputMatrices, output_matrices
 
@@ -70,11 +81,19 @@ class FrequencyResponseError(ValueError):
 # --- inputs ------------------------------------------------------------------------------------
 
 def input_names(model: BogieModel) -> tuple[str, ...]:
-    """The inputs H can be computed from: each motor's air-gap torque ``IDk.motor.torque`` [N m]
-    and a longitudinal creep-force disturbance at each wheel ``IDk.rimN.creep_disturbance`` [N]."""
+    """The inputs H can be computed from: each motor's air-gap torque ``IDk.motor.torque`` [N m],
+    a longitudinal creep-force disturbance at each wheel ``IDk.rimN.creep_disturbance`` [N] and
+    each wheel's rail–wheel surface deviation ``IDk.rimN.irregularity`` [m]."""
     motors = tuple(f"{drive}.motor.torque" for drive in DRIVES)
     wheels = tuple(f"{drive}.rim{k}.creep_disturbance" for drive in DRIVES for k in RIM_NODES)
-    return motors + wheels
+    return motors + wheels + irregularity_inputs(model)
+
+
+def input_unit(model: BogieModel, name: str) -> str:
+    """The unit of an input (:func:`input_names`): "N m", "N" or "m"."""
+    if is_irregularity(name) and name in irregularity_inputs(model):
+        return IRREGULARITY_UNIT
+    return input_force(model, name)[1]
 
 
 def input_force(model: BogieModel, name: str) -> tuple[np.ndarray, str]:
@@ -84,7 +103,11 @@ def input_force(model: BogieModel, name: str) -> tuple[np.ndarray, str]:
     driving sense — for ID1 the generalized force of the short-circuit torque M_C
     (``model.short_circuit_force``), for ID2 the same pattern as its steady torque in
     :func:`model.mechanics.outputs.static_load`.  ``IDk.rimN.creep_disturbance``: a longitudinal
-    force [N] at the wheel's contact point, ``e_x − r0 e_ry`` on the rim (as a creep force)."""
+    force [N] at the wheel's contact point, ``e_x − r0 e_ry`` on the rim (as a creep force).
+    An irregularity's force depends on the frequency (:meth:`IrregularityForces.force`)."""
+    if is_irregularity(name) and name in irregularity_inputs(model):
+        raise FrequencyResponseError(f"'{name}' is a displacement input: its generalized force "
+                                     "depends on the frequency")
     if name == "ID1.motor.torque":
         return model.short_circuit_force.astype(float), "N m"
     if name == "ID2.motor.torque":
@@ -110,6 +133,16 @@ class ModalTransfer:
     drift: np.ndarray  # (p,) rigid-body drift coefficient g (0 for element loads)
     magnitudes: np.ndarray  # (p, m) |(C₂TY)_j| |(Y⁻¹T⁻¹b₂)_j| etc.: the terms' sizes before cancellation
     condition: float  # cond(Y) of the eigenvector matrix (1-norm estimate)
+    # (p, 2) complex: H gains D0 + D1 s (an irregularity's Δ̇ and Δ̈ parts); None: no feed-through
+    feedthrough: np.ndarray | None = None
+    static: np.ndarray | None = None  # (p,) H(0) if known apart from the residues (feed-through)
+
+    def direct_part(self, s: np.ndarray) -> np.ndarray:
+        """D0 + D1 s (p x F complex; zeros without feed-through) at Laplace points ``s``."""
+        s = np.atleast_1d(s)
+        if self.feedthrough is None:
+            return np.zeros((self.residues.shape[0], len(s)), dtype=complex)
+        return self.feedthrough[:, :1] + self.feedthrough[:, 1:] * s[None, :]
 
     def __call__(self, f_hz: np.ndarray) -> np.ndarray:
         """H at frequencies ``f_hz`` [Hz] (p x F complex; f = 0 gives the static gain)."""
@@ -120,6 +153,7 @@ class ModalTransfer:
         if np.any(nonzero):
             out[:, nonzero] = self.residues @ (1.0 / (s[None, nonzero] - self.eigenvalues[:, None]))
             out[:, nonzero] += self.drift[:, None] / s[None, nonzero]
+            out[:, nonzero] += self.direct_part(s[nonzero])
         if np.any(~nonzero):
             out[:, ~nonzero] = self.static_gain()[:, None]
         return out
@@ -128,6 +162,8 @@ class ModalTransfer:
         """H(0) (p complex): −Σ R_j/λ_j over the eigenvalues that are not neutral (a neutral
         eigenvalue, zero to rounding, is a rigid-body velocity without damping: it has no static
         deflection); infinite for an output with a rigid-body drift."""
+        if self.static is not None:
+            return self.static
         keep = non_neutral(self.eigenvalues)
         gain = -(self.residues[:, keep] @ (1.0 / self.eigenvalues[keep]))
         return np.where(self.drift != 0, np.inf, gain)
@@ -191,11 +227,34 @@ def transfer(model: BogieModel, op: OperatingPoint, input: str = DEFAULT_INPUT,
              outputs: list[str] | None = None) -> tuple[ModalTransfer, OutputMatrices, np.ndarray]:
     """(the modal form of H from ``input`` to the chosen outputs, the output matrices, the chosen
     rows) at ``op``; the eigendecomposition is the cached one of :func:`bogie_system`."""
-    force, _ = input_force(model, input)
     matrices, rows = output_indices(model, op, outputs)
+    if is_irregularity(input) and input in irregularity_inputs(model):
+        return irregularity_transfer(model, op, input, matrices, rows), matrices, rows
+    force, _ = input_force(model, input)
     system = bogie_system(model, op)
     C = system.state_output(matrices.C_q[rows], matrices.C_v[rows])
     return modal_transfer(system, C, system.input_map(force)), matrices, rows
+
+
+def irregularity_transfer(model: BogieModel, op: OperatingPoint, input: str,
+                          matrices: OutputMatrices, rows: np.ndarray) -> ModalTransfer:
+    """The modal form of H from the surface deviation ``input`` [m] to the output rows on the
+    running system: ``H_q + s H_v + s² H_a`` as residues and feed-through (module docstring)."""
+    system = running_system(model, op)
+    forces = irregularity_forces(model, op)
+    j = forces.column(input)
+    C = system.state_output(matrices.C_q[rows], matrices.C_v[rows])
+    inputs = [system.input_map(G[:, j]) for G in (forces.G_q, forces.G_v, forces.G_a)]
+    q, v, a = (modal_transfer(system, C, b) for b in inputs)
+    lam = q.eigenvalues
+    residues = q.residues + lam[None, :] * v.residues + (lam * lam)[None, :] * a.residues
+    magnitudes = (q.magnitudes + np.abs(lam)[None, :] * v.magnitudes
+                  + (np.abs(lam) ** 2)[None, :] * a.magnitudes)
+    D1 = C @ inputs[2]
+    D0 = C @ inputs[1] + C @ (system.A @ inputs[2])
+    feedthrough = np.column_stack([D0, D1]).astype(complex)
+    return ModalTransfer(lam, residues, q.drift, magnitudes, q.condition, feedthrough,
+                         q.static_gain())
 
 
 # --- direct solves (the reference; a few frequencies) -----------------------------------------
@@ -207,10 +266,28 @@ def direct_response(model: BogieModel, op: OperatingPoint, f_hz, input: str = DE
     f_hz = np.atleast_1d(np.asarray(f_hz, dtype=float))
     if np.any(f_hz <= 0) or not np.all(np.isfinite(f_hz)):
         raise FrequencyResponseError("direct solves need frequencies > 0 Hz")
-    force, _ = input_force(model, input)
     matrices, rows = output_indices(model, op, outputs)
+    if is_irregularity(input) and input in irregularity_inputs(model):
+        return solve_irregularity(model, op, input, matrices.C_q[rows], matrices.C_v[rows], f_hz)
+    force, _ = input_force(model, input)
     return solve_direct(model, damping_matrix(model, op), force, matrices.C_q[rows],
                    matrices.C_v[rows], f_hz)
+
+
+def solve_irregularity(model: BogieModel, op: OperatingPoint, input: str, C_q: np.ndarray,
+                       C_v: np.ndarray, f_hz: np.ndarray) -> np.ndarray:
+    """H from the surface deviation ``input`` [m] by the running system's dynamic stiffness,
+    ``(−ω²(M + M_c) + iω(B_total + B_c) + K + K_c) Q̂ = G_q + iω G_v − ω² G_a``, at each
+    frequency of ``f_hz`` [Hz] (p x F complex)."""
+    forces = irregularity_forces(model, op)
+    M, B = model.M + forces.M_c, damping_matrix(model, op) + forces.B_c
+    K = model.K + forces.K_c
+    out = np.empty((C_q.shape[0], len(f_hz)), dtype=complex)
+    for k, f in enumerate(f_hz):
+        w = 2 * np.pi * f
+        q = np.linalg.solve(-w * w * M + 1j * w * B + K, forces.force(input, 1j * w))
+        out[:, k] = (C_q + 1j * w * C_v) @ q
+    return out
 
 
 def solve_direct(model: BogieModel, damping: np.ndarray, force: np.ndarray, C_q: np.ndarray,
@@ -241,7 +318,7 @@ class FrequencyResponse:
     """H(f) from one input to the named outputs at an operating point."""
 
     input: str  # input name (:func:`input_names`)
-    input_unit: str  # "N m" (motor torque) or "N" (creep disturbance)
+    input_unit: str  # "N m" (motor torque), "N" (creep disturbance) or "m" (irregularity)
     operating_point: OperatingPoint
     f_hz: np.ndarray  # (F,) [Hz], ascending, f_hz[0] = 0: the static gain
     names: tuple[str, ...]  # output names
@@ -325,7 +402,10 @@ def frequency_response(model: BogieModel, op: OperatingPoint, input: str = DEFAU
     estimate = model_transfer.rounding_estimate(grid)
     largest = np.abs(H_grid).max(axis=1, keepdims=True)
     suspect = np.flatnonzero(np.any(estimate > MODAL_TOLERANCE * largest, axis=0))
-    if len(suspect):
+    if len(suspect) and is_irregularity(input):
+        H_grid[:, suspect] = solve_irregularity(model, op, input, matrices.C_q[rows],
+                                                matrices.C_v[rows], grid[suspect])
+    elif len(suspect):
         force, _ = input_force(model, input)
         H_grid[:, suspect] = solve_direct(model, damping_matrix(model, op), force,
                                      matrices.C_q[rows], matrices.C_v[rows], grid[suspect])
@@ -333,7 +413,7 @@ def frequency_response(model: BogieModel, op: OperatingPoint, input: str = DEFAU
     f_all = np.concatenate([[0.0], grid])
     H = np.concatenate([gain[:, None], H_grid], axis=1)
     peaks = _peaks(model_transfer, grid, H_grid, gain, min_peak)
-    _, unit = input_force(model, input)
+    unit = input_unit(model, input)
     lam = model_transfer.eigenvalues
     stable = bool(np.all(lam[non_neutral(lam)].real <= 0))
     return FrequencyResponse(input, unit, op, f_all, tuple(matrices.names[i] for i in rows),
@@ -408,11 +488,13 @@ def _peak_maximum(model_transfer: ModalTransfer, rows: np.ndarray, low: np.ndarr
     residues = model_transfer.residues[rows]
     drift = model_transfer.drift[rows]
     lam = model_transfer.eigenvalues
+    direct = (np.zeros((len(rows), 2), dtype=complex) if model_transfer.feedthrough is None
+              else model_transfer.feedthrough[rows])
 
     def evaluate(f: np.ndarray) -> np.ndarray:
         s = 2j * np.pi * f
         return np.abs(np.einsum("pj,pj->p", residues, 1.0 / (s[:, None] - lam[None, :]))
-                      + drift / s)
+                      + drift / s + direct[:, 0] + direct[:, 1] * s)
 
     f_best, h_best = golden_section_maximum(evaluate, low, high, 1e-12, GOLDEN_ITERATIONS)
     better = h_best >= start_h
