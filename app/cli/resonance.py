@@ -5,6 +5,7 @@
     bogie frf --s0 0.005 --v 120 [--input ID1.motor.torque] [--f 0.1:1000:2000]
               [--outputs A,B] [--min-peak 0.01] [--csv FILE] [--json]
     bogie ripple --v 5:200:200 --s0 0.005 --ripple el:6=250,el:12=120 [--outputs A,B] [--json]
+    bogie ripple --v 5:200:200 --s0 0.005 --wheel-polygon 20=30 [--outputs A,B] [--json]
 
 Speeds in km/h, frequencies in Hz, amplitudes of H in output unit per N m of motor torque (per N
 of a creep disturbance, per m of a rail–wheel surface deviation).  Bad input: one line on stderr, exit status 2.
@@ -81,11 +82,14 @@ def register(subparsers) -> None:
     p.set_defaults(func=cmd_frf)
 
     p = subparsers.add_parser("ripple", help="steady amplitude of every output over speed under "
-                              "a motor torque ripple")
+                              "a motor torque ripple or polygonal wheels")
     _add_sweep_point(p)
-    p.add_argument("--ripple", required=True, metavar="LIST",
+    p.add_argument("--ripple", default=None, metavar="LIST",
                    help="order=amplitude [N m], e.g. el:6=250,el:12=120 (orders as --orders of "
                         "bogie campbell)")
+    p.add_argument("--wheel-polygon", default=None, metavar="LIST",
+                   help="instead of --ripple: polygonal wheels, order=radial amplitude [µm], e.g. "
+                        "20=30 (every wheel; the rear wheelset a wheelbase later)")
     p.add_argument("--input", default=DEFAULT_INPUT, metavar="NAME",
                    help="the rippling motor: ID1.motor.torque or ID2.motor.torque "
                         "(default %(default)s)")
@@ -282,6 +286,61 @@ def _frf_table(result) -> str:
 
 
 def cmd_ripple(args: argparse.Namespace) -> None:
+    if (args.ripple is None) == (args.wheel_polygon is None):
+        raise UsageError("give either --ripple (a motor torque ripple) or --wheel-polygon "
+                         "(polygonal wheels)")
+    if args.wheel_polygon is not None:
+        _polygon(args)
+        return
+    _ripple(args)
+
+
+def _polygon(args: argparse.Namespace) -> None:
+    from model.analysis.wheel_excitation import parse_polygon, polygon_response
+    from model.mechanics.operating_point import KMH
+
+    polygon = parse_polygon(args.wheel_polygon)
+    model, op, speeds = _sweep_model(args)
+    result = polygon_response(model, op, speeds, polygon, outputs=output_names(args))
+
+    def listed(values: np.ndarray) -> list[float | None]:
+        return [float(x) if np.isfinite(x) else None for x in values]
+
+    outputs = []
+    for i, (name, unit) in enumerate(zip(result.names, result.units, strict=True)):
+        finite = np.isfinite(result.total[i])
+        peak, at = result.peak(name) if finite.any() else (None, None)
+        outputs.append({"name": name, "unit": unit, "amplitude": listed(result.total[i]),
+                        "peak": peak, "peak_v_kmh": at / KMH if at is not None else None,
+                        "by_order": {str(n): listed(result.by_order[k, i])
+                                     for k, n in enumerate(result.orders)}})
+    data = {"operating_point": {"s0": op.s0, "N0": op.N0, "b_M": op.b_M},
+            "v_kmh": result.v_kmh.tolist(),
+            "wheel_polygon": [
+                {"order": n, "input_amplitude": float(a), "f_hz": listed(f),
+                 "wheels": [{"input": name, "phase_deg": float(phase)}
+                            for name, phase in zip(result.inputs, phases, strict=True)]}
+                for n, a, f, phases in zip(result.orders, result.amplitudes,
+                                           result.frequencies_hz, result.phases_deg, strict=True)],
+            "unstable_v_kmh": list(result.unstable_kmh),
+            "outputs": outputs}
+    given = ", ".join(f"order {n}: {a * 1e6:g} µm"
+                      for n, a in zip(result.orders, result.amplitudes, strict=True))
+    lines = [f"steady amplitude under polygonal wheels ({given}; every wheel, the rear wheelset "
+             f"a wheelbase later), {result.v_kmh[0]:g}…{result.v_kmh[-1]:g} km/h at s0 = "
+             f"{op.s0:g} (sum over the orders)",
+             *([] if not result.unstable_kmh else [
+                 "UNSTABLE running system at " + ", ".join(f"{v:g}" for v in result.unstable_kmh)
+                 + " km/h: a mode grows, the amplitudes are no steady state"]),
+             f"{'output':<34} {'unit':>5} {'peak':>11} {'at [km/h]':>10}"]
+    for row in outputs:
+        peak = "—" if row["peak"] is None else f"{row['peak']:.4g}"
+        at = "—" if row["peak_v_kmh"] is None else f"{row['peak_v_kmh']:.4g}"
+        lines.append(f"{row['name']:<34} {row['unit']:>5} {peak:>11} {at:>10}")
+    emit(args, data, "\n".join(lines))
+
+
+def _ripple(args: argparse.Namespace) -> None:
     from model.analysis.campbell import ripple_response
     from model.mechanics.excitation import parse_amplitudes
     from model.mechanics.operating_point import KMH

@@ -134,6 +134,31 @@ def test_ripple_json(capsys):
     assert output["peak"] == pytest.approx(total.max())
 
 
+def test_wheel_polygon_json(capsys):
+    """``bogie ripple --wheel-polygon``: the orders with their amplitudes [m], frequencies and the
+    four wheels' phases (the rear wheelset −n · wheelbase / r0); the total is the orders' sum."""
+    code, out, err = run(["ripple", "--v", "60:120:7", "--s0", "0.002", "--wheel-polygon",
+                          "7=40,20=25", "--outputs", "ID1.driving_shaft.torque", "--json"], capsys)
+    assert code == 0, err
+    data = json.loads(out)
+    assert set(data) == {"operating_point", "v_kmh", "wheel_polygon", "unstable_v_kmh", "outputs"}
+    assert [p["order"] for p in data["wheel_polygon"]] == [7, 20]
+    assert data["wheel_polygon"][0]["input_amplitude"] == pytest.approx(40e-6)
+    wheels = data["wheel_polygon"][1]["wheels"]
+    assert [w["input"] for w in wheels] == ["ID1.rim12.irregularity", "ID1.rim14.irregularity",
+                                            "ID2.rim12.irregularity", "ID2.rim14.irregularity"]
+    from model import load_parameters
+
+    parameters = load_parameters()
+    assert wheels[2]["phase_deg"] == pytest.approx(
+        np.degrees(-20 * parameters["wheelbase"] / parameters["wheel_radius"]))
+    (output,) = data["outputs"]
+    total = np.array(output["amplitude"])
+    parts = np.array([output["by_order"][k] for k in ("7", "20")])
+    np.testing.assert_allclose(total, parts.sum(axis=0), rtol=1e-12)
+    assert output["peak"] == pytest.approx(total.max())
+
+
 @pytest.mark.parametrize("argv", [
     ["campbell", "--v", "200:100:10"],  # an empty range
     ["campbell", "--v", "0:200:10"],  # below the model's speeds
@@ -163,7 +188,12 @@ def test_ripple_json(capsys):
     ["ripple", "--ripple", "el:6"],
     ["ripple", "--ripple", "el:-6=100"],
     ["ripple", "--ripple", "el:6=-1"],
-    ["ripple"],  # --ripple is required
+    ["ripple"],  # --ripple or --wheel-polygon is required
+    ["ripple", "--ripple", "el:6=250", "--wheel-polygon", "20=30"],  # one of the two
+    ["ripple", "--wheel-polygon", "20"],
+    ["ripple", "--wheel-polygon", "20.5=30"],
+    ["ripple", "--wheel-polygon", "20=-3"],
+    ["ripple", "--wheel-polygon", "500=3"],
 ])
 def test_bad_input_is_one_line_with_exit_status_2(argv, capsys):
     code, out, err = run(argv, capsys)
