@@ -3,7 +3,7 @@
 :mod:`.main` builds the parser from the groups' ``register`` functions and runs a command.
 Groups: :mod:`.analysis` (eigen, limit, modes, locus, export), :mod:`.calibrate`, :mod:`.serve`,
 :mod:`.response`, :mod:`.antislip`, :mod:`.sensitivity` (sensitivity, uncertainty),
-:mod:`.study`, :mod:`.compare`, :mod:`.report`, :mod:`.resonance` (campbell, frf, ripple).
+:mod:`.study`, :mod:`.compare`, :mod:`.report`, :mod:`.resonance` (campbell, frf, ripple, track).
 What several groups need lives below them:
 :mod:`.options` (the parser, numbers with bounds, the operating point, ranges, the time grid, the
 short circuit, the creep, anti-slip and uncertainty options) and :mod:`.output` (JSON or a table,

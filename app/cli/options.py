@@ -48,6 +48,7 @@ def input_errors() -> tuple[type[BaseException], ...]:
     from model.analysis.response import ResponseError
     from model.analysis.sensitivity import SensitivityError
     from model.analysis.stability import NoStabilityLimit
+    from model.analysis.track_spectrum import TrackSpectrumError
     from model.analysis.wheel_excitation import WheelExcitationError
     from model.mechanics.excitation import ExcitationError
     from model.mechanics.operating_point import OperatingPointError
@@ -60,7 +61,7 @@ def input_errors() -> tuple[type[BaseException], ...]:
     # ResponseError covers the nonlinear solver's, the design loads' and the assessment's
     return (UsageError, ParameterError, OperatingPointError, NoStabilityLimit, ResponseError,
             ExcitationError, FrequencyResponseError, CampbellError, SensitivityError,
-            WheelExcitationError,
+            WheelExcitationError, TrackSpectrumError,
             SpectrumError, UncertaintyError, PosteriorError, StoreMismatch, VariantError,
             SettingsError, VerdictUncertaintyError, FatigueError)
 

@@ -1,4 +1,5 @@
-"""``bogie campbell``, ``frf`` and ``ripple``: where the drive resonates (docs/resonance.md).
+"""``bogie campbell``, ``frf``, ``ripple`` and ``track``: where the drive resonates, what the track
+and the wheels do to it (docs/resonance.md).
 
     bogie campbell --v 5:200:200 --s0 0.005 [--orders wheel:1,rotor:1,mesh:1,el:1,el:2,el:6,el:12]
                    [--freq 450,900] [--input ID1.motor.torque] [--participation 0.01] [--json]
@@ -6,6 +7,7 @@
               [--outputs A,B] [--min-peak 0.01] [--csv FILE] [--json]
     bogie ripple --v 5:200:200 --s0 0.005 --ripple el:6=250,el:12=120 [--outputs A,B] [--json]
     bogie ripple --v 5:200:200 --s0 0.005 --wheel-polygon 20=30 [--outputs A,B] [--json]
+    bogie track --s0 0.002 --v 120 [--spectrum low] [--outputs A,B] [--json]
 
 Speeds in km/h, frequencies in Hz, amplitudes of H in output unit per N m of motor torque (per N
 of a creep disturbance, per m of a rail–wheel surface deviation).  Bad input: one line on stderr, exit status 2.
@@ -36,7 +38,7 @@ BAND = "0.1:1000:2000"  # [Hz]
 
 
 def register(subparsers) -> None:
-    """campbell, frf, ripple."""
+    """campbell, frf, ripple, track."""
     from model.analysis.campbell import DEFAULT_PARTICIPATION
     from model.analysis.frequency_response import DEFAULT_INPUT, DEFAULT_MIN_PEAK
     from model.mechanics.excitation import DEFAULT_ORDERS
@@ -97,6 +99,16 @@ def register(subparsers) -> None:
                    help="comma-separated output names (default: all)")
     _add_excitation(p)
     p.set_defaults(func=cmd_ripple)
+
+    p = subparsers.add_parser("track", help="PSD and RMS of every output under the random "
+                              "vertical track irregularity at one speed")
+    add_operating_point(p)
+    p.add_argument("--spectrum", default="low", metavar="NAME",
+                   help="the track spectrum: low (the German high-speed / ERRI B176 low level) "
+                        "(default %(default)s)")
+    p.add_argument("--outputs", default=None, metavar="LIST",
+                   help="comma-separated output names (default: all)")
+    p.set_defaults(func=cmd_track)
 
 
 def _add_sweep_point(p: argparse.ArgumentParser) -> None:
@@ -379,4 +391,36 @@ def _ripple(args: argparse.Namespace) -> None:
         peak = "—" if row["peak"] is None else f"{row['peak']:.4g}"
         at = "—" if row["peak_v_kmh"] is None else f"{row['peak_v_kmh']:.4g}"
         lines.append(f"{row['name']:<34} {row['unit']:>5} {peak:>11} {at:>10}")
+    emit(args, data, "\n".join(lines))
+
+
+def cmd_track(args: argparse.Namespace) -> None:
+    from model.analysis.track_spectrum import random_response, track_spectrum
+
+    spectrum = track_spectrum(args.spectrum)
+    model, op, _ = load_model(args)
+    result = random_response(model, op, spectrum, outputs=output_names(args))
+    f_lo, f_hi = spectrum.band_hz(op.v)
+    data = {"operating_point": op.as_dict(),
+            "spectrum": {"name": spectrum.name, "A_v": spectrum.A_v, "omega_c": spectrum.omega_c,
+                         "omega_r": spectrum.omega_r, "wavelength_min": spectrum.wavelength_min,
+                         "wavelength_max": spectrum.wavelength_max, "source": spectrum.source,
+                         "rms_m": spectrum.variance() ** 0.5},
+            "stable": result.stable, "f_hz": result.f_hz.tolist(),
+            "input_psd": result.input_psd.tolist(),
+            "outputs": [{"name": name, "unit": unit, "rms": float(result.rms[i]),
+                         "moments": result.moments[i].tolist(), "psd": result.psd[i].tolist()}
+                        for i, (name, unit) in enumerate(zip(result.names, result.units,
+                                                             strict=True))]}
+    lines = [f"random vertical track ({spectrum.name}: A_v = {spectrum.A_v:g} m² rad/m, Ω_c = "
+             f"{spectrum.omega_c:g}, Ω_r = {spectrum.omega_r:g} rad/m, wavelengths "
+             f"{spectrum.wavelength_min:g}…{spectrum.wavelength_max:g} m, RMS "
+             f"{spectrum.variance() ** 0.5 * 1e3:.3g} mm) at s0 = {op.s0:g}, v = {op.v_kmh:g} "
+             f"km/h: {f_lo:.3g}…{f_hi:.3g} Hz; both rails alike, the rear wheelset a wheelbase "
+             "later",
+             *([] if result.stable else [
+                 "UNSTABLE running system: a mode grows, the RMS is no stationary response"]),
+             f"{'output':<34} {'unit':>5} {'RMS':>11}"]
+    for i, (name, unit) in enumerate(zip(result.names, result.units, strict=True)):
+        lines.append(f"{name:<34} {unit:>5} {result.rms[i]:>11.4g}")
     emit(args, data, "\n".join(lines))

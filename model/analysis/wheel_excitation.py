@@ -58,30 +58,46 @@ def wheel_phases(model: BogieModel, omega: float, v: float) -> np.ndarray:
     return -omega * (x.max() - x) / v
 
 
+class WheelTransfer:
+    """The running system's pieces at one operating point, for H_j(2π f) from each wheel's
+    deviation at many frequencies (the matrices are formed once)."""
+
+    def __init__(self, model: BogieModel, op: OperatingPoint, rows: np.ndarray | None = None):
+        forces = irregularity_forces(model, op)
+        matrices, all_rows = output_indices(model, op)
+        rows = all_rows if rows is None else rows
+        self.model, self.op = model, op
+        self.M, self.K = model.M + forces.M_c, model.K + forces.K_c
+        self.B = damping_matrix(model, op) + forces.B_c
+        self.G = (forces.G_q, forces.G_v, forces.G_a)
+        self.C_q, self.C_v = matrices.C_q[rows], matrices.C_v[rows]
+
+    def wheels(self, f_hz: float) -> np.ndarray:
+        """H_j(2π f) (p x 4 complex) [output unit per m]: the dynamic stiffness solved once with
+        the four wheels' generalized forces ``G_q + iω G_v − ω² G_a``."""
+        s = 2j * math.pi * f_hz
+        G_q, G_v, G_a = self.G
+        q = np.linalg.solve(s * s * self.M + s * self.B + self.K, G_q + s * G_v + s * s * G_a)
+        return (self.C_q + s * self.C_v) @ q
+
+    def combined(self, f_hz: float) -> tuple[np.ndarray, np.ndarray]:
+        """(Σ_j H_j(2π f) e^(i φ_j) (p complex), the phases φ_j [rad]) (:func:`wheel_phases`)."""
+        phases = wheel_phases(self.model, 2 * math.pi * f_hz, self.op.v)
+        return self.wheels(f_hz) @ np.exp(1j * phases), phases
+
+
 def wheel_responses(model: BogieModel, op: OperatingPoint, f_hz: float,
                     rows: np.ndarray | None = None) -> np.ndarray:
     """H_j(2π f) of the chosen output rows (default all) from each wheel's deviation [output unit
-    per m] (p x 4 complex): the running system's dynamic stiffness solved once with the four
-    wheels' generalized forces ``G_q + iω G_v − ω² G_a``."""
-    forces = irregularity_forces(model, op)
-    matrices, all_rows = output_indices(model, op)
-    rows = all_rows if rows is None else rows
-    w = 2 * math.pi * f_hz
-    s = 1j * w
-    dynamic = (s * s * (model.M + forces.M_c) + s * (damping_matrix(model, op) + forces.B_c)
-               + model.K + forces.K_c)
-    right = forces.G_q + s * forces.G_v + s * s * forces.G_a
-    q = np.linalg.solve(dynamic, right)
-    return (matrices.C_q[rows] + s * matrices.C_v[rows]) @ q
+    per m] (p x 4 complex): :meth:`WheelTransfer.wheels`."""
+    return WheelTransfer(model, op, rows).wheels(f_hz)
 
 
 def combined_response(model: BogieModel, op: OperatingPoint, f_hz: float,
                       rows: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(Σ_j H_j(2π f) e^(i φ_j) per metre of the front wheels' deviation (p complex), the phases
     φ_j [rad]) at ``op``'s speed (:func:`wheel_phases`)."""
-    w = 2 * math.pi * f_hz
-    phases = wheel_phases(model, w, op.v)
-    return wheel_responses(model, op, f_hz, rows) @ np.exp(1j * phases), phases
+    return WheelTransfer(model, op, rows).combined(f_hz)
 
 
 def polygon_frequency_hz(order: float, v, r0: float) -> np.ndarray:
@@ -164,11 +180,11 @@ def polygon_response(model: BogieModel, op: OperatingPoint, v_values,
     def solve(speeds: np.ndarray) -> np.ndarray:
         out = np.full((len(orders), len(rows), len(speeds)), np.nan)
         for i, speed in enumerate(speeds):
-            point = replace(op, v=float(speed))
+            system = WheelTransfer(model, replace(op, v=float(speed)), rows)
             for k, n in enumerate(orders):
                 f = float(polygon_frequency_hz(n, speed, r0))
                 if 0 < f <= MODEL_FREQUENCY_LIMIT_HZ:
-                    H, _ = combined_response(model, point, f, rows)
+                    H, _ = system.combined(f)
                     out[k, :, i] = amplitudes[k] * np.abs(H)
         return out
 

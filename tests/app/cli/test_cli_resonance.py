@@ -159,7 +159,25 @@ def test_wheel_polygon_json(capsys):
     assert output["peak"] == pytest.approx(total.max())
 
 
+def test_track_json(capsys):
+    """``bogie track``: the spectrum with its source and class parameters, the RMS from the
+    moments (√m0), a PSD per output on the frequency grid, the running system's stability."""
+    code, out, err = run(["track", "--s0", "0.002", "--v", "120", "--outputs",
+                          "ID1.disc_clutch.torque", "--json"], capsys)
+    assert code == 0, err
+    data = json.loads(out)
+    assert set(data) == {"operating_point", "spectrum", "stable", "f_hz", "input_psd", "outputs"}
+    assert data["spectrum"]["name"] == "low"
+    assert "ERRI" in data["spectrum"]["source"]
+    assert data["stable"] is True
+    (output,) = data["outputs"]
+    assert output["rms"] == pytest.approx(output["moments"][0] ** 0.5, rel=1e-12)
+    assert len(output["psd"]) == len(data["f_hz"]) == len(data["input_psd"])
+
+
 @pytest.mark.parametrize("argv", [
+    ["track", "--spectrum", "class9"],
+    ["track", "--outputs", "ID1.nothing"],
     ["campbell", "--v", "200:100:10"],  # an empty range
     ["campbell", "--v", "0:200:10"],  # below the model's speeds
     ["campbell", "--v", "5:200:1"],
