@@ -6,7 +6,9 @@ drives checked in the four load cases, with safety factors and the governing che
                  [--m0 M --f F --decay D] [--t-end T] [--fs FS]
                  [--unstable-s0 S --unstable-v V] [--anti-slip-delay T --anti-slip-threshold W
                  --anti-slip-rate R --anti-slip-floor F] [--starting-v V]
-                 [--ripple ORDER=AMPLITUDE,… --ripple-v LIST] [--params FILE]
+                 [--ripple ORDER=AMPLITUDE,… --ripple-v LIST]
+                 [--running [--running-s0 LIST --running-v LIST --wheel-polygon N=µm,…
+                 --random-multiple K]] [--params FILE]
                  [--samples N [--seed S] [--indices] [--ranges FILE] [--write-samples DIR]]
                  [--scheduler tcp://HOST:PORT | --workers N | --serial] [--json]
 
@@ -17,7 +19,11 @@ deceleration.  That grid runs on the study engine as
 the envelope does (a local Dask cluster by default, ``--scheduler`` a running one, ``--serial`` in
 this process); the other cases are single runs in this process.  The ripple case takes the set's
 ripple amplitudes or ``--ripple`` (as ``bogie ripple``), over ``--ripple-v`` (default 10:200:20
-km/h, refined at every resonance).  ``--samples N`` (a power of two) runs the assessment for N
+km/h, refined at every resonance).  ``--running`` adds the running case: mean traction, the
+ripple, polygonal wheels (``--wheel-polygon``, default 20=30: order 20, 30 µm, an assumed
+amplitude) and ``--random-multiple`` (default 3) times the RMS under the random track, over
+``--running-v`` (default 20:200:10 km/h) at ``--running-s0`` (default 0.002; the running system
+must be stable there).  ``--samples N`` (a power of two) runs the assessment for N
 scrambled Sobol' samples of the unknowns' prior ranges (model.studies.verdict_priors; ``--ranges``
 a TOML file of others) on the study engine, every sample a work item, and prints each check's
 5/50/95 % band and probability of falling below its required factor; ``--indices`` adds the
@@ -90,6 +96,19 @@ def register(subparsers) -> None:
     ripple.add_argument("--ripple-v", default="10:200:20", metavar="LIST",
                         help="speeds [km/h] before the refinement at the resonances "
                              "(default %(default)s)")
+    running = p.add_argument_group("running (mean traction, ripple, wheel polygon, random track)")
+    running.add_argument("--running", action="store_true",
+                         help="add the running load case (docs/assessment.md)")
+    running.add_argument("--running-s0", default="0.002", metavar="LIST",
+                         help="creepages of the running case (default %(default)s)")
+    running.add_argument("--running-v", default="20:200:10", metavar="LIST",
+                         help="speeds [km/h] of the running case (default %(default)s)")
+    running.add_argument("--wheel-polygon", default="20=30", metavar="N=µm,…",
+                         help="polygonal wheels: order = radial amplitude [µm] (default "
+                              "%(default)s: an assumed amplitude, docs/resonance.md)")
+    running.add_argument("--random-multiple", type=bounded("--random-multiple", "[0, 10]"),
+                         default=3.0, help="the random track's part as this multiple of its "
+                                           "RMS (default %(default)s)")
     samples = p.add_argument_group("the verdict under uncertainty")
     samples.add_argument("--samples", type=int, default=None, metavar="N",
                          help="N scrambled Sobol' samples (a power of two) of the unknowns' "
@@ -134,11 +153,22 @@ def options_from_args(args: argparse.Namespace):
                          f"{args.f:g} Hz: must be at least {MIN_SAMPLES_PER_PERIOD * args.f:g} Hz")
     ripple = None if args.ripple is None else parse_amplitudes(args.ripple)
     ripple_v = [x * KMH for x in quantity_values(args.ripple_v, "v", increasing=True)]
+    running = {}
+    if args.running:
+        from model.analysis.wheel_excitation import parse_polygon
+        from model.studies.assessment import LOAD_CASES
+
+        running = {"cases": (*LOAD_CASES, "running"),
+                   "running_s0": tuple(quantity_values(args.running_s0, "s0", increasing=True)),
+                   "running_v": tuple(x * KMH for x in quantity_values(args.running_v, "v",
+                                                                       increasing=True)),
+                   "wheel_polygon": parse_polygon(args.wheel_polygon),
+                   "random_multiple": args.random_multiple}
     options = AssessmentOptions(
         s0=tuple(s0), v=tuple(v), N0=args.n0, b_M=args.bm, excitation=short_circuit_from(args),
         t_end=args.t_end, fs=args.fs, unstable_s0=args.unstable_s0,
         unstable_v=args.unstable_v * KMH, anti_slip=anti_slip_from(args),
-        starting_v=args.starting_v * KMH, ripple=ripple, ripple_v=tuple(ripple_v))
+        starting_v=args.starting_v * KMH, ripple=ripple, ripple_v=tuple(ripple_v), **running)
     return parameters, options
 
 
@@ -156,7 +186,10 @@ def assessment_table(result) -> str:
     notes = list(dict.fromkeys(c.note for c in result.checks if c.note))  # numbered in order
     for c in result.checks:
         at = "steady" if math.isnan(c.time) else f"t = {c.time:.4g} s"
-        if not math.isnan(c.alternating):  # under the ripple: its worst speed, mean ± amplitude
+        if not math.isnan(c.rms):  # running: its worst speed, mean ± amplitude, the random RMS
+            at = (f"{c.v_kmh:.4g} km/h, mean {c.mean:.4g} ± {c.alternating:.4g} N m (polygon "
+                  f"{c.amplitude:.3g}, RMS {c.rms:.4g}; s0 = {c.scenario['s0']:g})")
+        elif not math.isnan(c.alternating):  # under the ripple: its worst speed, mean ± amplitude
             at = (f"{c.v_kmh:.4g} km/h, mean {c.mean:.4g} ± {c.alternating:.4g} N m "
                   f"({', '.join(o['order'] for o in c.orders)})")
         elif "v_kmh" in c.scenario:
@@ -186,13 +219,17 @@ def cmd_assess(args: argparse.Namespace) -> None:
     parameters, options = options_from_args(args)
     short_circuit_points(parameters, options)  # an unstable grid point: refused before any work
     if args.samples is not None:
+        if args.running:
+            raise UsageError("--running and --samples: the running case is not part of the "
+                             "verdict under uncertainty")
         return assess_under_uncertainty(args, parameters, options)
     for name in ("indices", "ranges", "write_samples", "out"):
         if getattr(args, name):
             raise UsageError(f"--{name.replace('_', '-')} needs --samples")
     with study_engine(args, "assess") as (mapper, where):
         print(f"assess: short_circuit ({len(options.s0) * len(options.v)} point(s) on {where}), "
-              "unstable_adhesion, starting, ripple …", file=sys.stderr)
+              f"unstable_adhesion, starting, ripple{', running' if args.running else ''} …",
+              file=sys.stderr)
         result = assess(parameters, options, mapper, ProgressBar("assess: short_circuit",
                                                                  unit="points"))
     emit(args, {**result.as_dict(), "rail": args.rail}, assessment_table(result))

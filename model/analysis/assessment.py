@@ -243,7 +243,11 @@ class Check:
     alternating: float = math.nan  # the amplitude of the oscillation about it [N m]
     v_kmh: float = math.nan  # the speed [km/h]
     orders: tuple = ()  # per order: {"order", "f_hz", "amplitude" (its share of the amplitude,
-    #                     N m), "ripple_amplitude" (the excitation's amplitude, N m)}
+    #                     N m), "ripple_amplitude" (the excitation's amplitude, N m)}; in the
+    #                     running case the wheel polygon's: {"order", "f_hz", "input_amplitude"
+    #                     [m], "wheels": [{"input", "phase_deg"}], "amplitude" [N m]}
+    rms: float = math.nan  # the running case: the random track's RMS of the torque [N m]
+    amplitude: float = math.nan  # the running case: the wheel polygon's amplitude [N m]
 
     @property
     def utilisation(self) -> float:
@@ -258,7 +262,8 @@ class Check:
                 "time_s": None if math.isnan(self.time) else self.time,
                 "scenario": dict(self.scenario), "note": self.note,
                 "mean": _number_or_none(self.mean), "alternating": _number_or_none(self.alternating),
-                "v_kmh": _number_or_none(self.v_kmh), "orders": [dict(o) for o in self.orders]}
+                "v_kmh": _number_or_none(self.v_kmh), "orders": [dict(o) for o in self.orders],
+                "rms": _number_or_none(self.rms), "amplitude": _number_or_none(self.amplitude)}
 
 
 def _number_or_none(value: float) -> float | None:

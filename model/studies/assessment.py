@@ -71,8 +71,19 @@ from model.studies.ripple_case import (
     ripple_amplitudes,
     ripple_sweep,
 )
+from model.studies.running_case import (
+    DEFAULT_RANDOM_MULTIPLE,
+    DEFAULT_RUNNING_S0,
+    DEFAULT_RUNNING_V,
+    DEFAULT_WHEEL_POLYGON,
+    RunningCaseError,
+    running_check,
+    running_loads,
+    running_sweep,
+)
 
 LOAD_CASES = ("short_circuit", "unstable_adhesion", "starting", "ripple")
+OPTIONAL_CASES = ("running",)  # computed when asked for (options.cases; bogie assess --running)
 DEFAULT_S0 = (0.002, 0.005)  # stable creepages of the short-circuit grid [-]
 DEFAULT_V_KMH = (80.0, 120.0, 200.0)  # speeds of the short-circuit grid [km/h]
 MIN_HORIZON = 2.0  # [s]: the study's window
@@ -109,6 +120,12 @@ class AssessmentOptions:
     ripple_v: tuple[float, ...] = DEFAULT_RIPPLE_V  # ripple: speeds before refinement [m/s]
     ripple_drive: DriveExcitation | None = None  # ripple: pole pairs, pinion teeth (None: the file's)
     cases: tuple[str, ...] = LOAD_CASES  # the load cases assess() computes, in this order
+    running_s0: tuple[float, ...] = DEFAULT_RUNNING_S0  # running: creepages [-]
+    running_v: tuple[float, ...] = DEFAULT_RUNNING_V  # running: speeds [m/s]
+    wheel_polygon: dict[int, float] | None = None  # running: {order: radial amplitude [m]}
+    #                                                (None: DEFAULT_WHEEL_POLYGON)
+    track: str = "low"  # running: the track spectrum (model.analysis.track_spectrum.SPECTRA)
+    random_multiple: float = DEFAULT_RANDOM_MULTIPLE  # running: the random part as k × RMS
 
     def __post_init__(self) -> None:
         for label, values in (("--s0", self.s0), ("--v", self.v)):
@@ -124,9 +141,10 @@ class AssessmentOptions:
                 and np.all(np.isfinite(speeds)) and speeds[0] > 0 and np.all(np.diff(speeds) > 0)):
             raise AssessmentError(f"ripple speeds: give 2 to {MAX_RIPPLE_SPEEDS} increasing speeds "
                                   "above 0")
-        unknown = [name for name in self.cases if name not in LOAD_CASES]
+        unknown = [name for name in self.cases if name not in LOAD_CASES + OPTIONAL_CASES]
         if not self.cases or unknown or len(set(self.cases)) != len(self.cases):
-            raise AssessmentError(f"load cases: give distinct names of {', '.join(LOAD_CASES)}"
+            raise AssessmentError(f"load cases: give distinct names of "
+                                  f"{', '.join(LOAD_CASES + OPTIONAL_CASES)}"
                                   + (f" (not {', '.join(map(str, unknown))})" if unknown else ""))
 
 
@@ -170,6 +188,7 @@ class LoadCase:
     scenario: dict  # what defines it (operating points, creep, protection)
     alternating: bool = False  # True: the loads are AlternatingLoad, checked by
     #                            alternating_components (press fits, fatigue, vibratory torque)
+    checks: tuple = ()  # checks the case made itself (the running case: with its RMS and orders)
 
 
 @dataclass(frozen=True)
@@ -481,6 +500,60 @@ def ripple_load_case(sweep: RippleSweep, parameters: Parameters, options: Assess
                     alternating=True)
 
 
+def running_case(parameters: Parameters, outputs: list[str], options: AssessmentOptions
+                 ) -> LoadCase:
+    """The running case (:mod:`model.studies.running_case`): mean traction, both converters'
+    ripple (the ripple case's orders and amplitudes), the wheel polygon and the random track over
+    ``options.running_v`` at ``options.running_s0``, each running system checked stable (else
+    :class:`AssessmentError`); its checks made here, with the RMS and the polygon's orders."""
+    from model.analysis.track_spectrum import TrackSpectrumError, track_spectrum
+    from model.mechanics.excitation import load_excitation
+    from model.studies.maps import cached_model
+
+    polygon = DEFAULT_WHEEL_POLYGON if options.wheel_polygon is None else options.wheel_polygon
+    try:
+        spectrum = track_spectrum(options.track)
+    except TrackSpectrumError as error:
+        raise AssessmentError(str(error)) from None
+    drive = options.ripple_drive if options.ripple_drive is not None else load_excitation()
+    ripple = ripple_of(parameters, options)
+    points = [operating_point(parameters, s0, options.running_v[0], options)
+              for s0 in options.running_s0]
+    try:
+        sweep = running_sweep(cached_model(parameters), points, options.running_v, outputs, ripple,
+                              drive, polygon, spectrum, options.random_multiple)
+    except RunningCaseError as error:
+        raise AssessmentError(str(error)) from None
+    loads = running_loads(sweep)
+    checks = tuple(running_check(c, sweep, loads[c.output])
+                   for c in alternating_components(parameters))
+    v_kmh = np.asarray(options.running_v) / KMH
+    words = ", ".join(f"order {n} = {a * 1e6:g} µm" for n, a in zip(
+        sweep.polygon_orders, sweep.polygon_amplitudes, strict=True))
+    description = (
+        f"normal running over {v_kmh[0]:g}…{v_kmh[-1]:g} km/h ({len(v_kmh)} speeds) at s0 = "
+        f"{', '.join(f'{x:g}' for x in sweep.s0)}: the steady traction's mean, plus both "
+        f"converters' ripple ({', '.join(o.name for o in sweep.ripple_orders)}, magnitudes "
+        f"added), plus polygonal wheels ({words}; every wheel, the rear wheelset a wheelbase "
+        f"later), plus {sweep.random_multiple:g} × the RMS under the random track "
+        f"({spectrum.name}: {spectrum.source}); the parts added as magnitudes (the worst phase); "
+        "on the running system (the creep force following the wheel force)")
+    first = points[0]
+    scenario = {"s0": list(sweep.s0), "v_kmh": [float(x) for x in v_kmh],
+                "wheel_polygon": [{"order": int(n), "input_amplitude": float(a)}
+                                  for n, a in zip(sweep.polygon_orders, sweep.polygon_amplitudes,
+                                                  strict=True)],
+                "ripple": [{"order": o.name, "amplitude": float(a)}
+                           for o, a in zip(sweep.ripple_orders, sweep.ripple_amplitudes,
+                                           strict=True)],
+                "track": {"name": spectrum.name, "A_v": spectrum.A_v, "omega_c": spectrum.omega_c,
+                          "omega_r": spectrum.omega_r, "source": spectrum.source},
+                "random_multiple": sweep.random_multiple, "N0": first.N0, "b_M": first.b_M,
+                "creep": "linear"}
+    return LoadCase("running", description, None, loads, scenario, alternating=True,
+                    checks=checks)
+
+
 def assess(parameters: Parameters, options: AssessmentOptions | None = None,
            map_unordered=None, progress=None) -> Assessment:
     """The load cases of ``options.cases`` (default all four) and every check under them.  The
@@ -494,7 +567,8 @@ def assess(parameters: Parameters, options: AssessmentOptions | None = None,
                                                     progress),
         "unstable_adhesion": lambda: unstable_adhesion_case(parameters, outputs, options),
         "starting": lambda: starting_case(parameters, outputs, options),
-        "ripple": lambda: ripple_case(parameters, outputs, options)}
+        "ripple": lambda: ripple_case(parameters, outputs, options),
+        "running": lambda: running_case(parameters, outputs, options)}
     return assessment_of(parameters, [builders[name]() for name in options.cases])
 
 
@@ -512,6 +586,9 @@ def assessment_of(parameters: Parameters, cases: list[LoadCase]) -> Assessment:
     under_alternating = alternating_components(parameters)
     checks = []
     for case in cases:
+        if case.checks:
+            checks += list(case.checks)
+            continue
         if case.alternating:
             checks += [verify_alternating(c, case.name, case.loads[c.output])
                        for c in under_alternating]

@@ -153,6 +153,9 @@ def bad_ranges(tmp_path_factory):
     (["--samples", "3", "--serial"], "must be a power of 2"),
     (["--indices"], "--indices needs --samples"),
     (["--samples", "4", "--serial", "--ranges", "RANGES"], "gear_seat_friction_min"),
+    (["--running", "--wheel-polygon", "20"], "is not order=amplitude"),
+    (["--running", "--running-v", "200,100"], "must increase"),
+    (["--running", "--samples", "2", "--serial"], "--running and --samples"),
 ])
 def test_bad_input_is_one_line_with_exit_status_2(argv, message, bad_set, bad_ranges, capsys):
     argv = [{"BAD": bad_set, "RANGES": bad_ranges}.get(a, a) for a in argv]
@@ -185,3 +188,59 @@ def test_a_sample_of_the_verdict_under_uncertainty_reruns_from_its_file(tmp_path
     assert again["component"] == sample["governing"]["component"]
     assert again["load_case"] == sample["governing"]["load_case"]
     assert again["safety_factor"] == pytest.approx(sample["governing"]["safety_factor"], rel=1e-9)
+
+
+@pytest.mark.slow
+def test_running_case_recomputed_from_the_export(capsys, tmp_path):
+    """``bogie assess --running``: the running checks carry v_kmh, rms and the wheel polygon's
+    orders (order, f_hz, input_amplitude [m], wheels with their phases); the check with the
+    largest deterministic polygon amplitude is recomputed from ``bogie export`` at its creepage
+    and speed with numpy alone — Σ over its orders of |Σ_wheels H_wheel(2π f) e^(i phase)| ·
+    input_amplitude, H from the exported running system — to 1e-3 (the JSON's speed and phases
+    are exact; 1e-3 leaves room for the rounding of the frequency through f = n v / 2π r0)."""
+    code, out, err = run(["assess", *GRID, "--ripple-v", "40:120:3", "--running",
+                          "--running-v", "100,200", "--serial", "--json"], capsys)
+    assert code == 0, err
+    data = json.loads(out)
+    assert [c["name"] for c in data["load_cases"]][-1] == "running"
+    running = [c for c in data["checks"] if c["load_case"] == "running"]
+    assert len(running) == 16
+    for c in running:
+        assert {"v_kmh", "rms", "orders", "amplitude", "mean", "alternating"} <= set(c)
+        assert c["v_kmh"] in (100.0, 200.0)
+        assert c["rms"] > 0
+        (order,) = c["orders"]
+        assert {"order", "f_hz", "input_amplitude", "wheels"} <= set(order)
+        assert order["order"] == 20
+        assert order["input_amplitude"] == pytest.approx(30e-6)
+        assert [w["input"] for w in order["wheels"]] == [
+            "ID1.rim12.irregularity", "ID1.rim14.irregularity", "ID2.rim12.irregularity",
+            "ID2.rim14.irregularity"]
+        # the parts the check adds: ripple + polygon + 3 × RMS
+        assert c["alternating"] == pytest.approx(
+            c["scenario"]["ripple_amplitude"] + c["amplitude"] + 3.0 * c["rms"], rel=1e-12)
+    worst = max(running, key=lambda c: c["amplitude"])
+    path = tmp_path / "system.npz"
+    code, _, err = run(["export", "--s0", str(worst["scenario"]["s0"]), "--v",
+                        str(worst["v_kmh"]), "--out", str(path)], capsys)
+    assert code == 0, err
+    import numpy as np
+
+    with np.load(path, allow_pickle=False) as arrays:
+        M = arrays["M"] + arrays["M_irr_coupling"]
+        B = arrays["B"] + arrays["B_irr_coupling"]
+        K = arrays["K"] + arrays["K_irr_coupling"]
+        inputs = list(arrays["irregularity_inputs"])
+        row = list(arrays["outputs"]).index(worst["output"])
+        C_q, C_v = arrays["C_q"][row], arrays["C_v"][row]
+        G = (arrays["G_irr_q"], arrays["G_irr_v"], arrays["G_irr_a"])
+    amplitude = 0.0
+    for order in worst["orders"]:
+        w = 2 * math.pi * order["f_hz"]
+        s = 1j * w
+        q = np.linalg.solve(s * s * M + s * B + K, G[0] + s * G[1] + s * s * G[2])
+        H = (C_q + s * C_v) @ q  # (4,) per wheel
+        total = sum(H[inputs.index(wheel["input"])] * np.exp(1j * math.radians(wheel["phase_deg"]))
+                    for wheel in order["wheels"])
+        amplitude += abs(total) * order["input_amplitude"]
+    assert worst["amplitude"] == pytest.approx(amplitude, rel=1e-3)
