@@ -184,7 +184,8 @@ class ResonanceView:
         checks = None
         if verdicts.result is not None and self._state is not None \
                 and verdicts.shown_for.point().without("v") == self._state.point().without("v"):
-            checks = tuple(c for c in verdicts.result.checks if c.load_case == "ripple")
+            checks = tuple(c for c in verdicts.result.checks
+                           if c.load_case in ("ripple", "running"))
         self.table.object = crossings_html(self.campbell, checks=checks)
 
     def _redraw(self) -> None:

@@ -262,13 +262,22 @@ CROSSINGS_LISTED = 8  # rows of the crossings table
 CROSSING_SPEED_RTOL = 0.02  # a ripple check is driven by a crossing within 2 % of its speed
 
 
+def order_name(order: dict) -> str:
+    """The Campbell diagram's name of a check's order: a ripple order's own (``el:6``), a wheel
+    polygon's of the running case (``{"order": 20, "wheels": …}``) ``wheel:20``."""
+    if "wheels" in order:
+        return f"wheel:{float(order['order']):g}"
+    return str(order["order"])
+
+
 def driven_check(crossing, checks) -> str:
-    """The ripple check a crossing drives: of the checks under the converters' ripple (``checks``,
-    those with an alternating load) whose worst speed lies within :data:`CROSSING_SPEED_RTOL` of
-    the crossing's and whose orders include the crossing's, the one with the least margin, as
-    "component, check: S = safety factor"; "—" if none."""
+    """The check a crossing drives: of the checks under alternating load (``checks``: the
+    converters' ripple, and the running case, whose orders are the wheel polygon's) whose worst
+    speed lies within :data:`CROSSING_SPEED_RTOL` of the crossing's and whose orders include the
+    crossing's, the one with the least margin, as "component, check: S = safety factor"; "—" if
+    none."""
     driven = [c for c in checks if abs(c.v_kmh - crossing.v_kmh) <= CROSSING_SPEED_RTOL * crossing.v_kmh
-              and any(o["order"] == crossing.order for o in c.orders)]
+              and any(order_name(o) == crossing.order for o in c.orders)]
     if not driven:
         return "—"
     c = max(driven, key=lambda c: c.utilisation)

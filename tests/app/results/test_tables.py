@@ -108,3 +108,29 @@ def test_unstable_case_says_unbounded_with_the_growth_rate_beside_the_nonlinear_
     assert abs(_number(vswing)) < 10 * response.M_ad / 1e3  # bounded: no 1e32
     # an output without a limit
     assert _cells(table, "ID1.disc_clutch.force_y")[:2] == ["—", "—"]
+
+
+def test_a_wheel_order_crossing_names_the_running_check_it_drives():
+    """A crossing of the Campbell diagram's ``wheel:20`` line drives the running case's check
+    whose polygon orders hold order 20 at (within 2 % of) the crossing's speed; a ripple check
+    still matches its own order by name; none: "—"."""
+    from types import SimpleNamespace
+
+    from app.results.tables import driven_check, order_name
+
+    wheels = [{"input": "ID1.rim12.irregularity", "phase_deg": 0.0}]
+    running = SimpleNamespace(v_kmh=100.0, component="ID1 gear seat", kind="press_fit_slip",
+                              safety_factor=1.8, utilisation=1.5 / 1.8,
+                              orders=({"order": 20, "f_hz": 141.5, "input_amplitude": 3e-5,
+                                       "wheels": wheels, "amplitude": 1.0},))
+    ripple = SimpleNamespace(v_kmh=100.0, component="ID1 axle", kind="torsional_fatigue",
+                             safety_factor=4.0, utilisation=0.25,
+                             orders=({"order": "el:6", "f_hz": 300.0, "amplitude": 1.0,
+                                      "ripple_amplitude": 256.0},))
+    assert order_name(running.orders[0]) == "wheel:20"
+    assert order_name(ripple.orders[0]) == "el:6"
+    at = SimpleNamespace(v_kmh=101.0, order="wheel:20")
+    assert driven_check(at, (running, ripple)).startswith("ID1 gear seat")
+    assert driven_check(SimpleNamespace(v_kmh=99.0, order="el:6"),
+                        (running, ripple)).startswith("ID1 axle")
+    assert driven_check(SimpleNamespace(v_kmh=120.0, order="wheel:20"), (running,)) == "—"
