@@ -88,6 +88,8 @@ STEPS = (
          "docs/results/design_loads.json (the worked example of docs/design-loads.md)"),
     Step("resonance", (_python("example_resonance.py"),),
          "docs/results/resonance_example.json (the worked example of docs/resonance.md)"),
+    Step("running", (_python("example_running.py"),),
+         "docs/results/running.json (the running system, the random track, the running case)"),
     Step("assessment", (_python("example_assessment.py"), _python("example_verdict_uncertainty.py")),
          "docs/results/assessment.json, verdict_uncertainty.json (docs/assessment.md's examples)"),
     Step("screenshots", (_python("bench_app.py", "--only-screenshots"),
