@@ -18,6 +18,7 @@ from bokeh.plotting import figure
 
 from app.results import compute
 from app.results.case import CaseBase
+from app.results.tables import order_name
 from model.analysis.assessment import KIND_NAMES, VERDICT_WORDS, verdict_colour
 from model.mechanics.operating_point import KMH
 from model.studies.assessment import (
@@ -166,7 +167,11 @@ def check_rows(result: Assessment, uncertainty=None) -> list[dict]:
     rows = []
     for c in sorted(result.checks, key=lambda c: -c.utilisation):
         where = "steady" if math.isnan(c.time) else f"t = {c.time:.4g} s"
-        if not math.isnan(c.alternating):  # under the ripple: its worst speed, mean ± amplitude
+        if not math.isnan(c.rms):  # running: its worst speed, mean ± amplitude, the random RMS
+            where = (f"{c.v_kmh:.4g} km/h, mean {c.mean / 1e3:.1f} ± {c.alternating / 1e3:.3g} "
+                     f"kN m (ripple, {', '.join(order_name(o) for o in c.orders)}, "
+                     f"RMS {c.rms / 1e3:.3g} kN m)")
+        elif not math.isnan(c.alternating):  # under the ripple: its worst speed, mean ± amplitude
             where = (f"{c.v_kmh:.4g} km/h, mean {c.mean / 1e3:.1f} ± {c.alternating / 1e3:.3g} "
                      f"kN m ({', '.join(o['order'] for o in c.orders)})")
         elif "v_kmh" in c.scenario:

@@ -64,3 +64,23 @@ def test_dashboard_assessment_is_the_models_at_an_unstable_point():
         N0=N0, b_M=b_M, excitation=ShortCircuit(M0=50e3, f=90.0, D=0.04), unstable_s0=0.012,
         unstable_v=140.0 * KMH))
     _same(shown, expected)
+
+
+@pytest.mark.slow
+def test_running_rows_say_the_parts_of_their_amplitude():
+    """A running check's row (what the Verdicts table and the report list): its worst speed,
+    mean ± amplitude, the parts (ripple, the wheel polygon's orders by the Campbell diagram's
+    names, the random RMS)."""
+    from app.results.verdicts import check_rows
+    from model import load_parameters
+    from model.mechanics.operating_point import KMH
+    from model.studies.assessment import AssessmentOptions, assess
+
+    result = assess(load_parameters(), AssessmentOptions(cases=("running",),
+                                                         running_v=(100 * KMH, 200 * KMH)))
+    rows = check_rows(result)
+    assert len(rows) == 16
+    for row, check in zip(rows, sorted(result.checks, key=lambda c: -c.utilisation), strict=True):
+        assert row["load case"] == "running"
+        assert "wheel:20" in row["where"]
+        assert f"RMS {check.rms / 1e3:.3g} kN m" in row["where"]
