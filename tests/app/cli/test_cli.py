@@ -23,7 +23,9 @@ from model.mechanics.outputs import output_matrices
 from model.mechanics.parameters import ESTIMATE_FILE, dumps_parameters
 
 EIGEN_KEYS = {"operating_point", "stable", "complex", "real", "rigid_body"}
-EXPORT_ARRAYS = {"M", "B", "K", "dofs", "f_mc", "motor_torque", "C_q", "C_v", "outputs"}
+EXPORT_ARRAYS = {"M", "B", "K", "dofs", "f_mc", "motor_torque", "C_q", "C_v", "outputs",
+                 "G_irr_q", "G_irr_v", "G_irr_a", "irregularity_inputs", "M_irr_coupling",
+                 "B_irr_coupling", "K_irr_coupling"}
 
 
 def run(argv: list[str], capsys) -> tuple[int, str, str]:
@@ -311,3 +313,12 @@ def test_export_contract(capsys, tmp_path, model):
     assert tuple(arrays["outputs"]) == outputs.names
     assert np.allclose(arrays["C_q"], outputs.C_q, rtol=1e-14, atol=0)
     assert np.allclose(arrays["C_v"], outputs.C_v, rtol=1e-14, atol=0)
+    # the irregularities' inputs at that point (model.mechanics.irregularity)
+    from model.mechanics.irregularity import irregularity_forces
+
+    forces = irregularity_forces(model, op)
+    assert tuple(arrays["irregularity_inputs"]) == forces.names
+    for name, value in (("G_irr_q", forces.G_q), ("G_irr_v", forces.G_v), ("G_irr_a", forces.G_a),
+                        ("M_irr_coupling", forces.M_c), ("B_irr_coupling", forces.B_c),
+                        ("K_irr_coupling", forces.K_c)):
+        assert np.array_equal(arrays[name], value), name
