@@ -24,6 +24,15 @@ alternating`` (slip at the peak), the shafts' DIN 743 fatigue with that amplitud
 the couplings' T_KW against it (:func:`model.analysis.assessment.verify_alternating`).  The
 deterministic parts are the steady state, the random one stationary: a running system with a
 growing mode at any point of the grid is refused (:class:`RunningCaseError`).
+
+**The random part's spectral fatigue damage** (beside the verdict, which is DIN 743's amplitude
+check): for a shaft's fatigue check, the Miner damage per hour of the random torque alone at the
+check's speed by Dirlik's method and the narrow-band bound (:mod:`model.analysis.spectral_fatigue`)
+against an S–N curve in torque amplitude through the permissible amplitude T_ADK about the mean
+at N_D = 10⁶ cycles with the slope k = 8 for shear stress and Haibach's 2k − 1 = 15 below the knee
+(FKM guideline, the torsion of steel; :data:`RANDOM_SN_SLOPE`, :data:`RANDOM_SN_KNEE`).  It
+says how much the random track alone uses up per hour of running at that speed; the
+deterministic amplitudes on top of it are not in that number.
 """
 
 from __future__ import annotations
@@ -51,6 +60,8 @@ DEFAULT_RUNNING_V = tuple(float(x) * KMH for x in np.linspace(20.0, 200.0, 10)) 
 # locomotives' polygonal wear on 1250 mm wheels (docs/resonance.md, its sources); 30 µm is an
 # assumed radial amplitude, not a measured one (none was available in a form to cite)
 DEFAULT_WHEEL_POLYGON = {20: 30e-6}
+RANDOM_SN_SLOPE = 8.0  # k of the S–N curve for shear stress (FKM guideline, steel)
+RANDOM_SN_KNEE = 1e6  # N_D [cycles] at the permissible amplitude
 
 
 class RunningCaseError(ValueError):
@@ -75,6 +86,7 @@ class RunningSweep:
     phases_deg: np.ndarray  # (polygon orders, 4) the wheels' phases [deg]
     inputs: tuple[str, ...]  # the wheels' inputs
     rms: np.ndarray  # (s0, outputs, V) the random track's RMS [N m]
+    moments: np.ndarray  # (s0, outputs, V, 4) its spectral moments m0, m1, m2, m4
     random_multiple: float
     spectrum: TrackSpectrum
 
@@ -106,6 +118,7 @@ def running_sweep(model: BogieModel, points: list[OperatingPoint], speeds, outpu
     motors = np.column_stack([input_force(model, m)[0] for m in MOTOR_INPUTS])
     shape = (len(points), len(outputs), len(v))
     mean, ripple_part, rms = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+    moments = np.zeros((*shape, 4))
     polygon_part = np.zeros((len(points), len(polygon_orders), len(outputs), len(v)))
     inputs: tuple[str, ...] = ()
     for a, op in enumerate(points):
@@ -132,13 +145,15 @@ def running_sweep(model: BogieModel, points: list[OperatingPoint], speeds, outpu
                 polygon_part[a, k, :, i] = polygon_amplitudes[k] * np.abs(H)
             random = random_response(model, point, spectrum, outputs)
             rms[a, :, i] = random.rms
+            moments[a, :, i, :] = random.moments
     x = np.array([model.positions[rim][0] for rim in model.rims])
     phases = np.degrees(-np.outer(polygon_orders, x.max() - x) / r0).reshape(
         len(polygon_orders), len(x))
     inputs = tuple(f"{rim}.irregularity" for rim in model.rims)
     return RunningSweep(v, tuple(op.s0 for op in points), tuple(outputs), mean, ripple_part,
                         ripple_orders, ripple_amplitudes, polygon_orders, polygon_amplitudes,
-                        polygon_part, polygon_hz, phases, inputs, rms, random_multiple, spectrum)
+                        polygon_part, polygon_hz, phases, inputs, rms, moments, random_multiple,
+                        spectrum)
 
 
 def running_loads(sweep: RunningSweep) -> dict[str, AlternatingLoad]:
@@ -184,5 +199,23 @@ def running_check(component: Component, sweep: RunningSweep, load: AlternatingLo
                                   for o, x in zip(sweep.ripple_orders, sweep.ripple_amplitudes,
                                                   strict=True)],
                 "random_multiple": sweep.random_multiple}
+    if component.kind == "torsional_fatigue" and check.capacity > 0:
+        from model.analysis.spectral_fatigue import (
+            SNCurve,
+            SpectralMoments,
+            dirlik_damage_rate,
+            haibach_slope,
+            narrow_band_damage_rate,
+        )
+
+        curve = SNCurve(check.capacity, RANDOM_SN_KNEE, RANDOM_SN_SLOPE,
+                        haibach_slope(RANDOM_SN_SLOPE))
+        moments = SpectralMoments(*(float(x) for x in sweep.moments[a, j, i]))
+        scenario["random_damage_per_hour"] = {
+            "dirlik": 3600.0 * dirlik_damage_rate(moments, curve),
+            "narrow_band": 3600.0 * narrow_band_damage_rate(moments, curve),
+            "sn_curve": {"amplitude_at_knee": check.capacity, "knee_cycles": RANDOM_SN_KNEE,
+                         "slope": RANDOM_SN_SLOPE,
+                         "slope_beyond_knee": haibach_slope(RANDOM_SN_SLOPE)}}
     return replace(check, orders=orders, rms=float(sweep.rms[a, j, i]),
                    amplitude=float(sweep.polygon[a, :, j, i].sum()), scenario=scenario)

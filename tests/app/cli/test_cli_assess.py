@@ -216,6 +216,12 @@ def test_running_case_recomputed_from_the_export(capsys, tmp_path):
         assert [w["input"] for w in order["wheels"]] == [
             "ID1.rim12.irregularity", "ID1.rim14.irregularity", "ID2.rim12.irregularity",
             "ID2.rim14.irregularity"]
+        if c["kind"] == "torsional_fatigue":  # the random part's spectral damage beside it
+            damage = c["scenario"]["random_damage_per_hour"]
+            # below the knee Haibach's slope still counts every cycle: both rates are positive
+            assert damage["dirlik"] > 0
+            assert damage["narrow_band"] > 0
+            assert damage["sn_curve"]["amplitude_at_knee"] == pytest.approx(c["capacity"])
         # the parts the check adds: ripple + polygon + 3 × RMS
         assert c["alternating"] == pytest.approx(
             c["scenario"]["ripple_amplitude"] + c["amplitude"] + 3.0 * c["rms"], rel=1e-12)
