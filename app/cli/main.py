@@ -19,6 +19,7 @@ from app.cli import (
     assess,
     calibrate,
     compare,
+    life,
     loads,
     parameters,
     report,
@@ -33,7 +34,7 @@ from app.cli.options import EXIT_BAD_INPUT, BogieParser, input_errors
 COMMAND_GROUPS = (analysis.register, calibrate.register, analysis.register_export, serve.register,
                   response.register, sensitivity.register, antislip.register, study.register,
                   compare.register, report.register, loads.register, resonance.register,
-                  assess.register, parameters.register)
+                  assess.register, life.register, parameters.register)
 
 
 def build_parser() -> BogieParser:

@@ -47,13 +47,16 @@ def input_errors() -> tuple[type[BaseException], ...]:
     from model.analysis.load_spectrum import SpectrumError
     from model.analysis.response import ResponseError
     from model.analysis.sensitivity import SensitivityError
+    from model.analysis.spectral_fatigue import SpectralFatigueError
     from model.analysis.stability import NoStabilityLimit
     from model.analysis.track_spectrum import TrackSpectrumError
     from model.analysis.wheel_excitation import WheelExcitationError
     from model.mechanics.excitation import ExcitationError
     from model.mechanics.operating_point import OperatingPointError
     from model.mechanics.parameters import ParameterError
+    from model.studies.life import LifeError
     from model.studies.posterior import PosteriorError
+    from model.studies.route import RouteError
     from model.studies.store import StoreMismatch
     from model.studies.uncertainty import UncertaintyError
     from model.studies.verdict_priors import VerdictUncertaintyError
@@ -63,7 +66,8 @@ def input_errors() -> tuple[type[BaseException], ...]:
             ExcitationError, FrequencyResponseError, CampbellError, SensitivityError,
             WheelExcitationError, TrackSpectrumError,
             SpectrumError, UncertaintyError, PosteriorError, StoreMismatch, VariantError,
-            SettingsError, VerdictUncertaintyError, FatigueError)
+            SettingsError, VerdictUncertaintyError, FatigueError, RouteError, LifeError,
+            SpectralFatigueError)
 
 
 class BogieParser(argparse.ArgumentParser):

@@ -184,6 +184,11 @@ def fatigue_capacity(component: Component, mean: float) -> float:
     return permissible_amplitude(data, mean / W_t) * W_t
 
 
+def fatigue_data(component: Component) -> TorsionalFatigue:
+    """The DIN 743 data of a torsional fatigue component (:func:`fatigue_shaft`)."""
+    return _fatigue_data(component)
+
+
 def _fatigue_data(component: Component) -> TorsionalFatigue:
     fields = {name: component.inputs[name] for name in TorsionalFatigue.__dataclass_fields__}
     return TorsionalFatigue(**fields)

@@ -100,6 +100,19 @@ class SNCurve:
                 below = self.knee_cycles * ratio**self.slope_beyond_knee
         return np.where(a >= self.fatigue_limit, above, below)
 
+    def amplitude_at(self, cycles: float) -> float:
+        """The amplitude σ_a [Pa] at which the curve gives ``cycles`` to failure (the inverse of
+        :meth:`cycles_to_failure`; on the line beyond the knee for more cycles than N_D, where
+        there is one; ``ValueError`` where there is none)."""
+        if not (math.isfinite(cycles) and cycles > 0):
+            raise SpectralFatigueError(f"S-N curve: cycles to failure must be > 0, got {cycles!r}")
+        if cycles <= self.knee_cycles:
+            return self.fatigue_limit * (self.knee_cycles / cycles) ** (1.0 / self.slope)
+        if self.slope_beyond_knee is None:
+            raise SpectralFatigueError(f"S-N curve: no amplitude lasts {cycles:g} cycles and "
+                                       "fails: beyond the knee nothing does damage")
+        return self.fatigue_limit * (self.knee_cycles / cycles) ** (1.0 / self.slope_beyond_knee)
+
     def damage(self, amplitudes, counts) -> float:
         """Miner's sum Σ nᵢ / N(σ_aᵢ) [-] of ``counts`` nᵢ cycles at ``amplitudes`` σ_aᵢ [Pa]."""
         n = np.asarray(counts, dtype=float)

@@ -97,12 +97,14 @@ class RippleCaseError(ValueError):
 
 def ripple_sweep(model: BogieModel, points: list[OperatingPoint],
                  speeds: np.ndarray | tuple[float, ...], ripple: dict[Order, float],
-                 drive: DriveExcitation, outputs: list[str]) -> RippleSweep:
+                 drive: DriveExcitation, outputs: list[str], extra_speeds=None) -> RippleSweep:
     """The responses of the ripple case (module docstring) before the envelope over creepages:
     ``points`` one operating point per creepage (its s0, N0 and b_M; the speed is replaced by
     each of ``speeds`` [m/s], the grid before refinement), each converter's ``ripple``
     {order: amplitude [N m]}, the motor's pole pairs and the pinion's teeth ``drive``.  An
-    unstable point of the grid is refused (:class:`RippleCaseError`)."""
+    unstable point of the grid is refused (:class:`RippleCaseError`).  ``extra_speeds`` [m/s]
+    (e.g. a route's, between the grid's ends) join the refined grid: computed, not checked for
+    stability one by one, as the refinement's own speeds."""
     from model.analysis.eigen import bogie_system
     from model.analysis.frequency_response import MODEL_FREQUENCY_LIMIT_HZ, input_force, output_indices
     from model.mechanics.operating_point import damping_matrix
@@ -122,7 +124,8 @@ def ripple_sweep(model: BogieModel, points: list[OperatingPoint],
     found = [resonant_speeds(model, op, coarse, orders, drive, motor)
              for op in points for motor in MOTOR_INPUTS]
     refined = distinct_speeds(np.concatenate([np.asarray(f, dtype=float) for f in found]))
-    v = np.unique(np.concatenate([coarse, refined]))
+    extra = np.zeros(0) if extra_speeds is None else np.asarray(extra_speeds, dtype=float)
+    v = np.unique(np.concatenate([coarse, refined, extra]))
     frequencies = np.array([order.frequency_hz(v, model.parameters, drive) for order in orders])
     frequencies[(frequencies > MODEL_FREQUENCY_LIMIT_HZ) | (frequencies <= 0)] = np.nan
     forces = np.column_stack([input_force(model, motor)[0] for motor in MOTOR_INPUTS])
