@@ -110,7 +110,8 @@ def life_table(result) -> str:
                      f"{_life(life.life_years, ''):>14}  {where}")
     least = result.least_life
     lines += ["", f"least life: {least.section.name}, {_life(least.life_km, 'km')} "
-                  f"({_life(least.life_years, 'years')})",
+                  f"({_life(least.life_years, 'years')})" if least.damage > 0 else
+              "least life: none — no source does damage to any section",
               "Miner's linear damage sum with the FKM guideline's shear S-N curve through DIN "
               "743's fatigue limit: a comparison of sections and speeds, not a certified life "
               "(docs/assessment.md). Not counted: wheel polygons and track irregularities, "
