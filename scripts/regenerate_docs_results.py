@@ -92,6 +92,8 @@ STEPS = (
          "docs/results/running.json (the running system, the random track, the running case)"),
     Step("assessment", (_python("example_assessment.py"), _python("example_verdict_uncertainty.py")),
          "docs/results/assessment.json, verdict_uncertainty.json (docs/assessment.md's examples)"),
+    Step("life", (_python("example_life.py"),),
+         "docs/results/life.json (docs/assessment.md's fatigue life over the bundled route)"),
     Step("screenshots", (_python("bench_app.py", "--only-screenshots"),
                          _python("screenshot_design_loads.py"), _python("screenshot_resonances.py")),
          "assets/screenshots/*.png (Chromium)", needs_browser=True),

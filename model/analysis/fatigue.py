@@ -37,7 +37,8 @@ or a fit); the effective diameter of the raw part for K1 is the section's outer 
 only torsion (the bending of an axle under the wheel forces is EN 13103-1's, not checked here);
 the yield limit of the section ``τ_FK`` is the section's permissible shear stress of the parameter
 set (R_e/√3), without DIN 743's static support factor K2F γ_F ≥ 1 (conservative); no surface
-hardening (K_V = 1); the fatigue limit (infinite life), no damage sum over a service spectrum.
+hardening (K_V = 1); the fatigue limit (infinite life; the damage sum over a route is
+:mod:`model.studies.life`'s, with an S–N curve through this limit).
 Stresses in Pa, lengths in m.
 """
 
