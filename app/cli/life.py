@@ -120,9 +120,11 @@ def life_table(result) -> str:
 
 
 def cmd_life(args: argparse.Namespace) -> None:
-    from model.studies.life import route_life
+    from model.studies.life import check_events, route_life
 
     parameters, route, options, sources = options_from_args(args)
+    if any(source.name == "short_circuit" for source in sources):
+        check_events(parameters, route)  # an unstable event refused before any work
     print(f"life: {route.name}: {', '.join(s.name for s in sources)} …", file=sys.stderr)
     result = route_life(parameters, route, options, sources)
     emit(args, {**result.as_dict(), "rail": args.rail}, life_table(result))

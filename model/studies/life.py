@@ -346,7 +346,12 @@ class RippleSource:
         from model.mechanics.excitation import load_excitation
         from model.mechanics.operating_point import OperatingPoint
         from model.studies.maps import cached_model
-        from model.studies.ripple_case import envelope_loads, ripple_amplitudes, ripple_sweep
+        from model.studies.ripple_case import (
+            RippleCaseError,
+            envelope_loads,
+            ripple_amplitudes,
+            ripple_sweep,
+        )
 
         route, options = context.route, context.options
         edges, points = _route_speeds(route, RIPPLE_FLOOR)
@@ -365,12 +370,36 @@ class RippleSource:
         resonances = [r * (1 + RESONANCE_OFFSETS) for r in _clusters(refined)]
         extra = np.concatenate([points, *resonances]) if resonances else points
         extra = extra[(extra >= edges[0]) & (extra <= edges[-1])]
-        sweep = ripple_sweep(model, ops, edges, ripple, drive, outputs, extra)
+        try:
+            sweep = ripple_sweep(model, ops, edges, ripple, drive, outputs, extra)
+        except RippleCaseError as error:
+            raise LifeError(str(error)) from None
         loads = envelope_loads(sweep)
         labels = [o.name for o in sweep.orders]
         return {s.output: steady_contributions(
             self.name, s, route, sweep.v, loads[s.output].mean, loads[s.output].by_order,
             loads[s.output].frequencies_hz, labels, RIPPLE_FLOOR) for s in context.sections}
+
+
+def check_events(parameters: Parameters, route: Route) -> None:
+    """Refuse a route whose short circuits happen at an unstable operating point
+    (:class:`LifeError`, one line): the response is a linear one about a stable state."""
+    from model.analysis.eigen import bogie_system
+    from model.analysis.load_peaks import GROWTH_RATE
+    from model.mechanics.operating_point import OperatingPoint
+    from model.studies.maps import cached_model
+
+    events = route.short_circuit
+    if events is None:
+        return
+    model = cached_model(parameters)
+    for v in events.v:
+        op = OperatingPoint(events.s0, v, parameters["wheel_force"], parameters["motor_slope"])
+        growth = float(np.max(bogie_system(model, op).eigenvalues().real))
+        if growth > GROWTH_RATE:
+            raise LifeError(f"short circuit: s0 = {op.s0:g} at {op.v_kmh:g} km/h is not stable "
+                            f"(growth rate {growth:.3g} 1/s): the route's short circuits take "
+                            "stable creepages")
 
 
 class ShortCircuitSource:
@@ -391,6 +420,7 @@ class ShortCircuitSource:
             return {s.output: [] for s in context.sections}
         p = context.parameters
         model = cached_model(p)
+        check_events(p, context.route)
         outputs = [s.output for s in context.sections]
         histories = {name: [] for name in outputs}
         for v, per_year in events.per_year_at():
@@ -457,7 +487,8 @@ class LifeResult:
                 "sn_curves": {"source": SN_SOURCE, "beyond_knee": self.options.beyond_knee,
                               "mean_stress": "tau_eq = tau_a tau_WK / tau_ADK(tau_m), DIN 743-1 "
                                              "case 1"},
-                "least_life": self.least_life.section.name,
+                "least_life": self.least_life.section.name if self.least_life.damage > 0
+                else None,
                 "sections": [s.as_dict() for s in self.sections]}
 
 

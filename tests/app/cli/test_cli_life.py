@@ -87,6 +87,14 @@ def test_bad_options_refused(route_file, capsys, argv, words):
     assert words in err
 
 
+def test_unstable_short_circuit_refused(tmp_path, capsys):
+    path = tmp_path / "unstable.toml"
+    path.write_text(ROUTE.replace("s0 = 0.005", "s0 = 0.014"), encoding="utf-8")
+    code, out, err = run(["life", "--route", str(path), "--sources", "short_circuit"], capsys)
+    assert_one_line_error(code, out, err)
+    assert "not stable" in err
+
+
 def test_bad_route_files_refused(tmp_path, capsys):
     code, out, err = run(["life", "--route", str(tmp_path / "missing.toml")], capsys)
     assert_one_line_error(code, out, err)
