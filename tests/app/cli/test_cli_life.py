@@ -1,4 +1,4 @@
-"""``bogie life``: the JSON contract on a short route (sections with damage, life, S–N curve and
+"""``bogie life``: the JSON contract on the bundled route (sections with damage, life, S–N curve and
 contributions; the least-life section's damage the sum of its contributions and each counted
 contribution cycles / N(stress_amplitude), to 1e-9), the table, and bad input refused in one
 line with exit status 2."""
@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import pytest
 from test_cli import assert_one_line_error, run
@@ -41,12 +42,16 @@ def _n(sn: dict, amplitude: float) -> float:
     return knee * (limit / amplitude) ** sn["slope_beyond_knee"]
 
 
+EXAMPLE = str(Path(__file__).resolve().parents[3] / "assets" / "routes" /
+              "mixed_passenger_200.toml")
+
+
 @pytest.mark.slow
-def test_json_contract(route_file, capsys):
-    code, out, err = run(["life", "--route", route_file, "--json"], capsys)
+def test_json_contract_on_the_bundled_route(capsys):
+    code, out, err = run(["life", "--route", EXAMPLE, "--json"], capsys)
     assert code == 0, err
     data = json.loads(out)
-    assert data["route"]["annual_distance_km"] == 100000
+    assert data["route"]["annual_distance_km"] == 250000
     assert data["sources"] == ["ripple", "short_circuit"]
     sections = data["sections"]
     assert len(sections) == 6
@@ -61,11 +66,15 @@ def test_json_contract(route_file, capsys):
     assert least["name"] == data["least_life"]
     assert least["damage"] == pytest.approx(math.fsum(c["damage"] for c in
                                                       least["contributions"]), rel=1e-9)
-    assert least["life_km"] == pytest.approx(100000 / least["damage"], rel=1e-9)
+    assert least["life_km"] == pytest.approx(250000 / least["damage"], rel=1e-9)
+    assert {c["source"] for c in least["contributions"]} == {"ripple", "short_circuit"}
     for c in least["contributions"]:
         assert c["damage"] == pytest.approx(c["cycles"] / _n(least["sn"], c["stress_amplitude"]),
                                             rel=1e-9)
 
+
+@pytest.mark.slow
+def test_table_with_miners_original_rule(route_file, capsys):
     code, out, err = run(["life", "--route", route_file, "--sources", "ripple",
                           "--beyond-knee", "limit"], capsys)
     assert code == 0, err
