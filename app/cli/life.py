@@ -1,13 +1,15 @@
 """``bogie life``: how long each shaft section lasts over a route — Miner's damage sum a year from
-the converters' ripple over the route's speeds and the short circuits a year, the life in
-kilometres and years, and where the damage comes from.
+the converters' ripple, the wheels' polygons and the track's irregularity over the route's
+speeds and the short circuits a year, the life in kilometres and years, and where the damage
+comes from.
 
     bogie life --route FILE [--beyond-knee haibach|elementary|limit] [--slope K]
-               [--knee-cycles N] [--sources ripple,short_circuit] [--ripple ORDER=AMPLITUDE,…]
+               [--knee-cycles N] [--sources ripple,polygon,track,short_circuit]
+               [--ripple ORDER=AMPLITUDE,…]
                [--rail calibrated|dry|wet] [--params FILE] [--json]
 
 The route file (TOML: a speed histogram or a ``t_s,v_kmh`` CSV, the annual distance, short
-circuits a year) is described in model.studies.route; the computation in model.studies.life.
+circuits a year, the track's spectrum, the wheels' polygon) is described in model.studies.route; the computation in model.studies.life.
 ``--json`` prints ``{"route": …, "sections": [{"name", "damage", "life_km", "life_years", "sn":
 {"fatigue_limit", "knee_cycles", "slope", "slope_beyond_knee"}, "contributions": [{"source",
 "v_kmh", "damage", "cycles", "stress_amplitude", …}]}], …}`` (damage a year; stress amplitudes in
@@ -24,7 +26,7 @@ import sys
 from app.cli.options import UsageError, add_rail, load_parameters_from
 from app.cli.output import emit
 
-SOURCES = ("ripple", "short_circuit")
+SOURCES = ("ripple", "polygon", "track", "short_circuit")
 TOP_CONTRIBUTIONS = 3  # per section in the table
 
 
@@ -56,7 +58,13 @@ def options_from_args(args: argparse.Namespace):
     from model.mechanics.excitation import parse_amplitudes
     from model.studies.assessment import check_ripple
     from model.studies.envelope import rail_parameters
-    from model.studies.life import LifeOptions, RippleSource, ShortCircuitSource
+    from model.studies.life import (
+        LifeOptions,
+        PolygonSource,
+        RippleSource,
+        ShortCircuitSource,
+        TrackSource,
+    )
     from model.studies.route import load_route
 
     names = [name.strip() for name in args.sources.split(",") if name.strip()]
@@ -75,7 +83,8 @@ def options_from_args(args: argparse.Namespace):
         knee_cycles=defaults.knee_cycles if args.knee_cycles is None else args.knee_cycles,
         slope=defaults.slope if args.slope is None else args.slope,
         beyond_knee=args.beyond_knee, ripple=ripple)
-    by_name = {"ripple": RippleSource(), "short_circuit": ShortCircuitSource()}
+    by_name = {"ripple": RippleSource(), "polygon": PolygonSource(), "track": TrackSource(),
+               "short_circuit": ShortCircuitSource()}
     return parameters, route, options, tuple(by_name[name] for name in names)
 
 
@@ -112,10 +121,10 @@ def life_table(result) -> str:
     lines += ["", f"least life: {least.section.name}, {_life(least.life_km, 'km')} "
                   f"({_life(least.life_years, 'years')})" if least.damage > 0 else
               "least life: none — no source does damage to any section",
+              *result.notes,
               "Miner's linear damage sum with the FKM guideline's shear S-N curve through DIN "
               "743's fatigue limit: a comparison of sections and speeds, not a certified life "
-              "(docs/assessment.md). Not counted: wheel polygons and track irregularities, "
-              "bending of the axle."]
+              "(docs/assessment.md). Not counted: the axle's bending, fretting at the seats."]
     return "\n".join(lines)
 
 

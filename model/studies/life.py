@@ -64,7 +64,7 @@ import numpy as np
 
 from model.analysis.assessment import alternating_components, fatigue_data
 from model.analysis.fatigue import TorsionalFatigue, permissible_amplitude
-from model.analysis.spectral_fatigue import SNCurve, dirlik_damage_rate, haibach_slope, spectral_moments
+from model.analysis.spectral_fatigue import SNCurve, SpectralMoments, dirlik_damage_rate, haibach_slope
 from model.mechanics.operating_point import KMH
 from model.mechanics.parameters import Parameters
 from model.studies.route import Route
@@ -183,6 +183,7 @@ class LifeContext:
     route: Route
     sections: list[Section]
     options: LifeOptions
+    notes: list[str] = field(default_factory=list)  # what a source left out, and why
 
 
 class LoadSource(Protocol):
@@ -245,12 +246,14 @@ def steady_contributions(source: str, section: Section, route: Route, v: np.ndar
 
 
 def spectral_contributions(source: str, section: Section, route: Route, v: np.ndarray,
-                           mean: np.ndarray, spectrum, floor: float = 0.0
-                           ) -> list[Contribution]:
-    """Per route bin: the damage a year of a stationary Gaussian torque about ``mean`` (V,)
-    [N m] whose one-sided PSD at speed ``v[i]`` [m/s] is ``spectrum(i)`` -> (f [Hz], G [N² m²/Hz])
-    by Dirlik's method, the stress scaled by the mean-stress correction; ``cycles`` the peaks
-    (one rainflow cycle per peak), its amplitude the equivalent one."""
+                           at_speed, floor: float = 0.0) -> list[Contribution]:
+    """Per route bin: the damage a year of a stationary Gaussian torque whose spectral moments
+    and mean at speed ``v[i]`` [m/s] are ``at_speed(i)`` -> (:class:`SpectralMoments` of the
+    torque [N² m², …], mean [N m]), or None where there is no stationary response (a bin holding
+    such a speed is left out): Dirlik's damage rate of the stress, its moments scaled by the
+    square of the mean-stress correction's τ_eq per N m, averaged over the bin (trapezoidal rule
+    over the speeds ``v`` in it, which hold its edges); ``cycles`` the peaks (one rainflow cycle
+    per peak), the amplitude the equivalent one."""
     out = []
     for low, high, seconds in zip(route.edges[:-1], route.edges[1:], route.seconds_per_year,
                                   strict=True):
@@ -259,12 +262,17 @@ def spectral_contributions(source: str, section: Section, route: Route, v: np.nd
             continue
         time = seconds * (high - start) / (high - low)
         idx, w = bin_weights(v, start, high)
+        points = [at_speed(int(i)) for i in idx]
+        if any(p is None for p in points):
+            continue
         damage = cycles = 0.0
-        for i, weight in zip(idx, w, strict=True):
-            f_hz, psd = spectrum(int(i))
-            per_torque = float(section.equivalent_amplitude(1.0, mean[i]))  # τ_eq per N m [1/m³]
-            moments = spectral_moments(f_hz, np.asarray(psd, dtype=float) * per_torque**2)
-            damage += time * weight * dirlik_damage_rate(moments, section.sn)
+        for (moments, mean), weight in zip(points, w, strict=True):
+            if not (moments.m0 > 0 and moments.m2 > 0 and moments.m4 > 0):
+                continue  # no response at this speed
+            per_torque = float(section.equivalent_amplitude(1.0, mean))  # τ_eq per N m [1/m³]
+            stress = SpectralMoments(*(m * per_torque**2 for m in (
+                moments.m0, moments.m1, moments.m2, moments.m4)))
+            damage += time * weight * dirlik_damage_rate(stress, section.sn)
             cycles += time * weight * moments.peak_rate
         c = counted(source, 0.5 * (low + high) / KMH, cycles, damage, section.sn,
                     {"seconds": time, "method": "Dirlik"})
@@ -381,6 +389,188 @@ class RippleSource:
             loads[s.output].frequencies_hz, labels, RIPPLE_FLOOR) for s in context.sections}
 
 
+def _running_ops(context: LifeContext, v: float) -> list:
+    """The operating points at speed ``v`` [m/s], one per creepage of the options, at which the
+    running system (:func:`model.analysis.eigen.running_system`: the bogie with the wheel-force
+    coupling the wheels' deviations act through) has no growing mode."""
+    from model.analysis.eigen import non_neutral, running_system
+    from model.mechanics.operating_point import OperatingPoint
+    from model.studies.maps import cached_model
+
+    p = context.parameters
+    model = cached_model(p)
+    stable = []
+    for s0 in context.options.s0:
+        op = OperatingPoint(s0, float(v), p["wheel_force"], p["motor_slope"])
+        lam = running_system(model, op).eigen[0]
+        if np.all(lam[non_neutral(lam)].real <= 0):
+            stable.append(op)
+    return stable
+
+
+def traction_mean(model, op, outputs: list[str]) -> np.ndarray:
+    """The steady traction's static load of ``outputs`` at ``op`` [N m] (the ripple case's mean)."""
+    from model.analysis.frequency_response import output_indices
+    from model.mechanics.outputs import static_deflection
+
+    matrices, rows = output_indices(model, op, outputs)
+    return (matrices.C_q @ static_deflection(model, op))[rows]
+
+
+def _stable_bins(context: LifeContext, edges: np.ndarray, source: str):
+    """(per edge speed: its stable operating points, per bin: True where both edges have one);
+    a note names the bins left out."""
+    ops = [_running_ops(context, v) for v in edges]
+    usable = [bool(a) and bool(b) for a, b in itertools.pairwise(ops)]
+    left = [f"{a / KMH:g}-{b / KMH:g}" for (a, b), ok in
+            zip(itertools.pairwise(edges), usable, strict=True) if not ok]
+    if left:
+        context.notes.append(
+            f"{source}: left out in {', '.join(left)} km/h, where the running system has a "
+            f"growing mode at every creepage of {', '.join(f'{x:g}' for x in context.options.s0)}"
+            " (no steady or stationary response)")
+    return ops, usable
+
+
+class PolygonSource:
+    """Polygonal wheels (:func:`model.analysis.wheel_excitation.polygon_response`, the route's
+    ``[wheel_polygon]``): every section's steady amplitude per polygon order over the route's
+    speeds from 10 km/h, at the options' creepages where the running system is stable at both
+    ends of a bin (the envelope: the largest amplitude and mean), densely around each resonance
+    the response's own search finds; as the ripple, per bin and order."""
+
+    name = "polygon"
+
+    def contributions(self, context: LifeContext) -> dict[str, list[Contribution]]:
+        from dataclasses import replace
+
+        from model.analysis.wheel_excitation import WheelExcitationError, polygon_response
+        from model.mechanics.operating_point import OperatingPoint
+        from model.studies.maps import cached_model
+
+        polygon = context.route.wheel_polygon
+        edges, points = _route_speeds(context.route, RIPPLE_FLOOR)
+        if not polygon:
+            context.notes.append("polygon: the route gives no [wheel_polygon]")
+        if not polygon or len(edges) < 2:
+            return {s.output: [] for s in context.sections}
+        model = cached_model(context.parameters)
+        outputs = [s.output for s in context.sections]
+        ops, usable = _stable_bins(context, edges, self.name)
+        # per creepage: the bins where it is stable at both edges
+        creepages = sorted({op.s0 for at in ops for op in at})
+        stable_bins = {s0: [any(o.s0 == s0 for o in a) and any(o.s0 == s0 for o in b)
+                            for a, b in itertools.pairwise(ops)] for s0 in creepages}
+
+        def inside(speeds: np.ndarray, bins: list[bool]) -> np.ndarray:
+            mask = np.zeros(len(speeds), dtype=bool)
+            for (a, b), ok in zip(itertools.pairwise(edges), bins, strict=True):
+                if ok:
+                    mask |= (speeds >= a) & (speeds <= b)
+            return mask
+
+        v = points[inside(points, usable)]
+        if len(v) < 2:
+            return {s.output: [] for s in context.sections}
+        p = context.parameters
+        template = [OperatingPoint(s0, float(v[0]), p["wheel_force"], p["motor_slope"])
+                    for s0 in creepages]
+        try:  # the resonances the response's own search finds, then one grid for all
+            found = np.concatenate([np.setdiff1d(polygon_response(model, op, v, polygon,
+                                                                  outputs).v, v)
+                                    for op in template])
+            dense = [r * (1 + RESONANCE_OFFSETS) for r in _clusters(found)]
+            grid = np.unique(np.concatenate([v, *dense])) if dense else v
+            grid = grid[inside(grid, usable)]
+            responses = [polygon_response(model, op, grid, polygon, outputs, refine=False)
+                         for op in template]
+        except WheelExcitationError as error:
+            raise LifeError(str(error)) from None
+        amplitude = np.full(responses[0].by_order.shape, -np.inf)  # (orders, outputs, V)
+        mean = np.zeros((len(outputs), len(grid)))
+        for op, r in zip(template, responses, strict=True):
+            mask = inside(grid, stable_bins[op.s0])
+            means = np.array([traction_mean(model, replace(op, v=float(x)), outputs)
+                              for x in grid]).T
+            amplitude = np.where(mask, np.maximum(amplitude, np.nan_to_num(r.by_order)),
+                                 amplitude)
+            mean = np.where(mask & (np.abs(means) > np.abs(mean)), means, mean)
+        amplitude[~np.isfinite(amplitude)] = 0.0
+        labels = [f"polygon:{n}" for n in responses[0].orders]
+        route = _usable_route(context.route, edges, usable)
+        return {s.output: steady_contributions(self.name, s, route, grid, mean[j],
+                                                amplitude[:, j, :], responses[0].frequencies_hz,
+                                                labels, RIPPLE_FLOOR)
+                for j, s in enumerate(context.sections)}
+
+
+def _usable_route(route: Route, edges: np.ndarray, usable: list[bool]) -> Route:
+    """``route`` with no time in the bins (between ``edges`` [m/s]) a source leaves out."""
+    from dataclasses import replace
+
+    seconds = route.seconds_per_year.copy()
+    for (a, b), ok in zip(itertools.pairwise(edges), usable, strict=True):
+        if not ok:
+            centre = 0.5 * (a + b)
+            seconds[(route.edges[:-1] <= centre) & (route.edges[1:] >= centre)] = 0.0
+    return replace(route, seconds_per_year=seconds)
+
+
+class TrackSource:
+    """The track's random vertical irregularity (:func:`model.analysis.track_spectrum.
+    random_response`, the route's ``[track] spectrum``): every section's torque spectrum (its
+    moments by adaptive quadrature) at the route's bin edges from 10 km/h, Dirlik's damage of
+    the mean-corrected stress, averaged over each bin; at each speed the creepage of the
+    options with the larger damage among those where the running system is stable (a bin with
+    an edge where none is, is left out and noted)."""
+
+    name = "track"
+
+    def contributions(self, context: LifeContext) -> dict[str, list[Contribution]]:
+        from model.analysis.track_spectrum import random_response, track_spectrum
+        from model.studies.maps import cached_model
+
+        route = context.route
+        edges, _ = _route_speeds(route, RIPPLE_FLOOR)
+        if route.track is None:
+            context.notes.append("track: the route gives no [track] spectrum")
+        if route.track is None or len(edges) < 2:
+            return {s.output: [] for s in context.sections}
+        model = cached_model(context.parameters)
+        spectrum = track_spectrum(route.track)
+        outputs = [s.output for s in context.sections]
+        ops, _ = _stable_bins(context, edges, self.name)
+        # per edge and stable creepage: (moments (outputs, 4), means (outputs,))
+        computed = []
+        for at in ops:
+            here = []
+            for op in at:
+                r = random_response(model, op, spectrum, outputs)
+                here.append((r.moments, traction_mean(model, op, outputs)))
+            computed.append(here)
+        out = {}
+        for j, s in enumerate(context.sections):
+            def at_speed(i, j=j, s=s):
+                best, best_damage = None, -1.0
+                for moments, means in computed[i]:
+                    m = SpectralMoments(*(float(x) for x in moments[j]))
+                    if not (m.m0 > 0 and m.m2 > 0 and m.m4 > 0):
+                        damage = 0.0
+                        if damage > best_damage:
+                            best, best_damage = (m, float(means[j])), damage
+                        continue
+                    per_torque = float(s.equivalent_amplitude(1.0, means[j]))
+                    damage = dirlik_damage_rate(SpectralMoments(
+                        m.m0 * per_torque**2, m.m1 * per_torque**2, m.m2 * per_torque**2,
+                        m.m4 * per_torque**2), s.sn)
+                    if damage > best_damage:
+                        best, best_damage = (m, float(means[j])), damage
+                return best
+            out[s.output] = spectral_contributions(self.name, s, route, edges, at_speed,
+                                                   RIPPLE_FLOOR)
+        return out
+
+
 def check_events(parameters: Parameters, route: Route) -> None:
     """Refuse a route whose short circuits happen at an unstable operating point
     (:class:`LifeError`, one line): the response is a linear one about a stable state."""
@@ -416,6 +606,8 @@ class ShortCircuitSource:
         from model.studies.maps import cached_model
 
         events = context.route.short_circuit
+        if events is None:
+            context.notes.append("short_circuit: the route gives no [short_circuit] events")
         if events is None or events.per_year == 0:
             return {s.output: [] for s in context.sections}
         p = context.parameters
@@ -433,7 +625,7 @@ class ShortCircuitSource:
                 for s in context.sections}
 
 
-DEFAULT_SOURCES = (RippleSource(), ShortCircuitSource())
+DEFAULT_SOURCES = (RippleSource(), PolygonSource(), TrackSource(), ShortCircuitSource())
 
 
 # --- the result ------------------------------------------------------------------------------
@@ -476,6 +668,7 @@ class LifeResult:
     options: LifeOptions
     sections: list[SectionLife]
     sources: tuple[str, ...]
+    notes: tuple[str, ...] = ()  # what a source left out, and why
 
     @property
     def least_life(self) -> SectionLife:
@@ -483,7 +676,7 @@ class LifeResult:
 
     def as_dict(self) -> dict:
         return {"route": self.route.as_dict(), "damage_basis": "Miner's sum per year of the route",
-                "sources": list(self.sources),
+                "sources": list(self.sources), "notes": list(self.notes),
                 "sn_curves": {"source": SN_SOURCE, "beyond_knee": self.options.beyond_knee,
                               "mean_stress": "tau_eq = tau_a tau_WK / tau_ADK(tau_m), DIN 743-1 "
                                              "case 1"},
@@ -494,8 +687,9 @@ class LifeResult:
 
 def route_life(parameters: Parameters, route: Route, options: LifeOptions | None = None,
                sources=DEFAULT_SOURCES) -> LifeResult:
-    """Every section's damage a year over ``route`` from ``sources`` (default the ripple and the
-    short circuit), its life in years and kilometres (module docstring)."""
+    """Every section's damage a year over ``route`` from ``sources`` (default all four: the
+    ripple, the wheels' polygon, the track, the short circuit; each takes what the route gives
+    and notes what it does not), its life in years and kilometres (module docstring)."""
     options = LifeOptions() if options is None else options
     context = LifeContext(parameters, route, sections_of(parameters, options), options)
     by_source = [source.contributions(context) for source in sources]
@@ -506,5 +700,6 @@ def route_life(parameters: Parameters, route: Route, options: LifeOptions | None
         years = 1.0 / damage if damage > 0 else math.inf
         lives.append(SectionLife(section, damage, years, years * route.annual_distance / 1e3,
                                  contributions))
-    return LifeResult(route, options, lives, tuple(s.name for s in sources))
+    return LifeResult(route, options, lives, tuple(s.name for s in sources),
+                      tuple(context.notes))
 

@@ -18,6 +18,12 @@ annual distance, and the short circuits a year with the operating points they ha
     # csv = "trip.csv"              # columns t_s,v_kmh (a header line), t increasing
     # bin_kmh = 5
 
+    [track]                         # optional: the track's random irregularity
+    spectrum = "low"                # a spectrum of model.analysis.track_spectrum
+
+    [wheel_polygon]                 # optional: every wheel's polygon
+    amplitudes_um = "20=30"         # order = radial amplitude [µm], …
+
     [short_circuit]                 # optional
     per_year = 0.1                  # ID1's motor short-circuits per year
     s0 = 0.005                      # the creepage it happens at [-]
@@ -49,7 +55,8 @@ import numpy as np
 from model.mechanics.operating_point import KMH
 
 SECONDS_PER_YEAR = 365.25 * 24 * 3600.0  # [s]: the ceiling of running time a year
-TOP_KEYS = {"name", "source", "annual_distance_km", "speeds", "short_circuit"}
+TOP_KEYS = {"name", "source", "annual_distance_km", "speeds", "short_circuit", "track",
+            "wheel_polygon"}
 SPEED_KEYS = {"edges_kmh", "share", "csv", "bin_kmh"}
 EVENT_KEYS = {"per_year", "s0", "v_kmh", "share"}
 
@@ -83,6 +90,8 @@ class Route:
     seconds_per_year: np.ndarray  # (bins,) running time in each bin [s/year]
     short_circuit: ShortCircuitEvents | None = None
     origin: dict = field(default_factory=dict)  # how the file gave the speeds (histogram or csv)
+    track: str | None = None  # the track's irregularity spectrum (model.analysis.track_spectrum)
+    wheel_polygon: dict | None = None  # every wheel's polygon {order: radial amplitude [m]}
 
     @property
     def centres(self) -> np.ndarray:
@@ -104,7 +113,9 @@ class Route:
                 "short_circuit": None if events is None else {
                     "per_year": events.per_year, "s0": events.s0,
                     "v_kmh": [v / KMH for v in events.v], "share": list(events.share)},
-                "speeds_from": dict(self.origin)}
+                "speeds_from": dict(self.origin), "track": self.track,
+                "wheel_polygon_um": None if self.wheel_polygon is None else {
+                    str(n): a * 1e6 for n, a in self.wheel_polygon.items()}}
 
 
 def _number(table: dict, key: str, where: str, low: float = 0.0, strict: bool = True) -> float:
@@ -245,8 +256,29 @@ def route_from_dict(data: dict, base: Path | None = None) -> Route:
         events = ShortCircuitEvents(_number(table, "per_year", "short_circuit.", strict=False),
                                     s0, tuple(float(x) * KMH for x in v),
                                     tuple(float(x) for x in _shares(share, "short_circuit.")))
+    track = polygon = None
+    if "track" in data:
+        table = data["track"]
+        if not isinstance(table, dict) or set(table) != {"spectrum"}:
+            raise RouteError("route: [track] takes spectrum = the name of a track spectrum")
+        from model.analysis.track_spectrum import TrackSpectrumError, track_spectrum
+
+        try:
+            track = track_spectrum(str(table["spectrum"])).name
+        except TrackSpectrumError as error:
+            raise RouteError(f"route: track: {error}") from None
+    if "wheel_polygon" in data:
+        table = data["wheel_polygon"]
+        if not isinstance(table, dict) or set(table) != {"amplitudes_um"}:
+            raise RouteError('route: [wheel_polygon] takes amplitudes_um = "order=µm,…"')
+        from model.analysis.wheel_excitation import WheelExcitationError, parse_polygon
+
+        try:
+            polygon = parse_polygon(str(table["amplitudes_um"]))
+        except WheelExcitationError as error:
+            raise RouteError(f"route: wheel_polygon: {error}") from None
     return Route(name, source, annual, np.asarray(edges_kmh, dtype=float) * KMH,
-                 np.asarray(seconds, dtype=float), events, origin)
+                 np.asarray(seconds, dtype=float), events, origin, track, polygon)
 
 
 def load_route(path) -> Route:

@@ -26,7 +26,9 @@ from model.mechanics.operating_point import KMH
 from model.studies.life import (
     LifeError,
     LifeOptions,
+    PolygonSource,
     Section,
+    TrackSource,
     event_contributions,
     route_life,
     spectral_contributions,
@@ -138,21 +140,30 @@ def test_event_classes_sum_to_the_rainflow_damage():
 
 
 def test_spectral_source_is_dirlik_on_the_corrected_stress():
+    """A bin with the same torque spectrum at both edges: its damage is the time × Dirlik's rate
+    of the stress spectrum scaled by the mean-stress correction, its cycles the peaks."""
     section = _section()
     W_t = section.fatigue.section_modulus
     edges = [50, 70]
     route = _route(edges, [1])
-    v = _grid(edges, 3)
-    mean = np.full(len(v), 100 * MPA * W_t)
     f = np.linspace(0.0, 200.0, 801)
     G = np.where((f > 20) & (f < 120), 1.0, 0.0) * (0.5 * section.fatigue.tau_WK * W_t) ** 2 / 100
-    found = spectral_contributions("track", section, route, v, mean, lambda i: (f, G))
+    torque = spectral_moments(f, G)
+    mean = 100 * MPA * W_t
+    found = spectral_contributions("track", section, route, np.array(edges) * KMH,
+                                   lambda i: (torque, mean))
     scale = section.fatigue.tau_WK / permissible_amplitude(section.fatigue, 100 * MPA) / W_t
-    moments = spectral_moments(f, G * scale**2)
+    stress = spectral_moments(f, G * scale**2)
     T = route.seconds_per_year[0]
-    assert found[0].damage == pytest.approx(T * dirlik_damage_rate(moments, section.sn),
+    assert found[0].damage == pytest.approx(T * dirlik_damage_rate(stress, section.sn),
                                             rel=1e-12)
-    assert found[0].cycles == pytest.approx(T * moments.peak_rate, rel=1e-12)
+    assert found[0].cycles == pytest.approx(T * torque.peak_rate, rel=1e-12)
+    assert found[0].damage == pytest.approx(
+        found[0].cycles / float(section.sn.cycles_to_failure(found[0].stress_amplitude)),
+        rel=1e-9)
+    # a speed without a stationary response leaves its bin out
+    assert spectral_contributions("track", section, route, np.array(edges) * KMH,
+                                  lambda i: None if i == 1 else (torque, mean)) == []
 
 
 def test_bad_options_refused():
@@ -175,7 +186,7 @@ def short_route_life():
 @pytest.mark.slow
 def test_route_life_sums_its_contributions(short_route_life):
     result = short_route_life
-    assert result.sources == ("ripple", "short_circuit")
+    assert result.sources == ("ripple", "polygon", "track", "short_circuit")
     assert len(result.sections) == 6
     least = result.least_life
     assert least.section.name == "ID1 driving shaft"  # the resonance of docs/assessment.md
@@ -184,7 +195,8 @@ def test_route_life_sums_its_contributions(short_route_life):
                                             rel=1e-9)
         assert life.life_km == pytest.approx(100_000.0 / life.damage, rel=1e-12)
     sources = {c.source for c in least.contributions}
-    assert sources == {"ripple", "short_circuit"}
+    assert sources == {"ripple", "short_circuit"}  # the route gives no polygon, no track
+    assert any(note.startswith("polygon: the route gives no") for note in result.notes)
     for c in least.contributions:
         assert c.cycles is not None
         assert c.cycles > 0
@@ -196,3 +208,39 @@ def test_route_life_sums_its_contributions(short_route_life):
     for c in ripple:
         assert c.cycles == pytest.approx(c.detail["f_hz"] * c.detail["seconds"], rel=1e-9)
     assert max(ripple, key=lambda c: c.damage).v_kmh == 87.5  # the bin holding the resonance
+
+
+@pytest.mark.slow
+def test_polygon_and_track_sources_on_the_model():
+    """A route with the track's spectrum and a wheel polygon: both sources give every section
+    contributions that obey damage = cycles / N(stress_amplitude); the polygon's cycles are its
+    frequency n v / (2π r0) × the time at the bin's centre speed."""
+    route = _route([60, 80, 100], [1, 2], annual_km=100_000.0, track={"spectrum": "low"},
+                   wheel_polygon={"amplitudes_um": "20=30"})
+    result = route_life(load_parameters(), route, sources=(PolygonSource(), TrackSource()))
+    assert result.notes == ()
+    r0 = load_parameters()["wheel_radius"]
+    for life in result.sections:
+        assert {c.source for c in life.contributions} == {"polygon", "track"}
+        assert life.damage == pytest.approx(math.fsum(c.damage for c in life.contributions),
+                                            rel=1e-9)
+        for c in life.contributions:
+            N = float(life.section.sn.cycles_to_failure(c.stress_amplitude))
+            assert c.damage == pytest.approx(c.cycles / N, rel=1e-9)
+            if c.source == "polygon":
+                f = 20 * c.v_kmh * KMH / (2 * math.pi * r0)
+                assert c.cycles == pytest.approx(f * c.detail["seconds"], rel=1e-9)
+
+
+@pytest.mark.slow
+def test_track_left_out_where_the_running_system_grows():
+    """At s0 = 0.005 the running system's 1.56 Hz suspension mode grows from about 70 km/h: the
+    bin 60-80 km/h has no stationary response and is left out, with a note."""
+    route = _route([40, 60, 80], [1, 1], track={"spectrum": "low"})
+    result = route_life(load_parameters(), route, LifeOptions(s0=(0.005,)),
+                        sources=(TrackSource(),))
+    assert result.notes == ("track: left out in 60-80 km/h, where the running system has a "
+                            "growing mode at every creepage of 0.005 (no steady or stationary "
+                            "response)",)
+    for life in result.sections:
+        assert [c.v_kmh for c in life.contributions] == [50.0]

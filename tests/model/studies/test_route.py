@@ -60,6 +60,17 @@ def test_bundled_example():
     assert sum(route.short_circuit.share) == pytest.approx(1.0)
     assert float(np.sum(route.seconds_per_year * route.centres)) == pytest.approx(250_000e3)
     assert route.source.startswith("estimate")
+    assert route.track == "low"
+    assert route.wheel_polygon is None
+
+
+def test_track_and_polygon():
+    route = route_from_dict(_histogram(track={"spectrum": "low"},
+                                       wheel_polygon={"amplitudes_um": "20=30, 3=5"}))
+    assert route.track == "low"
+    assert route.wheel_polygon == {20: pytest.approx(30e-6), 3: pytest.approx(5e-6)}
+    assert route.as_dict()["wheel_polygon_um"] == {"20": pytest.approx(30.0),
+                                                   "3": pytest.approx(5.0)}
 
 
 @pytest.mark.parametrize(("changes", "words"), [
@@ -72,6 +83,10 @@ def test_bundled_example():
     ({"speed": {}}, "unknown entry speed"),
     ({"annual_distance_km": 1e9}, "more than a year"),
     ({"short_circuit": {"per_year": 1, "s0": 0.005, "v_kmh": [80, 0]}}, "short_circuit"),
+    ({"track": {"spectrum": "rough"}}, "unknown track spectrum"),
+    ({"track": {"level": "low"}}, "takes spectrum"),
+    ({"wheel_polygon": {"amplitudes_um": "20=30000"}}, "wheel_polygon"),
+    ({"wheel_polygon": {"orders": "20=30"}}, "amplitudes_um"),
 ])
 def test_bad_routes_refused(changes, words):
     with pytest.raises(RouteError, match=words) as error:
