@@ -15,6 +15,7 @@ from pathlib import Path
 
 from model import load_parameters
 from model.studies.life import LifeOptions, route_life
+from model.studies.life_sources import default_sources
 from model.studies.ripple_case import ripple_amplitudes
 from model.studies.route import load_route
 
@@ -58,19 +59,20 @@ def summary(result) -> dict:
 def main() -> None:
     parameters = load_parameters()
     route = load_route(ROUTE)
-    result = route_life(parameters, route)
+    result = route_life(parameters, route, default_sources())
     data = {"route": route.as_dict(), "default": summary(result),
             "sn": {key(s.section.name): s.section.sn.as_dict() for s in result.sections},
             "beyond_knee": {}, "ripple_factor": {}}
     for beyond in ("elementary", "limit"):
-        data["beyond_knee"][beyond] = summary(route_life(parameters, route,
+        data["beyond_knee"][beyond] = summary(route_life(parameters, route, default_sources(),
                                                          LifeOptions(beyond_knee=beyond)))
     base = ripple_amplitudes(parameters)
     for factor in RIPPLE_FACTORS:
         ripple = {order: factor * amplitude for order, amplitude in base.items()}
         data["ripple_factor"][f"{factor:g}"] = {
             "ripple": {o.name: a for o, a in ripple.items()},
-            **summary(route_life(parameters, route, LifeOptions(ripple=ripple)))}
+            **summary(route_life(parameters, route, default_sources(),
+                                 LifeOptions(ripple=ripple)))}
     least = result.least_life
     print(f"least life: {least.section.name}: {least.life_km:.3g} km, "
           f"{least.life_years:.3g} years")

@@ -9,7 +9,8 @@ comes from.
                [--rail calibrated|dry|wet] [--params FILE] [--json]
 
 The route file (TOML: a speed histogram or a ``t_s,v_kmh`` CSV, the annual distance, short
-circuits a year, the track's spectrum, the wheels' polygon) is described in model.studies.route; the computation in model.studies.life.
+circuits a year, the track's spectrum, the wheels' polygon) is described in
+model.studies.route; the computation in model.studies.life and model.studies.life_sources.
 ``--json`` prints ``{"route": …, "sections": [{"name", "damage", "life_km", "life_years", "sn":
 {"fatigue_limit", "knee_cycles", "slope", "slope_beyond_knee"}, "contributions": [{"source",
 "v_kmh", "damage", "cycles", "stress_amplitude", …}]}], …}`` (damage a year; stress amplitudes in
@@ -58,8 +59,8 @@ def options_from_args(args: argparse.Namespace):
     from model.mechanics.excitation import parse_amplitudes
     from model.studies.assessment import check_ripple
     from model.studies.envelope import rail_parameters
-    from model.studies.life import (
-        LifeOptions,
+    from model.studies.life import LifeOptions
+    from model.studies.life_sources import (
         PolygonSource,
         RippleSource,
         ShortCircuitSource,
@@ -129,11 +130,12 @@ def life_table(result) -> str:
 
 
 def cmd_life(args: argparse.Namespace) -> None:
-    from model.studies.life import check_events, route_life
+    from model.studies.life import route_life
+    from model.studies.life_sources import check_events
 
     parameters, route, options, sources = options_from_args(args)
     if any(source.name == "short_circuit" for source in sources):
         check_events(parameters, route)  # an unstable event refused before any work
     print(f"life: {route.name}: {', '.join(s.name for s in sources)} …", file=sys.stderr)
-    result = route_life(parameters, route, options, sources)
+    result = route_life(parameters, route, sources, options)
     emit(args, {**result.as_dict(), "rail": args.rail}, life_table(result))

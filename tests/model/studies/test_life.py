@@ -26,14 +26,13 @@ from model.mechanics.operating_point import KMH
 from model.studies.life import (
     LifeError,
     LifeOptions,
-    PolygonSource,
     Section,
-    TrackSource,
     event_contributions,
     route_life,
     spectral_contributions,
     steady_contributions,
 )
+from model.studies.life_sources import PolygonSource, TrackSource, default_sources
 from model.studies.route import route_from_dict
 
 MPA = 1e6
@@ -179,8 +178,8 @@ def short_route_life():
     87.5 km/h) with a short circuit a year at 90 km/h."""
     route = _route([80, 85, 90, 95], [1, 2, 1], annual_km=100_000.0,
                    short_circuit={"per_year": 1.0, "s0": 0.005, "v_kmh": [90]})
-    return route_life(load_parameters(), route, LifeOptions(short_circuit_t_end=1.0,
-                                                            short_circuit_fs=5000.0))
+    return route_life(load_parameters(), route, default_sources(),
+                      LifeOptions(short_circuit_t_end=1.0, short_circuit_fs=5000.0))
 
 
 @pytest.mark.slow
@@ -217,7 +216,7 @@ def test_polygon_and_track_sources_on_the_model():
     frequency n v / (2π r0) × the time at the bin's centre speed."""
     route = _route([60, 80, 100], [1, 2], annual_km=100_000.0, track={"spectrum": "low"},
                    wheel_polygon={"amplitudes_um": "20=30"})
-    result = route_life(load_parameters(), route, sources=(PolygonSource(), TrackSource()))
+    result = route_life(load_parameters(), route, (PolygonSource(), TrackSource()))
     assert result.notes == ()
     r0 = load_parameters()["wheel_radius"]
     for life in result.sections:
@@ -237,8 +236,7 @@ def test_track_left_out_where_the_running_system_grows():
     """At s0 = 0.005 the running system's 1.56 Hz suspension mode grows from about 70 km/h: the
     bin 60-80 km/h has no stationary response and is left out, with a note."""
     route = _route([40, 60, 80], [1, 1], track={"spectrum": "low"})
-    result = route_life(load_parameters(), route, LifeOptions(s0=(0.005,)),
-                        sources=(TrackSource(),))
+    result = route_life(load_parameters(), route, (TrackSource(),), LifeOptions(s0=(0.005,)))
     assert result.notes == ("track: left out in 60-80 km/h, where the running system has a "
                             "growing mode at every creepage of 0.005 (no steady or stationary "
                             "response)",)
