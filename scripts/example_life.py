@@ -56,6 +56,32 @@ def summary(result) -> dict:
                 "top": top_groups(s)} for s in result.sections}}
 
 
+def running_margins(parameters, route) -> dict:
+    """Per creepage of the life's options: the running system's largest real part of a
+    non-neutral eigenvalue [1/s] at the route's bin edges from 10 km/h (> 0: growing), and its
+    frequency [Hz]: where the track's and the polygons' responses are near their stability
+    limit."""
+    import numpy as np
+
+    from model.analysis.eigen import non_neutral, running_system
+    from model.mechanics.operating_point import KMH, OperatingPoint
+    from model.studies.maps import cached_model
+
+    model = cached_model(parameters)
+    out = {}
+    for s0 in LifeOptions().s0:
+        rows = []
+        for v in route.edges[route.edges >= 10 * KMH]:
+            lam = running_system(model, OperatingPoint(s0, float(v), parameters["wheel_force"],
+                                                       parameters["motor_slope"])).eigen[0]
+            lam = lam[non_neutral(lam)]
+            k = int(np.argmax(lam.real))
+            rows.append({"v_kmh": float(v / KMH), "growth": float(lam[k].real),
+                         "f_hz": float(abs(lam[k].imag) / (2 * np.pi))})
+        out[f"{s0:g}"] = rows
+    return out
+
+
 def main() -> None:
     parameters = load_parameters()
     route = load_route(ROUTE)
@@ -73,6 +99,7 @@ def main() -> None:
             "ripple": {o.name: a for o, a in ripple.items()},
             **summary(route_life(parameters, route, default_sources(),
                                  LifeOptions(ripple=ripple)))}
+    data["running_system"] = running_margins(parameters, route)
     least = result.least_life
     print(f"least life: {least.section.name}: {least.life_km:.3g} km, "
           f"{least.life_years:.3g} years")

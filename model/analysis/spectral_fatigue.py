@@ -214,6 +214,18 @@ def dirlik_amplitude_density(amplitude, moments: SpectralMoments) -> np.ndarray:
     return density / moments.rms
 
 
+def dirlik_exceedance(amplitude: float, moments: SpectralMoments) -> float:
+    """The probability [-] that a rainflow amplitude of Dirlik's density reaches ``amplitude``
+    [Pa]: D1 e^(−Z/Q) + D2 e^(−Z²/(2R²)) + D3 e^(−Z²/2) with Z = σ_a/√m0 (Rayleigh's e^(−Z²/2)
+    for a narrow band)."""
+    z = float(amplitude) / moments.rms
+    if _narrow(moments):
+        return math.exp(-z * z / 2)
+    c = dirlik_coefficients(moments)
+    return (c.D1 * math.exp(-z / c.Q) + c.D2 * math.exp(-z * z / (2 * c.R**2))
+            + c.D3 * math.exp(-z * z / 2))
+
+
 def rayleigh_amplitude_density(amplitude, moments: SpectralMoments) -> np.ndarray:
     """The narrow-band density of stress amplitudes σ_a/m0 e^(−σ_a²/(2 m0)) [1/Pa]."""
     a = np.asarray(amplitude, dtype=float)

@@ -63,7 +63,13 @@ import numpy as np
 
 from model.analysis.assessment import alternating_components, fatigue_data
 from model.analysis.fatigue import TorsionalFatigue, permissible_amplitude
-from model.analysis.spectral_fatigue import SNCurve, SpectralMoments, dirlik_damage_rate, haibach_slope
+from model.analysis.spectral_fatigue import (
+    SNCurve,
+    SpectralMoments,
+    dirlik_damage_rate,
+    dirlik_exceedance,
+    haibach_slope,
+)
 from model.mechanics.operating_point import KMH
 from model.mechanics.parameters import Parameters
 from model.studies.route import Route
@@ -146,7 +152,7 @@ class Contribution:
     source: str  # "ripple", "short_circuit", …
     v_kmh: float | None  # the speed bin's centre [km/h]; None for events
     damage: float  # Miner's damage a year [1/year]
-    cycles: float | None = None  # counted cycles a year [1/year] (None: a spectral estimate)
+    cycles: float | None = None  # counted cycles a year [1/year] (a random source's: its peaks)
     stress_amplitude: float | None = None  # the equivalent amplitude τ_eq [Pa] of those cycles
     detail: dict = field(default_factory=dict)  # e.g. order and f_hz, events a year
 
@@ -164,7 +170,8 @@ def counted(source: str, v_kmh: float | None, cycles: float, damage: float, curv
     if not (cycles > 0 and damage > 0):
         return None
     if not math.isfinite(damage):
-        return Contribution(source, v_kmh, damage, cycles, math.inf, detail)
+        raise LifeError(f"{source}: a steady mean torque alone reaches a section's yield limit "
+                        "(no permissible amplitude is left): no fatigue life to compute")
     return Contribution(source, v_kmh, float(damage), float(cycles),
                         curve.amplitude_at(cycles / damage), detail)
 
@@ -247,7 +254,8 @@ def spectral_contributions(source: str, section: Section, route: Route, v: np.nd
     such a speed is left out): Dirlik's damage rate of the stress, its moments scaled by the
     square of the mean-stress correction's τ_eq per N m, averaged over the bin (trapezoidal rule
     over the speeds ``v`` in it, which hold its edges); ``cycles`` the peaks (one rainflow cycle
-    per peak), the amplitude the equivalent one."""
+    per peak; below a fatigue limit without a slope beyond it, the peaks whose amplitude reaches
+    the limit), the amplitude the equivalent one."""
     out = []
     for low, high, seconds in zip(route.edges[:-1], route.edges[1:], route.seconds_per_year,
                                   strict=True):
@@ -267,7 +275,9 @@ def spectral_contributions(source: str, section: Section, route: Route, v: np.nd
             stress = SpectralMoments(*(m * per_torque**2 for m in (
                 moments.m0, moments.m1, moments.m2, moments.m4)))
             damage += time * weight * dirlik_damage_rate(stress, section.sn)
-            cycles += time * weight * moments.peak_rate
+            share = 1.0 if section.sn.slope_beyond_knee is not None else dirlik_exceedance(
+                section.sn.fatigue_limit, stress)  # only the damaging cycles are counted
+            cycles += time * weight * moments.peak_rate * share
         c = counted(source, 0.5 * (low + high) / KMH, cycles, damage, section.sn,
                     {"seconds": time, "method": "Dirlik"})
         if c is not None:

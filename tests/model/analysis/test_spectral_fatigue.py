@@ -40,6 +40,7 @@ from model.analysis.spectral_fatigue import (
     dirlik_amplitude_density,
     dirlik_coefficients,
     dirlik_damage_rate,
+    dirlik_exceedance,
     haibach_slope,
     narrow_band_damage_rate,
     rayleigh_amplitude_density,
@@ -228,3 +229,13 @@ def test_narrow_band_against_rainflow_of_a_narrow_band_history():
         for estimate in (narrow_band_damage_rate(m, curve), dirlik_damage_rate(m, curve)):
             assert abs(estimate / counted - 1) <= 0.02 + 3 * standard_error, (curve, estimate,
                                                                              counted)
+
+
+def test_dirlik_exceedance_is_the_density_s_tail():
+    m = spectral_moments(F_HZ, TWO_MODES)
+    for a in (0.0, 0.5 * RMS, 2 * RMS):
+        tail, _ = integrate.quad(lambda x: dirlik_amplitude_density(x, m), a, 20 * RMS)
+        assert dirlik_exceedance(a, m) == pytest.approx(tail, rel=1e-8)
+    narrow = spectral_moments(F_HZ, NARROW)
+    # a 1 Hz band at 10 Hz (γ ≈ 0.998): Dirlik's tail is Rayleigh's to a few parts in a thousand
+    assert dirlik_exceedance(RMS, narrow) == pytest.approx(math.exp(-0.5), rel=5e-3)

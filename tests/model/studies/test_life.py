@@ -21,7 +21,11 @@ import pytest
 from model import load_parameters
 from model.analysis.fatigue import permissible_amplitude, torsional_fatigue
 from model.analysis.load_spectrum import rainflow_cycles
-from model.analysis.spectral_fatigue import dirlik_damage_rate, spectral_moments
+from model.analysis.spectral_fatigue import (
+    dirlik_damage_rate,
+    dirlik_exceedance,
+    spectral_moments,
+)
 from model.mechanics.operating_point import KMH
 from model.studies.life import (
     LifeError,
@@ -160,7 +164,16 @@ def test_spectral_source_is_dirlik_on_the_corrected_stress():
     assert found[0].damage == pytest.approx(
         found[0].cycles / float(section.sn.cycles_to_failure(found[0].stress_amplitude)),
         rel=1e-9)
-    # a speed without a stationary response leaves its bin out
+    # Miner's original rule: only the peaks reaching the limit are counted, and they do the damage
+    limited = _section("limit")
+    found_limited = spectral_contributions("track", limited, route, np.array(edges) * KMH,
+                                           lambda i: (torque, mean))
+    assert found_limited[0].cycles == pytest.approx(
+        T * torque.peak_rate * dirlik_exceedance(limited.sn.fatigue_limit, stress), rel=1e-12)
+    assert found_limited[0].damage == pytest.approx(
+        found_limited[0].cycles / float(limited.sn.cycles_to_failure(
+            found_limited[0].stress_amplitude)), rel=1e-9)
+        # a speed without a stationary response leaves its bin out
     assert spectral_contributions("track", section, route, np.array(edges) * KMH,
                                   lambda i: None if i == 1 else (torque, mean)) == []
 
