@@ -27,7 +27,7 @@ are these equivalent amplitudes [Pa].
 
 **Load sources** (each a :class:`LoadSource`: a name and a function of the :class:`LifeContext`
 that gives every section its :class:`Contribution` s, damage per year; the four of
-:mod:`model.studies.life_sources`; a source is one of three shapes, each with its helper):
+:mod:`model.studies.life_sources`; a source is one of three shapes, each with its function):
 
 * steady oscillations at known frequencies over speed (:func:`steady_contributions`): the
   converters' ripple and the wheels' polygons (per order, its amplitude and frequency at each
