@@ -2,12 +2,14 @@
 
 Arrays: ``M``, ``B`` (all damping at the point: structural + b_M B_M + B_ad), ``K``, ``dofs``
 (names), ``dof_units``, ``massless`` (indices of the coordinates without mass: the yaw dampers'
-strokes, whose rows and columns of M are zero — they are first order, ``B_mm q̇_m + B_mi q̇_i +
+strokes and, with a torque control on ID2's converter, its filter's ``ID2.converter.filtered_angle``
+[rad], whose rows and columns of M are zero — they are first order, ``B_mm q̇_m + B_mi q̇_i +
 K_m q = 0``; a first-order form keeps their displacements but not their velocities as states,
 see :mod:`model.analysis.linear_system`), ``f_mc`` (generalized force per unit short-circuit torque M_C [1 or 1/m…]),
 ``motor_torque`` (M(s0, v) [N m]), ``C_q``, ``C_v``, ``outputs`` (names of y = C_q Δq + C_v Δq̇),
 ``output_units``, ``output_steady`` (pre-fault values), ``operating_point`` (s0 [-], v [m/s],
-N0 [N], b_M [N m s/rad]).  Strings are numpy unicode arrays: load with ``allow_pickle=False``.
+N0 [N], b_M [N m s/rad]), ``motor_bandwidth`` (the torque control's bandwidth f_c [Hz]; 0: none).
+Strings are numpy unicode arrays: load with ``allow_pickle=False``.
 
 For an independent nonlinear integrator (the quantities :mod:`model.analysis.nonlinear` steps with):
 ``B_without_longitudinal_creep`` (n x n, B_nl: ``B`` without eq. 19's b11 terms),
@@ -69,6 +71,7 @@ def export_system(model: BogieModel, op: OperatingPoint, path: str | Path) -> No
         output_units=np.array(outputs.units, dtype=str),
         output_steady=outputs.steady,
         operating_point=np.array([op.s0, op.v, op.N0, op.b_M]),
+        motor_bandwidth=np.float64(model.parameters["motor_bandwidth"]),
         B_without_longitudinal_creep=damping_without_longitudinal_creep(model, op),
         creep_velocity_map=creep_velocity_map(model), creep_force_map=creep_force_map(model),
         contacts=np.array(contact_names(model), dtype=str), f_m2=motor2_force(model),

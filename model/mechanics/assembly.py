@@ -41,7 +41,7 @@ import numpy as np
 from model.mechanics.beam import TubeSection, beam_global_matrices
 from model.mechanics.bodies import Body, carried_body, free_body, rigid_mass_matrix
 from model.mechanics.connections import MaxwellDamper, Spring, SpringDamper, axis_springs
-from model.mechanics.dofs import AXES6, DofMap
+from model.mechanics.dofs import AXES6, FILTERED_ANGLE, DofMap
 from model.mechanics.parameters import Parameters
 
 # Beam nodes of a drive, in the study's numbering 5…16 (docs/model.md, "DOF count and layout"):
@@ -60,7 +60,7 @@ DRIVES = ("ID1", "ID2")
 CENTRAL_SYMMETRY = np.diag([-1.0, -1.0, 1.0])  # drive 2 = drive 1 turned 180° about z
 CAR_BODY_AXES = ("x", "z", "rz")  # the half car body's coordinates
 YAW_DAMPERS = ("secondary.yaw_damper_left", "secondary.yaw_damper_right")  # +y, −y side
-CONVERTER_FILTER = "ID2.converter.filtered_angle"  # massless coordinate of ID2's torque control
+CONVERTER_FILTER = f"ID2.converter.{FILTERED_ANGLE}"  # massless coordinate of ID2's torque control
 
 
 def dof_names(converter: bool = False) -> tuple[str, ...]:

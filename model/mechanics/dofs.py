@@ -7,7 +7,10 @@ translations of its reference point [m]) and ``rx, ry, rz`` (small rotations abo
 to x, y, z [rad]: roll, pitch/spin, yaw).  A name is ``<subsystem>.<part>.<coordinate>``, e.g.
 ``ID1.rotor.ry``, ``ID2.rim14.z``, ``BF.rz``, ``CB.z``.  The massless inner coordinate of a
 Maxwell element (a yaw damper with its end bushes) is its damper's elongation
-``<element>.stroke`` [m], e.g. ``secondary.yaw_damper_left.stroke``.
+``<element>.stroke`` [m], e.g. ``secondary.yaw_damper_left.stroke``.  The massless coordinate of
+a converter's torque control is its filter's output ``<drive>.converter.filtered_angle`` [rad]
+(the rotor's angle relative to the stator and to the vehicle's rolling, high-passed at the
+control's bandwidth), e.g. ``ID2.converter.filtered_angle``.
 
 The published study writes a wheel rim's coordinates as ``[u, v, w, φ, ϑ, ψ]`` =
 ``[y, z, x, ry, rz, rx]`` here (see :data:`PAPER_RIM_ORDER`).
@@ -20,8 +23,11 @@ from dataclasses import dataclass
 import numpy as np
 
 AXES6 = ("x", "y", "z", "rx", "ry", "rz")
+# the SI unit of each coordinate, by the name's last part; stroke: a Maxwell element's damper
+# elongation, filtered_angle: a converter's torque-control filter (both massless coordinates)
 UNITS = {"x": "m", "y": "m", "z": "m", "rx": "rad", "ry": "rad", "rz": "rad",
-         "stroke": "m"}  # stroke: a Maxwell element's damper elongation (massless coordinate)
+         "stroke": "m", "filtered_angle": "rad"}
+FILTERED_ANGLE = "filtered_angle"  # the last part of a converter filter's coordinate
 PAPER_RIM_ORDER = ("y", "z", "x", "ry", "rz", "rx")  # the study's [u, v, w, φ, ϑ, ψ]
 
 
@@ -50,7 +56,7 @@ class DofMap:
         return np.array([self.index(name) for name in names], dtype=int)
 
     def unit(self, name: str) -> str:
-        """SI unit of a coordinate ('m' or 'rad')."""
+        """SI unit of a coordinate ('m' or 'rad', by the name's last part, :data:`UNITS`)."""
         return UNITS[name.rsplit(".", 1)[1]]
 
     def select(self, prefix: str) -> np.ndarray:

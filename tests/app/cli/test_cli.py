@@ -322,3 +322,27 @@ def test_export_contract(capsys, tmp_path, model):
                         ("M_irr_coupling", forces.M_c), ("B_irr_coupling", forces.B_c),
                         ("K_irr_coupling", forces.K_c)):
         assert np.array_equal(arrays[name], value), name
+
+
+def test_export_with_torque_control(capsys, tmp_path):
+    """With a torque control on ID2's converter (``--motor-bandwidth`` > 0) the model has the
+    filter's massless coordinate: the export names it, gives its unit (rad, as the naming
+    scheme declares it) and counts it among the massless coordinates; the bandwidth is in the
+    file."""
+    from model.mechanics.assembly import CONVERTER_FILTER
+
+    path = tmp_path / "controlled.npz"
+    code, _, err = run(["export", "--s0", "0.005", "--v", "120", "--motor-bandwidth", "5",
+                        "--out", str(path)], capsys)
+    assert code == 0, err
+    controlled = build_model(load_parameters().replace(motor_bandwidth=5.0))
+    with np.load(path, allow_pickle=False) as data:
+        dofs, units = tuple(data["dofs"]), tuple(data["dof_units"])
+        massless, bandwidth = data["massless"], float(data["motor_bandwidth"])
+        shape = data["M"].shape
+    assert dofs == controlled.dofs.names
+    assert dofs[-1] == CONVERTER_FILTER == "ID2.converter.filtered_angle"
+    assert units[-1] == "rad"
+    assert len(units) == len(dofs) == shape[0] == 198
+    assert len(dofs) - 1 in massless
+    assert bandwidth == 5.0

@@ -94,6 +94,19 @@ def test_dof_count_and_names(calibrated):
         assert calibrated.dofs.unit(name) == ("m" if axis in ("x", "y", "z", "stroke") else "rad")
 
 
+def test_converter_filter_coordinate_is_named_and_has_a_unit():
+    """With a torque control (``motor_bandwidth`` > 0) the one extra coordinate follows the naming
+    scheme (``<subsystem>.<part>.<coordinate>``) and has its unit (rad) like every other one."""
+    names = dof_names(converter=True)
+    assert names[:-1] == dof_names()
+    assert names[-1] == "ID2.converter.filtered_angle"
+    dofs = DofMap(names)
+    assert dofs.subsystem(names[-1]) == "ID2"
+    assert dofs.part(names[-1]) == "ID2.converter"
+    assert dofs.unit(names[-1]) == "rad"
+    assert {dofs.unit(name) for name in names} == {"m", "rad"}
+
+
 def test_rims_index_their_own_coordinates(calibrated):
     assert sorted(calibrated.rims) == ["ID1.rim12", "ID1.rim14", "ID2.rim12", "ID2.rim14"]
     for rim, index in calibrated.rims.items():
