@@ -18,7 +18,7 @@ import argparse
 import numpy as np
 
 from app.cli.options import UsageError, add_operating_point, bounded, load_model, parse_range, positive_int
-from app.cli.output import emit
+from app.cli.output import emit, writable_path
 
 
 def register(subparsers) -> None:
@@ -153,15 +153,9 @@ def cmd_locus(args: argparse.Namespace) -> None:
 
 
 def cmd_export(args: argparse.Namespace) -> None:
-    from pathlib import Path
-
     from model.analysis.export import export_system
 
-    out = Path(args.out)  # refused before the model is built
-    if out.suffix != ".npz":
-        raise UsageError(f"export file must end in .npz, got '{out.name}'")
-    if not out.parent.is_dir():
-        raise UsageError(f"directory '{out.parent}' does not exist")
+    writable_path(args.out, "--out", suffixes=(".npz",))  # refused before the model is built
     model, op, _ = load_model(args)
     export_system(model, op, args.out)
     emit(args, {"out": args.out, "n_dof": model.n}, f"wrote {args.out} ({model.n} DOF)")

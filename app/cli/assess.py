@@ -45,6 +45,7 @@ import sys
 from app.cli.options import (
     MAX_SAMPLES,
     MIN_SAMPLES_PER_PERIOD,
+    PARAMETER_FILE,
     UsageError,
     add_anti_slip_arguments,
     add_engine_options,
@@ -55,12 +56,19 @@ from app.cli.options import (
     anti_slip_from,
     bounded,
     check_samples,
+    input_file,
     load_parameters_from,
     quantity_values,
     short_circuit_from,
 )
-from app.cli.output import emit
+from app.cli.output import emit, writable_path
 from app.cli.runs import ProgressBar, study_engine
+
+
+def _load_ranges(path: str):
+    from model.studies.verdict_priors import load_ranges
+
+    return load_ranges(path)
 
 
 def register(subparsers) -> None:
@@ -117,14 +125,14 @@ def register(subparsers) -> None:
                                                              "(default %(default)s)")
     samples.add_argument("--indices", action="store_true",
                          help="first-order and total Sobol indices (N (d + 2) dynamics runs)")
-    samples.add_argument("--ranges", default=None, metavar="FILE",
+    samples.add_argument("--ranges", type=input_file(_load_ranges), default=None, metavar="FILE",
                          help="TOML file of prior ranges: name = { low = …, high = … }")
     samples.add_argument("--write-samples", default=None, metavar="DIR",
                          help="write each sample's complete parameter set as TOML into DIR")
     samples.add_argument("--out", default=None, metavar="FILE.json",
                          help="write the result as JSON (into the server's studies folder: the "
                               "Verdicts tab shows its bands)")
-    p.add_argument("--params", default=None, metavar="FILE",
+    p.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set; strength data it "
                         "lacks are the default set's)")
     add_engine_options(p.add_argument_group("where the short_circuit grid runs (as bogie "
@@ -135,7 +143,7 @@ def register(subparsers) -> None:
 
 def options_from_args(args: argparse.Namespace):
     """(parameters, :class:`model.studies.assessment.AssessmentOptions`) from the options."""
-    from model.mechanics.excitation import parse_amplitudes
+    from model.mechanics.excitation import ExcitationError, parse_amplitudes
     from model.mechanics.operating_point import KMH
     from model.studies.assessment import AssessmentOptions
     from model.studies.envelope import rail_parameters
@@ -151,17 +159,22 @@ def options_from_args(args: argparse.Namespace):
     if args.fs < MIN_SAMPLES_PER_PERIOD * args.f:
         raise UsageError(f"--fs = {args.fs:g} Hz is too low to resolve the excitation at f = "
                          f"{args.f:g} Hz: must be at least {MIN_SAMPLES_PER_PERIOD * args.f:g} Hz")
-    ripple = None if args.ripple is None else parse_amplitudes(args.ripple)
-    ripple_v = [x * KMH for x in quantity_values(args.ripple_v, "v", increasing=True)]
+    try:
+        ripple = None if args.ripple is None else parse_amplitudes(args.ripple)
+    except ExcitationError as error:
+        raise UsageError(f"--ripple: {error}") from None
+    ripple_v = [x * KMH for x in quantity_values(args.ripple_v, "v", increasing=True,
+                                                          option="--ripple-v")]
     running = {}
     if args.running:
         from model.analysis.wheel_excitation import parse_polygon
         from model.studies.assessment import LOAD_CASES
 
         running = {"cases": (*LOAD_CASES, "running"),
-                   "running_s0": tuple(quantity_values(args.running_s0, "s0", increasing=True)),
-                   "running_v": tuple(x * KMH for x in quantity_values(args.running_v, "v",
-                                                                       increasing=True)),
+                   "running_s0": tuple(quantity_values(args.running_s0, "s0", increasing=True,
+                                                       option="--running-s0")),
+                   "running_v": tuple(x * KMH for x in quantity_values(
+                       args.running_v, "v", increasing=True, option="--running-v")),
                    "wheel_polygon": parse_polygon(args.wheel_polygon),
                    "random_multiple": args.random_multiple}
     options = AssessmentOptions(
@@ -216,6 +229,8 @@ def assessment_table(result) -> str:
 def cmd_assess(args: argparse.Namespace) -> None:
     from model.studies.assessment import assess, short_circuit_points
 
+    writable_path(args.write_samples, "--write-samples", directory=True)  # before any work
+    writable_path(args.out, "--out", suffixes=(".json",))
     parameters, options = options_from_args(args)
     short_circuit_points(parameters, options)  # an unstable grid point: refused before any work
     if args.samples is not None:
@@ -256,14 +271,6 @@ def assess_under_uncertainty(args: argparse.Namespace, parameters, options) -> N
     ranges = None if args.ranges is None else merge_ranges(load_ranges(args.ranges))
     check_ranges(parameters, relevant_ranges(default_ranges() if ranges is None else ranges,
                                              options)[0])  # refused before any work
-    if args.write_samples is not None:
-        out = Path(args.write_samples)
-        if out.exists() and not out.is_dir():
-            raise UsageError(f"--write-samples {out}: not a directory")
-    if args.out is not None:
-        out = Path(args.out)
-        if out.suffix != ".json" or not out.parent.is_dir():
-            raise UsageError(f"--out {out}: a .json file in an existing directory")
     with study_engine(args, "assess") as (mapper, where):
         print(f"assess: {args.samples} samples{' with indices' if args.indices else ''} on "
               f"{where} …", file=sys.stderr)

@@ -12,13 +12,14 @@ from __future__ import annotations
 import argparse
 import sys
 
-from app.cli.options import UsageError, positive_int
-from app.cli.output import emit
+from app.cli.options import PARAMETER_FILE, UsageError, positive_int
+from app.cli.output import emit, writable_path
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("calibrate", help="fit the uncertain parameters to the published results")
-    p.add_argument("--start", default=None, metavar="FILE", help="starting set (default: estimate.toml)")
+    p.add_argument("--start", type=PARAMETER_FILE, default=None, metavar="FILE",
+                   help="starting set (default: estimate.toml)")
     p.add_argument("--out", default=None, metavar="FILE",
                    help="where to write the calibrated set (required; the bundled default set is "
                         "assets/parameters/calibrated.toml)")
@@ -41,9 +42,7 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
         raise UsageError("--out FILE is required: where to write the calibrated set (the bundled "
                          f"default set is {CALIBRATED_FILE.relative_to(CALIBRATED_FILE.parents[2])})")
     start = Path(args.start) if args.start else ESTIMATE_FILE
-    out = Path(args.out)
-    if not out.parent.is_dir():
-        raise UsageError(f"directory '{out.parent}' does not exist")
+    out = writable_path(args.out, "--out")
     if out.resolve() == CALIBRATED_FILE.resolve():
         print(f"bogie calibrate: replacing the bundled default set {CALIBRATED_FILE}", file=sys.stderr)
     phases = PHASES if args.max_evaluations is None else tuple(

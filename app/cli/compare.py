@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 
 from app.cli.options import (
+    PARAMETER_FILE,
     UsageError,
     add_operating_point,
     add_short_circuit,
@@ -27,8 +28,8 @@ from app.cli.output import emit
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("compare", help="a design variant beside its baseline (two TOML sets)")
-    p.add_argument("base", metavar="BASE.toml", help="baseline parameter file")
-    p.add_argument("variant", metavar="VARIANT.toml", help="variant parameter file")
+    p.add_argument("base", type=PARAMETER_FILE, metavar="BASE.toml", help="baseline parameter file")
+    p.add_argument("variant", type=PARAMETER_FILE, metavar="VARIANT.toml", help="variant parameter file")
     add_operating_point(p)
     # the comparison samples its response at a fixed 10 kHz (no --fs): f stays below that rate
     add_short_circuit(p, intervals={"f": "(0, 1e4)"}, phase=False)

@@ -27,6 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from app.cli.options import (
+    ANTI_SLIP_OPTIONS,
+    PARAMETER_FILE,
+    RAILS,
     UsageError,
     add_anti_slip_arguments,
     add_engine_options,
@@ -39,8 +42,8 @@ from app.cli.options import (
     parse_values,
     quantity_values,
 )
-from app.cli.output import check_history_file
-from app.cli.runs import ProgressBar, history_from_args, study_engine
+from app.cli.output import check_history_file, writable_path
+from app.cli.runs import ProgressBar, history_from_args, resume_store, study_engine
 
 AXIS_LABELS = {"rail": "rail", "s0": "s0", "v": "v [km/h]", "N0": "N0 [N]", "b_M": "b_M",
                "M0": "M0 [N m]", "f": "f [Hz]", "D": "D", "anti_slip": "anti-slip",
@@ -79,7 +82,7 @@ def register(subparsers) -> None:
     add_anti_slip_arguments(p, with_delay=False)
     add_time_grid(p, "horizon", "output sampling rate")
     add_output_selection(p)
-    p.add_argument("--params", default=None, metavar="FILE",
+    p.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
     p.add_argument("--out", default=None, metavar="X.zarr",
                    help="Zarr store of the peaks of every scenario (xarray dataset)")
@@ -109,9 +112,10 @@ def _names(text: str, label: str) -> list[str]:
 
 def study_from_args(args: argparse.Namespace):
     """(:class:`model.studies.envelope.EnvelopeStudy`, parameters) from the options."""
+    from model.analysis.response import ResponseError
     from model.mechanics.operating_point import KMH, OperatingPoint
     from model.mechanics.parameters import load_parameters
-    from model.studies.envelope import EnvelopeStudy, rail_parameters, resolve_outputs
+    from model.studies.envelope import DesignLoadError, EnvelopeStudy, rail_parameters, resolve_outputs
 
     parameters = load_parameters(args.params)
     s0 = quantity_values(args.s0, "s0", increasing=True)
@@ -124,6 +128,9 @@ def study_from_args(args: argparse.Namespace):
     f = quantity_values(args.f, "f", increasing=True)
     decay = quantity_values(args.decay, "D", increasing=True)
     rails = _names(args.rail, "--rail")
+    unknown = [rail for rail in rails if rail not in RAILS]
+    if unknown:
+        raise UsageError(f"--rail: '{unknown[0]}' is not known, use {', '.join(RAILS)}")
     if args.phase is None:
         fault, phase = "roots", ()
     elif args.phase.strip() == "all":
@@ -134,6 +141,9 @@ def study_from_args(args: argparse.Namespace):
         raise UsageError("--phase all needs --creep linear (the closed form over every fault "
                          "instant is a superposition); give a --phase grid with nonlinear creep")
     anti_slip = _names(args.anti_slip, "--anti-slip")
+    given = [name for name in ANTI_SLIP_OPTIONS if getattr(args, name) is not None]
+    if given and "on" not in anti_slip:
+        raise UsageError(f"--{given[0].replace('_', '-')} needs --anti-slip on")
     delays = (parse_values(args.anti_slip_delay, "--anti-slip-delay", 0, 60, "s", increasing=True)
               if args.anti_slip_delay is not None else [])
     if args.creep != "linear" and args.method != "auto":
@@ -144,7 +154,10 @@ def study_from_args(args: argparse.Namespace):
 
     model = cached_model(rail_parameters(parameters, rails[0]))
     first = OperatingPoint(s0[0], v[0], n0[0], bm[0])
-    outputs, units = resolve_outputs(model, first, output_names(args), args.creep)
+    try:
+        outputs, units = resolve_outputs(model, first, output_names(args), args.creep)
+    except (ResponseError, DesignLoadError) as error:
+        raise UsageError(f"--outputs: {error}") from None
     study = EnvelopeStudy(
         s0=s0, v=v, N0=n0, b_M=bm, outputs=outputs, units=units, rail=tuple(rails), M0=m0, f=f,
         D=decay, fault=fault, phase=tuple(phase), creep=args.creep, anti_slip=tuple(anti_slip),
@@ -178,7 +191,6 @@ def cmd_envelope(args: argparse.Namespace) -> None:
     from model.studies.store import (
         finished_chunks,
         open_study,
-        prepare_store,
         run_in_memory,
         run_into_store,
         store_layout,
@@ -189,12 +201,11 @@ def cmd_envelope(args: argparse.Namespace) -> None:
     if out is None and args.resume:
         raise UsageError("--resume needs --out (the store to continue)")
     if out is not None and not args.resume:
+        writable_path(args.out, "--out", directory=True)
         if out.exists():
-            raise UsageError(f"'{out}' exists: continue it with --resume, or remove it")
-        if not out.parent.is_dir():
-            raise UsageError(f"directory '{out.parent}' does not exist")
+            raise UsageError(f"--out '{out}' exists: continue it with --resume, or remove it")
     elif out is not None:
-        prepare_store(out, study, parameters, resume=True)  # refuses another study's store
+        resume_store(out, study, parameters)
     _check_first_point(study, parameters, args)
     progress = ProgressBar("envelope")
 

@@ -21,6 +21,7 @@ import itertools
 import math
 import re
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
@@ -135,19 +136,55 @@ def non_negative_int(label: str) -> Callable[[str], int]:
     return parse
 
 
-def positive_int(label: str) -> Callable[[str], int]:
-    """argparse type: a whole number >= 1, with a clear message otherwise."""
+def positive_int(label: str, high: int | None = None) -> Callable[[str], int]:
+    """argparse type: a whole number >= 1 (and <= ``high``), with a clear message otherwise."""
 
     def parse(text: str) -> int:
         try:
             value = int(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{label} must be a whole number, got '{text}'") from None
-        if value < 1:
-            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: must be >= 1")
+        if value < 1 or (high is not None and value > high):
+            allowed = ">= 1" if high is None else f"in [1, {high}]"
+            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: must be {allowed}")
         return value
 
     return parse
+
+
+# --- input files ---------------------------------------------------------------------------------
+
+def input_file(load: Callable[[str], object] | None = None) -> Callable[[str], str]:
+    """argparse type: a file that exists and can be read (``load``: and that it reads — a
+    parameter file, a ranges file —, its input error said as the option's); returns the path as
+    given, the command reads it again.  The message names the option (argparse's ``argument
+    --params: …``) and is one line."""
+
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError("the path is empty")
+        path = Path(text)
+        if not path.is_file():
+            what = "is a directory, not a file" if path.is_dir() else "does not exist"
+            raise argparse.ArgumentTypeError(f"'{text}' {what}")
+        try:
+            with path.open("rb") as handle:
+                handle.read(1)
+        except OSError as error:
+            reason = (error.strerror or type(error).__name__).lower()
+            raise argparse.ArgumentTypeError(f"cannot read '{text}' ({reason})") from None
+        if load is not None:
+            try:
+                load(text)
+            except input_errors() as error:
+                message = str(error.args[0] if error.args else error).splitlines()[0]
+                raise argparse.ArgumentTypeError(message) from None
+        return text
+
+    return parse
+
+
+PARAMETER_FILE = input_file(load_parameters)  # a parameter file (TOML) it can read
 
 
 # --- the case's quantities: one option each, from its declaration --------------------------------
@@ -208,7 +245,7 @@ def add_operating_point(parser: argparse.ArgumentParser, s0: float | None = 0.00
         if q.name == "v" and not speed:
             continue
         add_case_option(parser, q, default=s0 if q.name == "s0" else ...)
-    parser.add_argument("--params", default=None, metavar="FILE",
+    parser.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                         help="parameter file (TOML; default: the calibrated set)")
     parser.add_argument("--json", action="store_true", help="machine-readable JSON output")
 
@@ -264,12 +301,14 @@ def case_from_args(args: argparse.Namespace, set_key: str, parameters) -> Case:
     return Case.from_outer(set_key, case_option_values(args), parameters)
 
 
-def quantity_values(text: str, name: str, increasing: bool = False) -> list[float]:
+def quantity_values(text: str, name: str, increasing: bool = False,
+                    option: str | None = None) -> list[float]:
     """A value list ``x1,x2,…`` or ``A:B:N`` of the quantity ``name`` in the command line's
-    unit, each within the interval its option accepts."""
+    unit, each within the interval its option accepts; ``option``: the option the user typed,
+    where it is not the quantity's own (``--ripple-v`` gives speeds)."""
     q = Case.quantity(name)
     low, high, low_open, high_open = interval_ends(q.option_interval)
-    return parse_values(text, q.option, low, high, q.outer_unit, increasing, low_open,
+    return parse_values(text, option or q.option, low, high, q.outer_unit, increasing, low_open,
                         high_open)
 
 
@@ -285,6 +324,9 @@ def parse_range(text: str, label: str, scale: float = 1.0) -> np.ndarray:
     if len(parts) != 3 or count < 2 or count > 5000 or not (math.isfinite(start) and math.isfinite(stop)):
         raise UsageError(f"{label} must be A:B:N with finite A, B and 2 <= N <= 5000, got '{text}'")
     return np.linspace(start, stop, count) * scale
+
+
+MAX_VALUES = 100_000  # the longest value list of an option
 
 
 def parse_values(text: str, label: str, low: float, high: float, unit: str,
@@ -304,6 +346,8 @@ def parse_values(text: str, label: str, low: float, high: float, unit: str,
                              f"comma-separated list, got '{text}'") from None
         if count < 1:
             raise UsageError(f"{label} = '{text}': N = {count} is not allowed, must be >= 1")
+        if count > MAX_VALUES:  # refused before the values are made
+            raise UsageError(f"{label}: {count} values, at most {MAX_VALUES} allowed")
         if count > 1 and not start < stop:
             raise UsageError(f"{label} = '{text}' is an empty range: A must be below B")
         values = [start] if count == 1 else list(np.linspace(start, stop, count))
@@ -324,8 +368,8 @@ def parse_values(text: str, label: str, low: float, high: float, unit: str,
                              f" {unit}")
     if increasing and any(b <= a for a, b in itertools.pairwise(values)):
         raise UsageError(f"{label} must increase")
-    if len(values) > 100_000:
-        raise UsageError(f"{label}: {len(values)} values, at most 100000 allowed")
+    if len(values) > MAX_VALUES:
+        raise UsageError(f"{label}: {len(values)} values, at most {MAX_VALUES} allowed")
     return [float(v) for v in values]
 
 
@@ -523,7 +567,10 @@ def output_names(args: argparse.Namespace) -> list[str] | None:
     """The names of ``--outputs`` (None: all loads)."""
     if args.outputs is None:
         return None
-    return [s.strip() for s in args.outputs.split(",") if s.strip()]
+    names = [s.strip() for s in args.outputs.split(",") if s.strip()]
+    if not names:
+        raise UsageError(f"--outputs '{args.outputs}': no output names given")
+    return names
 
 
 def check_sampling(args: argparse.Namespace, frequency_hz: float, what: str,

@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -25,18 +26,48 @@ def emit(args: argparse.Namespace, data: dict, table: str) -> None:
         print(table)
 
 
-def check_history_file(path: str | None) -> Path | None:
-    """The ``--out`` file of a time history (``.npz``, ``.csv`` or ``.json`` in an existing
-    directory), checked before any work; None without ``--out``."""
-    if path is None:
+def writable_path(text: str | None, option: str, *, suffixes: tuple[str, ...] = (),
+                  directory: bool = False) -> Path | None:
+    """The output ``text`` of ``option`` (``--out``), checked before any work: not empty, ending
+    in one of ``suffixes`` (any without), in an existing directory, not a directory itself (a
+    file) or not a file (``directory``: a folder the command fills, created if missing), and
+    writable — a temporary file is created there and removed at once (a permission check
+    alone says yes to root on a read-only or virtual file system such as /proc).  None
+    without the option."""
+    if text is None:
         return None
-    out = Path(path)
-    if out.suffix not in HISTORY_SUFFIXES:
-        raise UsageError(f"unknown file extension '{out.suffix or out.name}': use .npz, .csv or "
-                         ".json")
-    if not out.parent.exists():
-        raise UsageError(f"directory '{out.parent}' does not exist")
-    return out
+    if not text.strip():
+        raise UsageError(f"{option}: the path is empty")
+    path = Path(text)
+    if suffixes and path.suffix.lower() not in suffixes:
+        raise UsageError(f"{option} '{text}': the file name must end in {' or '.join(suffixes)}")
+    folder = path.parent
+    if not folder.is_dir():
+        raise UsageError(f"{option} '{text}': directory '{folder}' does not exist")
+    if path.exists():
+        if directory and not path.is_dir():
+            raise UsageError(f"{option} '{text}': not a directory")
+        if not directory and path.is_dir():
+            raise UsageError(f"{option} '{text}': is a directory, give a file name")
+        if directory:
+            folder = path
+    try:
+        if path.exists() and not directory:
+            with path.open("ab"):  # appends nothing: the file stays as it is
+                pass
+        else:
+            with tempfile.NamedTemporaryFile(dir=folder, prefix=".bogie-write-check-"):
+                pass
+    except OSError as error:
+        reason = error.strerror or type(error).__name__
+        raise UsageError(f"{option} '{text}': cannot write there ({reason.lower()})") from None
+    return path
+
+
+def check_history_file(path: str | None, option: str = "--out") -> Path | None:
+    """The ``--out`` file of a time history (``.npz``, ``.csv`` or ``.json`` in an existing,
+    writable directory), checked before any work; None without ``--out``."""
+    return writable_path(path, option, suffixes=HISTORY_SUFFIXES)
 
 
 def finish(args: argparse.Namespace, result, out: Path | None, write, summarize, table) -> None:

@@ -15,13 +15,14 @@ from __future__ import annotations
 
 import argparse
 
+from app.cli.options import PARAMETER_FILE
 from app.cli.output import emit
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("parameters", help="the parameter set as a table, with the "
                               "calibration's bounds")
-    p.add_argument("--params", default=None, metavar="FILE",
+    p.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
     p.add_argument("--json", action="store_true", help="machine-readable JSON output")
     p.set_defaults(func=cmd_parameters)

@@ -24,6 +24,7 @@ from app.cli.options import (
     case_from_args,
     dashboard_interval,
 )
+from app.cli.output import writable_path
 from app.results.case import Case
 
 
@@ -47,11 +48,7 @@ def cmd_report(args: argparse.Namespace) -> None:
     from app.report.page import build_report
     from app.results.variants import VariantError, apply_variant, base_parameters, decode, set_key
 
-    out = Path(args.out)
-    if out.suffix.lower() not in (".html", ".htm"):
-        raise UsageError(f"--out must end in .html, got '{out.name}'")
-    if not out.parent.is_dir():
-        raise UsageError(f"directory '{out.parent}' does not exist")
+    out = writable_path(args.out, "--out", suffixes=(".html", ".htm"))
     if args.s0 is None:
         raise UsageError("--s0 is required")
     base = str(Path(args.params).resolve()) if args.params else ""

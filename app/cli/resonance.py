@@ -25,13 +25,14 @@ from app.cli.options import (
     UsageError,
     add_operating_point,
     bounded,
+    input_file,
     load_model,
     output_names,
     parse_range,
     parse_values,
     positive_int,
 )
-from app.cli.output import emit
+from app.cli.output import emit, writable_path
 
 SPEEDS = "5:200:200"  # [km/h]
 BAND = "0.1:1000:2000"  # [Hz]
@@ -118,13 +119,22 @@ def _add_sweep_point(p: argparse.ArgumentParser) -> None:
     add_operating_point(p, speed=False)
 
 
+MAX_TEETH = 1000  # the most pole pairs and pinion teeth model.mechanics.excitation accepts
+
+
+def _load_excitation(path: str):
+    from model.mechanics.excitation import load_excitation
+
+    return load_excitation(path)
+
+
 def _add_excitation(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--excitation", default=None, metavar="FILE",
+    p.add_argument("--excitation", type=input_file(_load_excitation), default=None, metavar="FILE",
                    help="the motor's pole pairs and the pinion's teeth (TOML; default "
                         "assets/parameters/excitation.toml)")
-    p.add_argument("--pole-pairs", type=positive_int("--pole-pairs"), default=None,
+    p.add_argument("--pole-pairs", type=positive_int("--pole-pairs", MAX_TEETH), default=None,
                    help="pole pairs of the traction motor (default: the excitation file's)")
-    p.add_argument("--pinion-teeth", type=positive_int("--pinion-teeth"), default=None,
+    p.add_argument("--pinion-teeth", type=positive_int("--pinion-teeth", MAX_TEETH), default=None,
                    help="teeth of the pinion (default: the excitation file's)")
 
 
@@ -174,11 +184,14 @@ def _check_motor_input(model, name: str) -> None:
 def cmd_campbell(args: argparse.Namespace) -> None:
     from model.analysis.campbell import campbell
     from model.analysis.frequency_response import MODEL_FREQUENCY_LIMIT_HZ
-    from model.mechanics.excitation import MAX_ORDERS, Order, parse_orders
+    from model.mechanics.excitation import MAX_ORDERS, ExcitationError, Order, parse_orders
 
     model, op, speeds = _sweep_model(args)
     _check_motor_input(model, args.input)
-    orders = parse_orders(args.orders)
+    try:
+        orders = parse_orders(args.orders)
+    except ExcitationError as error:
+        raise UsageError(f"--orders: {error}") from None
     if args.freq is not None:
         fixed = parse_values(args.freq, "--freq (Hz)", 1e-3, MODEL_FREQUENCY_LIMIT_HZ, "Hz (the "
                              "model's validity)")
@@ -251,14 +264,7 @@ def cmd_frf(args: argparse.Namespace) -> None:
 
 
 def _check_csv(path: str | None) -> Path | None:
-    if path is None:
-        return None
-    out = Path(path)
-    if out.suffix != ".csv":
-        raise UsageError(f"--csv needs a .csv file name, got '{path}'")
-    if not out.parent.exists():
-        raise UsageError(f"directory '{out.parent}' does not exist")
-    return out
+    return writable_path(path, "--csv", suffixes=(".csv",))
 
 
 def _write_csv(path: Path, result) -> None:
@@ -354,12 +360,15 @@ def _polygon(args: argparse.Namespace) -> None:
 
 def _ripple(args: argparse.Namespace) -> None:
     from model.analysis.campbell import ripple_response
-    from model.mechanics.excitation import parse_amplitudes
+    from model.mechanics.excitation import ExcitationError, parse_amplitudes
     from model.mechanics.operating_point import KMH
 
     model, op, speeds = _sweep_model(args)
     _check_motor_input(model, args.input)
-    ripple = parse_amplitudes(args.ripple)
+    try:
+        ripple = parse_amplitudes(args.ripple)
+    except ExcitationError as error:
+        raise UsageError(f"--ripple: {error}") from None
     result = ripple_response(model, op, speeds, ripple, _excitation(args), input=args.input,
                              outputs=output_names(args))
 

@@ -51,6 +51,17 @@ def history_from_args(args: argparse.Namespace):
     return result
 
 
+def resume_store(path, study, parameters) -> None:
+    """Check that the store ``path`` of ``--out … --resume`` is this study's (it exists, same
+    parameters and arguments), before any work; a mismatch is bad input naming both options."""
+    from model.studies.store import StoreMismatch, prepare_store
+
+    try:
+        prepare_store(path, study, parameters, resume=True)
+    except StoreMismatch as error:
+        raise UsageError(f"--out with --resume: {error}") from None
+
+
 class ProgressBar:
     """``[#####-----] 5/10 chunks, 12 s elapsed, ~12 s left`` on stderr (redrawn in place on a
     terminal; otherwise a line at most every 2 s and at the end)."""

@@ -17,12 +17,18 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 
-from app.cli.options import UsageError, add_operating_point, add_uncertainty_options, load_model, uncertainty_options
-from app.cli.output import emit
+from app.cli.options import (
+    PARAMETER_FILE,
+    UsageError,
+    add_operating_point,
+    add_uncertainty_options,
+    load_model,
+    uncertainty_options,
+)
+from app.cli.output import emit, writable_path
 
 
 def _finite(values) -> list:
@@ -43,7 +49,7 @@ def register(subparsers) -> None:
     p.add_argument("--samples", type=int, required=True,
                    help="base sample count n (a power of 2 >= 2); model runs: n (d + 2)")
     p.add_argument("--seed", type=int, default=12, help="seed of the scrambled Sobol' sequence")
-    p.add_argument("--params", default=None, metavar="FILE",
+    p.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
     add_uncertainty_options(p)
     p.add_argument("--json", action="store_true", help="machine-readable JSON output")
@@ -112,9 +118,7 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
     if n < 2 or n & (n - 1):
         raise UsageError(f"--samples = {n} is not allowed: must be a power of 2 >= 2 "
                          "(balance of the Sobol' sequence)")
-    out = Path(args.out) if args.out else None
-    if out is not None and not out.parent.is_dir():
-        raise UsageError(f"directory '{out.parent}' does not exist")
+    out = writable_path(args.out, "--out")
     options = uncertainty_options(args)
     parameters = load_parameters(args.params)
     try:

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from app.cli.options import (
+    PARAMETER_FILE,
     UsageError,
     add_engine_options,
     add_rail,
@@ -35,7 +36,8 @@ from app.cli.options import (
     quantity_values,
     uncertainty_options,
 )
-from app.cli.runs import ProgressBar, study_engine
+from app.cli.output import writable_path
+from app.cli.runs import ProgressBar, resume_store, study_engine
 
 
 def _common(p: argparse.ArgumentParser) -> None:
@@ -43,7 +45,7 @@ def _common(p: argparse.ArgumentParser) -> None:
                    help="wheel forces N0 [N]: x1,x2,… or A:B:N (default: the parameter set's)")
     p.add_argument("--bm", default=None, metavar="LIST",
                    help="motor slopes b_M [N m s/rad]: x1,x2,… or A:B:N (default: the set's)")
-    p.add_argument("--params", default=None, metavar="FILE",
+    p.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
     add_rail(p)
     p.add_argument("--out", required=True, metavar="X.zarr", help="Zarr store to write")
@@ -77,7 +79,7 @@ def register(subparsers) -> None:
     u.add_argument("--samples", type=positive_int("--samples"), required=True,
                    help="base sample count n (a power of 2 >= 2); model runs: n (d + 2)")
     u.add_argument("--seed", type=int, default=12, help="seed of the scrambled Sobol' sequence")
-    u.add_argument("--params", default=None, metavar="FILE",
+    u.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
     u.add_argument("--out", required=True, metavar="U.json", help="JSON result to write")
     u.add_argument("--chunk-size", type=positive_int("--chunk-size"), default=4,
@@ -133,9 +135,7 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
     if n < 2 or n & (n - 1):
         raise UsageError(f"--samples = {n} is not allowed: must be a power of 2 >= 2 "
                          "(balance of the Sobol' sequence)")
-    out = Path(args.out)
-    if not out.parent.is_dir():
-        raise UsageError(f"directory '{out.parent}' does not exist")
+    out = writable_path(args.out, "--out")
     options = uncertainty_options(args)
     parameters = load_parameters(args.params)
     bar, start = ProgressBar("study uncertainty", unit="model runs"), time.monotonic()
@@ -158,17 +158,15 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
 
 
 def _run(args: argparse.Namespace, study, parameters) -> None:
-    from model.studies.store import open_study, prepare_store, run_into_store
+    from model.studies.store import open_study, run_into_store
 
     progress = ProgressBar(f"study {study.kind}")
     if not args.resume:  # refuse a bad --out before starting a cluster
-        out = Path(args.out)
+        out = writable_path(args.out, "--out", directory=True)
         if out.exists():
-            raise UsageError(f"'{out}' exists: continue it with --resume, or remove it")
-        if not out.parent.is_dir():
-            raise UsageError(f"directory '{out.parent}' does not exist")
+            raise UsageError(f"--out '{out}' exists: continue it with --resume, or remove it")
     else:
-        prepare_store(args.out, study, parameters, resume=True)  # refuses another study's store
+        resume_store(args.out, study, parameters)
     def interrupted() -> str:
         from model.studies.store import finished_chunks
 

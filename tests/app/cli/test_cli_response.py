@@ -71,7 +71,7 @@ def test_json_summary_and_series(tmp_path, capsys):
     (["--m0", "-5"], "--m0"),
     (["--decay", "-1"], "--decay"),
     (["--f", "abc"], "--f"),
-    (["--out", "x.xlsx"], "extension"),
+    (["--out", "x.xlsx"], "must end in .npz or .csv or .json"),
     (["--outputs", "ID1.nonsense"], "unknown output"),
     (["--s0", "2"], "--s0"),
 ])

@@ -11,6 +11,7 @@ import pytest
 
 from app.cli.main import build_parser
 from app.cli.options import MAX_SAMPLES, UsageError, bounded, check_samples
+from model.mechanics.parameters import CALIBRATED_FILE, ESTIMATE_FILE
 
 
 @pytest.mark.parametrize(("interval", "inside", "outside"), [
@@ -83,7 +84,7 @@ def test_shared_option_blocks_have_the_same_labels(command, options, capsys):
     labels = {"--m0": "--m0 (amplitude, N m)", "--f": "--f (frequency, Hz)", "--decay": "--decay (D)",
               "--phase": "--phase (Δt, s)", "--t-end": "--t-end (horizon, s)",
               "--fs": "--fs (sampling rate, Hz)"}
-    positional = ["A.toml", "B.toml"] if command == "compare" else []
+    positional = [str(CALIBRATED_FILE), str(ESTIMATE_FILE)] if command == "compare" else []
     for option in options:
         assert not _parses([command, *positional, option, "1e300"])
         err = capsys.readouterr().err
