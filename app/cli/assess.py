@@ -2,7 +2,8 @@
 drives checked in the four load cases, with safety factors and the governing check; with
 ``--samples`` the verdict under uncertainty.
 
-    bogie assess [--s0 LIST] [--v LIST] [--n0 N] [--bm B] [--rail calibrated|dry|wet]
+    bogie assess [--s0 LIST] [--v LIST] [--n0 N] [--bm B] [--motor-bandwidth FC]
+                 [--rail calibrated|dry|wet]
                  [--m0 M --f F --decay D] [--t-end T] [--fs FS]
                  [--unstable-s0 S --unstable-v V] [--anti-slip-delay T --anti-slip-threshold W
                  --anti-slip-rate R --anti-slip-floor F] [--starting-v V]
@@ -15,7 +16,8 @@ drives checked in the four load cases, with safety factors and the governing che
 A LIST is ``A,B,C`` or ``A:B:N``, increasing; speeds in km/h.  ``--s0``/``--v`` are the short-circuit
 case's grid (stable creepages only), as ``bogie envelope --phase all`` takes them; without
 ``--t-end`` its horizon covers the settling to the static response of the vehicle's
-deceleration.  That grid runs on the study engine as
+deceleration.  ``--n0``, ``--bm`` and ``--motor-bandwidth`` (the converter's torque control
+f_c [Hz]; default the set's) hold for every case.  That grid runs on the study engine as
 the envelope does (a local Dask cluster by default, ``--scheduler`` a running one, ``--serial`` in
 this process); the other cases are single runs in this process.  The ripple case takes the set's
 ripple amplitudes or ``--ripple`` (as ``bogie ripple``), over ``--ripple-v`` (default 10:200:20
@@ -48,6 +50,7 @@ from app.cli.options import (
     PARAMETER_FILE,
     UsageError,
     add_anti_slip_arguments,
+    add_case_lists,
     add_engine_options,
     add_rail,
     add_short_circuit,
@@ -55,6 +58,7 @@ from app.cli.options import (
     add_wheel_force_and_motor_slope,
     anti_slip_from,
     bounded,
+    case_lists,
     check_samples,
     input_file,
     load_parameters_from,
@@ -63,6 +67,8 @@ from app.cli.options import (
 )
 from app.cli.output import emit, writable_path
 from app.cli.runs import ProgressBar, study_engine
+
+GRID = ("s0", "v")  # the quantities the short_circuit case takes a list of
 
 
 def _load_ranges(path: str):
@@ -75,10 +81,10 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("assess", help="verdicts: safety factors of every press fit, "
                               "shaft and coupling in the short-circuit, unstable-adhesion and "
                               "starting load cases")
-    p.add_argument("--s0", default="0.002,0.005", metavar="LIST",
-                   help="short_circuit: stable creepages s0 [-] (default %(default)s)")
-    p.add_argument("--v", default="80,120,200", metavar="LIST",
-                   help="short_circuit: speeds [km/h] (default %(default)s)")
+    # the short_circuit grid: lists of s0 and v (stable creepages around the operating creepage,
+    # the speed range of service); one value of each other quantity of the point, for every case
+    add_case_lists(p, "point", names=GRID, defaults={"s0": "0.002,0.005", "v": "80,120,200"},
+                   what="short_circuit: ")
     add_wheel_force_and_motor_slope(p)
     add_rail(p)
     add_short_circuit(p, phase=False)  # every fault instant: no --phase
@@ -149,8 +155,8 @@ def options_from_args(args: argparse.Namespace):
     from model.studies.envelope import rail_parameters
 
     parameters = rail_parameters(load_parameters_from(args), args.rail)
-    s0 = quantity_values(args.s0, "s0", increasing=True)
-    v = [x * KMH for x in quantity_values(args.v, "v", increasing=True)]
+    grid = case_lists(args, parameters, "point", names=GRID)  # SI
+    s0, v = grid["s0"], grid["v"]
     if args.t_end is not None:
         check_samples(args)
     elif 60.0 * args.fs > MAX_SAMPLES:
@@ -164,7 +170,7 @@ def options_from_args(args: argparse.Namespace):
     except ExcitationError as error:
         raise UsageError(f"--ripple: {error}") from None
     ripple_v = [x * KMH for x in quantity_values(args.ripple_v, "v", increasing=True,
-                                                          option="--ripple-v")]
+                                                 option="--ripple-v")]
     running = {}
     if args.running:
         from model.analysis.wheel_excitation import parse_polygon

@@ -1,6 +1,7 @@
 """``bogie envelope`` and ``bogie spectrum``: design loads from the command line.
 
-    bogie envelope [--s0 LIST] [--v LIST] [--n0 LIST] [--bm LIST] [--rail calibrated,dry,wet]
+    bogie envelope [--s0 LIST] [--v LIST] [--n0 LIST] [--bm LIST] [--motor-bandwidth LIST]
+                   [--rail calibrated,dry,wet]
                    [--m0 LIST] [--f LIST] [--decay LIST] [--phase LIST|all]
                    [--creep linear|nonlinear|tangent] [--anti-slip off,on] [--anti-slip-delay LIST]
                    [--t-end T --fs FS --outputs a,b --method M] [--params FILE]
@@ -8,7 +9,9 @@
                    [--json]
     bogie spectrum … the options of ``bogie response`` … [--slopes 3,5] [--out F.npz|.csv|.json]
 
-A LIST is ``A,B,C`` or ``A:B:N`` (N values from A to B), increasing; speeds in km/h.  Without
+A LIST is ``A,B,C`` or ``A:B:N`` (N values from A to B), increasing; speeds in km/h.  The lists
+are the case's quantities (:data:`app.results.case.QUANTITIES`), one option each as the
+dashboard's sliders; ``--motor-bandwidth`` not given: the parameter set's own.  Without
 ``--phase`` the fault instants are the two continuity roots per period (physics first); a
 ``--phase`` grid [s] or ``all`` (closed form over every Δt, linear creep) is the explicitly
 conservative case.  The envelope runs on the study engine (a local Dask cluster by default, as
@@ -29,13 +32,14 @@ import numpy as np
 from app.cli.options import (
     ANTI_SLIP_OPTIONS,
     PARAMETER_FILE,
-    RAILS,
     UsageError,
     add_anti_slip_arguments,
+    add_case_lists,
     add_engine_options,
     add_history_options,
     add_output_selection,
     add_time_grid,
+    case_lists,
     check_samples,
     check_sampling,
     output_names,
@@ -44,32 +48,19 @@ from app.cli.options import (
 )
 from app.cli.output import check_history_file, writable_path
 from app.cli.runs import ProgressBar, history_from_args, resume_store, study_engine
+from app.results.case import Case
 
+CASE_ROLES = ("set", "point", "override", "short_circuit")  # the case's quantities it lists
 AXIS_LABELS = {"rail": "rail", "s0": "s0", "v": "v [km/h]", "N0": "N0 [N]", "b_M": "b_M",
-               "M0": "M0 [N m]", "f": "f [Hz]", "D": "D", "anti_slip": "anti-slip",
+               "motor_bandwidth": "f_c [Hz]", "M0": "M0 [N m]", "f": "f [Hz]", "D": "D", "anti_slip": "anti-slip",
                "anti_slip_delay": "delay [s]"}
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("envelope", help="design loads: max and min of every output over "
                               "a grid of short-circuit scenarios, and where they occur")
-    p.add_argument("--s0", default="0.005", metavar="LIST", help="creepages s0 [-] (default "
-                   "%(default)s)")
-    p.add_argument("--v", default="120", metavar="LIST", help="speeds [km/h] (default "
-                   "%(default)s)")
-    p.add_argument("--n0", default=None, metavar="LIST",
-                   help="wheel forces N0 [N] (default: the parameter set's)")
-    p.add_argument("--bm", default=None, metavar="LIST",
-                   help="motor slopes b_M [N m s/rad] (default: the parameter set's)")
-    p.add_argument("--rail", default="calibrated", metavar="LIST",
-                   help="creep laws: calibrated (the set's own), dry, wet (Polach's presets); "
-                        "default %(default)s")
-    p.add_argument("--m0", default="50000", metavar="LIST",
-                   help="amplitudes M0 of the oscillating part [N m] (default %(default)s)")
-    p.add_argument("--f", default="90", metavar="LIST",
-                   help="frequencies f of the oscillating part [Hz] (default %(default)s)")
-    p.add_argument("--decay", default="0.04", metavar="LIST",
-                   help="decays D [-] (default %(default)s)")
+    # every quantity of the case a value list (the fault instant: --phase, below)
+    add_case_lists(p, *CASE_ROLES)
     p.add_argument("--phase", default=None, metavar="LIST|all",
                    help="fault instants Δt [s], or 'all' (every Δt in closed form; linear creep) "
                         "(default: the two continuity roots per period)")
@@ -113,24 +104,19 @@ def _names(text: str, label: str) -> list[str]:
 def study_from_args(args: argparse.Namespace):
     """(:class:`model.studies.envelope.EnvelopeStudy`, parameters) from the options."""
     from model.analysis.response import ResponseError
-    from model.mechanics.operating_point import KMH, OperatingPoint
+    from model.mechanics.operating_point import OperatingPoint
     from model.mechanics.parameters import load_parameters
-    from model.studies.envelope import DesignLoadError, EnvelopeStudy, rail_parameters, resolve_outputs
+    from model.studies.envelope import (
+        SET_VALUE_DIMS,
+        DesignLoadError,
+        EnvelopeStudy,
+        rail_parameters,
+        resolve_outputs,
+    )
 
     parameters = load_parameters(args.params)
-    s0 = quantity_values(args.s0, "s0", increasing=True)
-    v = [x * KMH for x in quantity_values(args.v, "v", increasing=True)]
-    n0 = (quantity_values(args.n0, "N0", increasing=True)
-          if args.n0 is not None else [parameters["wheel_force"]])
-    bm = (quantity_values(args.bm, "b_M", increasing=True)
-          if args.bm is not None else [parameters["motor_slope"]])
-    m0 = quantity_values(args.m0, "M0", increasing=True)
-    f = quantity_values(args.f, "f", increasing=True)
-    decay = quantity_values(args.decay, "D", increasing=True)
-    rails = _names(args.rail, "--rail")
-    unknown = [rail for rail in rails if rail not in RAILS]
-    if unknown:
-        raise UsageError(f"--rail: '{unknown[0]}' is not known, use {', '.join(RAILS)}")
+    lists = case_lists(args, parameters, *CASE_ROLES)  # SI, by quantity name
+    f = lists["f"]
     if args.phase is None:
         fault, phase = "roots", ()
     elif args.phase.strip() == "all":
@@ -152,16 +138,18 @@ def study_from_args(args: argparse.Namespace):
     check_samples(args)
     from model.studies.maps import cached_model
 
-    model = cached_model(rail_parameters(parameters, rails[0]))
-    first = OperatingPoint(s0[0], v[0], n0[0], bm[0])
+    axes = {q.target: lists[q.name] for q in Case.of_role(*CASE_ROLES) if q.name in lists}
+    first_set = parameters.replace(**{name: lists[name][0] for name in SET_VALUE_DIMS
+                                      if lists.get(name)})
+    model = cached_model(rail_parameters(first_set, lists["rail"][0]))
+    first = OperatingPoint(**{q.target: lists[q.name][0] for q in Case.of_role("point")})
     try:
         outputs, units = resolve_outputs(model, first, output_names(args), args.creep)
     except (ResponseError, DesignLoadError) as error:
         raise UsageError(f"--outputs: {error}") from None
     study = EnvelopeStudy(
-        s0=s0, v=v, N0=n0, b_M=bm, outputs=outputs, units=units, rail=tuple(rails), M0=m0, f=f,
-        D=decay, fault=fault, phase=tuple(phase), creep=args.creep, anti_slip=tuple(anti_slip),
-        anti_slip_delay=tuple(delays), anti_slip_threshold=args.anti_slip_threshold,
+        **axes, outputs=outputs, units=units, fault=fault, phase=tuple(phase), creep=args.creep,
+        anti_slip=tuple(anti_slip), anti_slip_delay=tuple(delays), anti_slip_threshold=args.anti_slip_threshold,
         anti_slip_rate=args.anti_slip_rate, anti_slip_floor=args.anti_slip_floor,
         t_end=args.t_end, fs=args.fs, method=args.method)
     return study, parameters
@@ -172,12 +160,11 @@ def _check_first_point(study, parameters, args) -> None:
     ``bogie response`` does; the other scenarios are checked after the run)."""
     from model.analysis.fault_instant import phase_families
     from model.mechanics.operating_point import OperatingPoint
-    from model.studies.envelope import rail_parameters
     from model.studies.maps import cached_model
 
     if study.creep != "linear":
         return
-    model = cached_model(rail_parameters(parameters, study.rail[0]))
+    model = cached_model(study.chunk_parameters(parameters, {}))
     op = OperatingPoint(study.s0[0], study.v[0], study.N0[0], study.b_M[0])
     family = phase_families(model, op, [(max(study.f), study.D[0])], study.t_end, study.fs,
                             list(study.outputs), study.method)[0]
@@ -247,7 +234,8 @@ def envelope_table(study, result, out: Path | None) -> str:
     from model.studies.envelope import FAULT_DESCRIPTIONS
 
     varying = [d for d, n in study.sizes.items() if n > 1 and d in AXIS_LABELS]
-    keys = {"rail": "rail", "s0": "s0", "v": "v_kmh", "N0": "n0", "b_M": "bm", "M0": "m0",
+    keys = {"rail": "rail", "s0": "s0", "v": "v_kmh", "N0": "n0", "b_M": "bm",
+            "motor_bandwidth": "motor_bandwidth", "M0": "m0",
             "f": "f", "D": "decay", "anti_slip": "anti_slip", "anti_slip_delay":
             "anti_slip_delay_s"}
 

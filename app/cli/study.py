@@ -1,14 +1,18 @@
 """``bogie study``: parameter studies on Dask (a local cluster by default, a cluster by address).
 
-    bogie study map   --s0 A:B:N --v A:B:N [--n0 LIST] [--bm LIST] [--params FILE] [--rail R]
+    bogie study map   --s0 A:B:N --v A:B:N [--n0 LIST] [--bm LIST] [--motor-bandwidth LIST]
+                      [--params FILE] [--rail R]
                       --out X.zarr [--scheduler tcp://HOST:PORT] [--workers N] [--resume]
-    bogie study limit --v A:B:N [--n0 LIST] [--bm LIST] … --out X.zarr …
+    bogie study limit --v A:B:N [--n0 LIST] [--bm LIST] [--motor-bandwidth LIST] … --out X.zarr …
     bogie study uncertainty --samples N [--seed S] [--params FILE] --out U.json
                       [--posterior | --no-indices] [--speeds LIST]
                       [--scheduler tcp://HOST:PORT] [--workers N] [--serial]
 
-``A:B:N`` is N values from A to B (N = 1: A alone); a LIST is comma-separated values or A:B:N.
-Speeds in km/h on the command line (m/s in the store).  Results: an xarray Dataset in a Zarr
+``A:B:N`` is N values from A to B (N = 1: A alone); a LIST is comma-separated values or A:B:N,
+increasing.  The lists are the case's quantities (:data:`app.results.case.QUANTITIES`), one option
+each as the dashboard's sliders; ``--motor-bandwidth`` (the converter's torque control f_c [Hz],
+a value of the parameter set: a model per value) not given: the set's own, and the store has no
+such dimension.  Speeds in km/h on the command line (m/s in the store).  Results: an xarray Dataset in a Zarr
 store (:mod:`model.studies.store`).  A progress bar with the time left goes to stderr.  Ctrl-C
 stops cleanly: the finished chunks stay in the store, ``--resume`` computes the rest.  Bad input
 (an empty range, N < 1, a store of another study, an unreachable scheduler): one line on
@@ -28,23 +32,28 @@ import numpy as np
 from app.cli.options import (
     PARAMETER_FILE,
     UsageError,
+    add_case_lists,
     add_engine_options,
     add_rail,
     add_uncertainty_options,
     bounded,
+    case_lists,
     positive_int,
-    quantity_values,
     uncertainty_options,
 )
 from app.cli.output import writable_path
 from app.cli.runs import ProgressBar, resume_store, study_engine
+from app.results.case import Case
+
+POINT_ROLES = ("point", "override")  # the case's quantities a study lists (the rail: one)
 
 
-def _common(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--n0", default=None, metavar="LIST",
-                   help="wheel forces N0 [N]: x1,x2,… or A:B:N (default: the parameter set's)")
-    p.add_argument("--bm", default=None, metavar="LIST",
-                   help="motor slopes b_M [N m s/rad]: x1,x2,… or A:B:N (default: the set's)")
+def _common(p: argparse.ArgumentParser, *, creepage: bool) -> None:
+    """The value lists of the case's quantities (``creepage``: with ``--s0``; ``--s0`` and ``--v``
+    required) and the options every map and limit study has."""
+    add_case_lists(p, *POINT_ROLES, names=None if creepage else
+                   tuple(name for name in Case.names(*POINT_ROLES) if name != "s0"),
+                   required=("s0", "v"))
     p.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
     add_rail(p)
@@ -58,9 +67,8 @@ def _common(p: argparse.ArgumentParser) -> None:
 def register(subparsers) -> None:
     p = subparsers.add_parser("study", help="parameter studies on Dask: stability map, s0*(v)")
     sub = p.add_subparsers(dest="study_command", required=True)
-    m = sub.add_parser("map", help="stability map over s0 × v (× N0 × b_M)")
-    m.add_argument("--s0", required=True, metavar="A:B:N", help="creepages s0 [-], increasing")
-    m.add_argument("--v", required=True, metavar="A:B:N", help="speeds [km/h]")
+    m = sub.add_parser("map", help="stability map over s0 × v (× N0 × b_M × f_c)")
+    _common(m, creepage=True)
     m.add_argument("--max-frequency", type=bounded("--max-frequency (Hz)", "(0.5, 500)", "Hz"),
                    default=10.0, help="method reduced: reduction basis disc |λ| < 2π f [Hz] "
                    "(default %(default)s)")
@@ -68,11 +76,9 @@ def register(subparsers) -> None:
                    default="reduced", help="per s0-line: the Galerkin-reduced model (default, "
                    "cheapest), the exact continuation of all eigenvalues, or a full "
                    "eigen-analysis per point")
-    _common(m)
     m.set_defaults(func=cmd_map)
-    limit = sub.add_parser("limit", help="stability limit s0*(v) for lists of N0 and b_M")
-    limit.add_argument("--v", required=True, metavar="A:B:N", help="speeds [km/h]")
-    _common(limit)
+    limit = sub.add_parser("limit", help="stability limit s0*(v) for lists of N0, b_M and f_c")
+    _common(limit, creepage=False)
     limit.set_defaults(func=cmd_limit)
     u = sub.add_parser("uncertainty", help="the Monte-Carlo/Sobol study of `bogie uncertainty` "
                        "(docs/sensitivity.md) on the same engine")
@@ -97,24 +103,18 @@ def _parameters(args):
     return rail_parameters(load_parameters(args.params), args.rail)
 
 
-def _grids(args, parameters):
-    from model.mechanics.operating_point import KMH
-
-    v = [x * KMH for x in quantity_values(args.v, "v", increasing=True)]
-    n0 = (quantity_values(args.n0, "N0") if args.n0 is not None
-          else [parameters["wheel_force"]])
-    bm = (quantity_values(args.bm, "b_M") if args.bm is not None
-          else [parameters["motor_slope"]])
-    return v, n0, bm
+def _grids(args, parameters) -> dict[str, tuple]:
+    """The study's axes by its field names (SI) from the value lists of the case's quantities
+    (the set's N0 and b_M where not given; no f_c list: the set's own)."""
+    lists = case_lists(args, parameters, *POINT_ROLES)
+    return {q.target: lists[q.name] for q in Case.of_role(*POINT_ROLES) if q.name in lists}
 
 
 def cmd_map(args: argparse.Namespace) -> None:
     from model.studies.maps import MapStudy
 
     parameters = _parameters(args)
-    s0 = quantity_values(args.s0, "s0", increasing=True)
-    v, n0, bm = _grids(args, parameters)
-    _run(args, MapStudy(s0, v, n0, bm, max_frequency_hz=args.max_frequency,
+    _run(args, MapStudy(**_grids(args, parameters), max_frequency_hz=args.max_frequency,
                         method=args.method), parameters)
 
 
@@ -122,8 +122,7 @@ def cmd_limit(args: argparse.Namespace) -> None:
     from model.studies.maps import LimitStudy
 
     parameters = _parameters(args)
-    v, n0, bm = _grids(args, parameters)
-    _run(args, LimitStudy(v, n0, bm), parameters)
+    _run(args, LimitStudy(**_grids(args, parameters)), parameters)
 
 
 def cmd_uncertainty(args: argparse.Namespace) -> None:
@@ -193,9 +192,12 @@ def _run(args: argparse.Namespace, study, parameters) -> None:
     if args.json:
         print(json.dumps(summary, indent=1, allow_nan=False))
         return
-    for (i, j, k), value in np.ndenumerate(limits):
+    for index, value in np.ndenumerate(limits):
+        i, j, k = index[:3]
+        control = (f", f_c = {dataset['motor_bandwidth'].values[index[3]]:g} Hz"
+                   if len(index) > 3 else "")
         lines.append(f"  v = {dataset['v_kmh'].values[i]:7.2f} km/h, N0 = {dataset['N0'].values[j]:g} N, "
-                     f"b_M = {dataset['b_M'].values[k]:g} N m s/rad: s0* = "
+                     f"b_M = {dataset['b_M'].values[k]:g} N m s/rad{control}: s0* = "
                      + ("none in range" if np.isnan(value) else f"{value:.6f}"))
         if len(lines) > 25:
             lines.append("  … (open the store with xarray for all)")

@@ -115,10 +115,9 @@ def peak_map(data: EnvelopeData, output: str, statistic: str, x_axis: str, y_axi
              ) -> np.ndarray:
     """The max (``statistic`` "max") or min over every other dimension of ``output``'s peaks, as
     a len(y) x len(x) array over the two axes (nan: not computed yet)."""
-    from model.studies.envelope import SCENARIO_DIMS
-
+    dims = data.study.scenario_dims
     values = data.arrays[statistic][list(data.study.outputs).index(output)]
-    keep = [SCENARIO_DIMS.index(x_axis), SCENARIO_DIMS.index(y_axis)]
+    keep = [dims.index(x_axis), dims.index(y_axis)]
     others = tuple(i for i in range(values.ndim) if i not in keep)
     reduce = np.fmax.reduce if statistic == "max" else np.fmin.reduce  # nan: not yet, no warning
     reduced = reduce(values, axis=others) if others else values

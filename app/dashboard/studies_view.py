@@ -74,7 +74,9 @@ def read_map(path: str | Path, n0_index: int = 0, bm_index: int = 0,
         if dataset.attrs.get("study") != "map":
             raise ValueError(f"'{name}' is not a stability-map store")
         dataset = dataset[["largest_real_part", "s0_limit", "chunk_done"]]
-        sliced = dataset.isel(N0=n0_index, b_M=bm_index).load()
+        # a store of ``bogie study map --motor-bandwidth LIST`` has a dimension per f_c: its first
+        extra = {name: 0 for name in ("motor_bandwidth",) if name in dataset.dims}
+        sliced = dataset.isel(N0=n0_index, b_M=bm_index, **extra).load()
         done = dataset["chunk_done"].values
         growth = np.where(sliced["chunk_done"].values[None, :] == 1,
                           sliced["largest_real_part"].values, np.nan)

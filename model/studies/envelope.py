@@ -8,6 +8,7 @@ API::
 
 **Scenario.**  One short circuit of ID1's motor as ``bogie response`` computes it: rail (creep
 law: the set's own or Polach's dry/wet preset), s0 [-], v [m/s], N0 [N], b_M [N m s/rad], the
+torque-control bandwidth f_c [Hz] of ID2's converter (a list, or the set's own), the
 excitation M0 [N m], f [Hz], D [-], the fault instant Δt [s] and, with nonlinear creep, the
 anti-slip protection (off/on) and its delay [s].  Its **peaks** are the max and the min over the
 time grid ``t = k/fs``, k = 0 … round(t_end·fs), of each output's *total* (pre-fault value plus
@@ -62,6 +63,10 @@ FAULT_DESCRIPTIONS = {
 CREEP_MODELS = ("linear", "nonlinear", "tangent")
 SCENARIO_DIMS = ("rail", "s0", "v", "N0", "b_M", "M0", "f", "D", "fault", "anti_slip",
                  "anti_slip_delay")
+# the parameter set's values a study may take a list of (each a dimension after b_M when given;
+# not given: the set's own value, no dimension — so a store written before stays readable)
+SET_VALUE_DIMS = ("motor_bandwidth",)
+SET_VALUE_UNITS = {"motor_bandwidth": "Hz"}
 PEAK_VARIABLES = ("max", "min", "time_of_max", "time_of_min", "phase_of_max", "phase_of_min")
 
 
@@ -90,10 +95,21 @@ def _axis(values, label: str) -> tuple[float, ...]:
     return values
 
 
+def set_value_axis(values, label: str) -> tuple[float, ...]:
+    """A list of the parameter set's values a study varies (empty: the set's own; else finite,
+    distinct, >= 0 — the set's own checks come when a chunk replaces the value)."""
+    if values is None or len(values) == 0:
+        return ()
+    values = _axis(values, label)
+    if min(values) < 0:
+        raise DesignLoadError(f"{label}: {min(values):g} is not allowed, must be >= 0")
+    return values
+
+
 @dataclass(frozen=True)
 class EnvelopeStudy:
     """A grid of short-circuit scenarios (SI units; module docstring).  Axes are tuples; the grid
-    is their product.  A chunk is one operating point (rail, s0, v, N0, b_M) with linear creep
+    is their product.  A chunk is one operating point (rail, s0, v, N0, b_M, f_c) with linear creep
     (every M0, f, D and fault instant from :func:`phase_families`), one scenario with nonlinear
     creep (every anti-slip delay of it)."""
 
@@ -103,6 +119,8 @@ class EnvelopeStudy:
     b_M: tuple[float, ...]  # motor slopes [N m s/rad]
     outputs: tuple[str, ...]  # output names (resolved: :func:`resolve_outputs`)
     units: tuple[str, ...]  # their units
+    # torque-control bandwidths f_c of ID2's converter [Hz] (empty: the parameter set's own)
+    motor_bandwidth: tuple[float, ...] = ()
     rail: tuple[str, ...] = ("calibrated",)
     M0: tuple[float, ...] = (50_000.0,)  # amplitudes [N m]
     f: tuple[float, ...] = (90.0,)  # frequencies [Hz]
@@ -124,6 +142,8 @@ class EnvelopeStudy:
         for name, label in (("s0", "--s0"), ("v", "--v"), ("N0", "--n0"), ("b_M", "--bm"),
                             ("M0", "--m0"), ("f", "--f"), ("D", "--decay")):
             object.__setattr__(self, name, _axis(getattr(self, name), label))
+        object.__setattr__(self, "motor_bandwidth", set_value_axis(self.motor_bandwidth,
+                                                                   "--motor-bandwidth"))
         object.__setattr__(self, "rail", tuple(self.rail))
         object.__setattr__(self, "anti_slip", tuple(self.anti_slip))
         object.__setattr__(self, "outputs", tuple(self.outputs))
@@ -191,6 +211,22 @@ class EnvelopeStudy:
     # --- the grid ---------------------------------------------------------------------------------
 
     @property
+    def scenario_dims(self) -> tuple[str, ...]:
+        """The dimensions of the scenario grid: :data:`SCENARIO_DIMS` with, after b_M, each
+        value of the parameter set the study gives a list of (:data:`SET_VALUE_DIMS`)."""
+        given = tuple(name for name in SET_VALUE_DIMS if getattr(self, name))
+        at = SCENARIO_DIMS.index("b_M") + 1
+        return SCENARIO_DIMS[:at] + given + SCENARIO_DIMS[at:]
+
+    def chunk_parameters(self, parameters: Parameters, key: dict[str, int]) -> Parameters:
+        """The parameter set of the scenarios at ``key`` (dimension -> index): the rail's creep
+        law and the set's values the study varies."""
+        parameters = rail_parameters(parameters, self.rail[key.get("rail", 0)])
+        changes = {name: getattr(self, name)[key.get(name, 0)] for name in SET_VALUE_DIMS
+                   if getattr(self, name)}
+        return parameters.replace(**changes) if changes else parameters
+
+    @property
     def fault_count(self) -> int:
         """Entries of the fault-instant axis: 2 roots, the grid's phases, or 1 (all)."""
         return {"roots": 2, "grid": len(self.phase), "all": 1}[self.fault]
@@ -198,7 +234,7 @@ class EnvelopeStudy:
     @property
     def sizes(self) -> dict[str, int]:
         """Dimension -> length of the scenario grid (and "output")."""
-        sizes = {name: len(getattr(self, name)) for name in SCENARIO_DIMS[:8]}
+        sizes = {name: len(getattr(self, name)) for name in self.scenario_dims[:-3]}
         sizes["fault"] = self.fault_count
         sizes["anti_slip"] = len(self.anti_slip)
         sizes["anti_slip_delay"] = max(1, len(self.anti_slip_delay))
@@ -208,14 +244,15 @@ class EnvelopeStudy:
     def scenarios(self) -> int:
         """Distinct scenarios (protection off counts once whatever the delays)."""
         sizes = self.sizes
-        rest = math.prod(sizes[d] for d in SCENARIO_DIMS[:9])
+        rest = math.prod(sizes[d] for d in self.scenario_dims[:-2])
         protections = sum(1 if a == "off" else sizes["anti_slip_delay"] for a in self.anti_slip)
         return rest * protections
 
     @property
     def marker_dims(self) -> tuple[str, ...]:
         """Dimensions a chunk key indexes."""
-        return SCENARIO_DIMS[:5] if self.creep == "linear" else SCENARIO_DIMS[:-1]
+        dims = self.scenario_dims
+        return dims[:dims.index("M0")] if self.creep == "linear" else dims[:-1]
 
     def chunks(self) -> list[tuple[int, ...]]:
         sizes = self.sizes
@@ -227,6 +264,8 @@ class EnvelopeStudy:
         data = {"kind": self.kind}
         for name in names:
             value = getattr(self, name)
+            if name in SET_VALUE_DIMS and not value:
+                continue  # the set's own: as a study written before the option existed
             data[name] = list(value) if isinstance(value, tuple) else value
         return data
 
@@ -257,7 +296,7 @@ class EnvelopeStudy:
         from model.studies.store import StoreLayout
 
         sizes = self.sizes
-        dims = ("output", *SCENARIO_DIMS)
+        dims = ("output", *self.scenario_dims)
         delays = np.array(self.anti_slip_delay) if self.anti_slip_delay else np.array([np.nan])
         fault_phase = np.array(self.phase) if self.fault == "grid" \
             else np.full(self.fault_count, np.nan)
@@ -271,6 +310,8 @@ class EnvelopeStudy:
             "v_kmh": (("v",), np.array(self.v) / KMH, {"units": "km/h"}),
             "N0": (("N0",), np.array(self.N0), {"units": "N"}),
             "b_M": (("b_M",), np.array(self.b_M), {"units": "N m s/rad"}),
+            **{name: ((name,), np.array(getattr(self, name)), {"units": SET_VALUE_UNITS[name]})
+               for name in SET_VALUE_DIMS if getattr(self, name)},
             "M0": (("M0",), np.array(self.M0), {"units": "N m"}),
             "f": (("f",), np.array(self.f), {"units": "Hz"}),
             "D": (("D",), np.array(self.D), {"units": "-"}),
@@ -292,7 +333,7 @@ class EnvelopeStudy:
         }
         variables = {name: (dims, np.float64, np.nan, {"units": unit, "description": text_})
                      for name, (text_, unit) in described.items()}
-        variables["truncated_at"] = (SCENARIO_DIMS, np.float64, np.nan, {
+        variables["truncated_at"] = (self.scenario_dims, np.float64, np.nan, {
             "units": "s", "description": "linear growth beyond 1e250: the grid ends here "
                                          "(nan: the whole horizon)"})
         variables["highest_excited_hz"] = (self.marker_dims, np.float64, np.nan, {
@@ -306,8 +347,10 @@ class EnvelopeStudy:
         """The peaks of chunk ``key`` as plain arrays (what the store writes)."""
         from model.studies.maps import cached_model
 
-        model = cached_model(rail_parameters(parameters, self.rail[key[0]]))
-        op = OperatingPoint(self.s0[key[1]], self.v[key[2]], self.N0[key[3]], self.b_M[key[4]])
+        key = dict(zip(self.marker_dims, key, strict=True))
+        model = cached_model(self.chunk_parameters(parameters, key))
+        op = OperatingPoint(self.s0[key["s0"]], self.v[key["v"]], self.N0[key["N0"]],
+                            self.b_M[key["b_M"]])
         if self.creep == "linear":
             return self._linear_chunk(model, op)
         return self._nonlinear_chunk(model, op, key)
@@ -343,11 +386,11 @@ class EnvelopeStudy:
     def _nonlinear_chunk(self, model: BogieModel, op: OperatingPoint, key) -> dict:
         from model.analysis.nonlinear import nonlinear_response
 
-        M0, f, D = self.M0[key[5]], self.f[key[6]], self.D[key[7]]
+        M0, f, D = self.M0[key["M0"]], self.f[key["f"]], self.D[key["D"]]
         step = motor_torque(model.parameters, op)
-        dt = self.fault_phases(step, M0, f)[key[8]]
+        dt = self.fault_phases(step, M0, f)[key["fault"]]
         excitation = ShortCircuit(M0=M0, f=f, D=D, dt=dt)
-        delays = [None] if self.anti_slip[key[9]] == "off" else list(self.anti_slip_delay)
+        delays = [None] if self.anti_slip[key["anti_slip"]] == "off" else list(self.anti_slip_delay)
         runs = []
         for delay in delays:
             r = nonlinear_response(model, op, excitation, self.t_end, self.fs, creep=self.creep,
@@ -416,11 +459,13 @@ class Envelope:
 
 
 def _scenario(study: EnvelopeStudy, index: tuple[int, ...], phase: float, time: float) -> dict:
-    """The scenario at grid ``index`` (over SCENARIO_DIMS) as the JSON ``…_at`` dict."""
-    i = dict(zip(SCENARIO_DIMS, index, strict=True))
+    """The scenario at grid ``index`` (over the study's scenario dimensions) as the JSON
+    ``…_at`` dict (a value of the set the study varies under its name: ``motor_bandwidth``)."""
+    i = dict(zip(study.scenario_dims, index, strict=True))
     at = {"s0": study.s0[i["s0"]], "v_kmh": study.v[i["v"]] / KMH, "phase_s": float(phase),
           "rail": study.rail[i["rail"]], "n0": study.N0[i["N0"]], "bm": study.b_M[i["b_M"]],
           "m0": study.M0[i["M0"]], "f": study.f[i["f"]], "decay": study.D[i["D"]]}
+    at.update({name: getattr(study, name)[i[name]] for name in SET_VALUE_DIMS if name in i})
     if study.creep != "linear":
         on = study.anti_slip[i["anti_slip"]] == "on"
         at["anti_slip"] = "on" if on else "off"
@@ -431,7 +476,7 @@ def _scenario(study: EnvelopeStudy, index: tuple[int, ...], phase: float, time: 
 
 def envelope(study: EnvelopeStudy, arrays: dict[str, np.ndarray]) -> Envelope:
     """The envelope of the per-scenario peaks ``arrays`` (name -> array over ("output",
-    *SCENARIO_DIMS), as :meth:`EnvelopeStudy.store_layout` lays them out)."""
+    *study.scenario_dims), as :meth:`EnvelopeStudy.store_layout` lays them out)."""
     maxima, minima = arrays["max"], arrays["min"]
     if np.isnan(maxima).any() or np.isnan(minima).any():
         raise DesignLoadError("the study is not complete: some scenarios have no peaks")

@@ -48,7 +48,7 @@ from model.mechanics.parameters import Parameters, parameter_hash
 UNITS = {"largest_real_part": "1/s", "stable": "-", "flutter_pairs": "-", "divergent_real": "-",
          "dense_points": "-", "s0_limit": "-", "outside_max_real_part": "1/s",
          "evaluations": "-", "chunk_done": "-", "s0": "-", "v": "m/s", "v_kmh": "km/h", "N0": "N",
-         "b_M": "N m s/rad"}
+         "b_M": "N m s/rad", "motor_bandwidth": "Hz"}
 DESCRIPTIONS = {
     "largest_real_part": "largest real part of all non-rigid eigenvalues",
     "stable": "all non-rigid eigenvalues in the closed left half-plane",
@@ -123,9 +123,9 @@ def store_layout(study) -> StoreLayout:
     own = getattr(study, "store_layout", None)
     if own is not None:
         return own()
-    point_dims = ("v", "N0", "b_M")
-    coords = {"v": ("v", np.array(study.v)), "N0": ("N0", np.array(study.N0)),
-              "b_M": ("b_M", np.array(study.b_M)), "v_kmh": ("v", np.array(study.v) / KMH)}
+    point_dims = study.point_dims  # v, N0, b_M and each list of the set's values given
+    coords = {name: (name, np.array(getattr(study, name))) for name in point_dims}
+    coords["v_kmh"] = ("v", np.array(study.v) / KMH)
     if study.kind == "map":
         coords["s0"] = ("s0", np.array(study.s0))
     coords = {name: ((dims,), data, {"units": UNITS[name]}) for name, (dims, data)
