@@ -235,7 +235,8 @@ def assessment_table(result) -> str:
 def cmd_assess(args: argparse.Namespace) -> None:
     from model.studies.assessment import assess, short_circuit_points
 
-    writable_path(args.write_samples, "--write-samples", directory=True)  # before any work
+    writable_path(args.write_samples, "--write-samples", directory=True,  # before any work
+                  parents=True)
     writable_path(args.out, "--out", suffixes=(".json",))
     parameters, options = options_from_args(args)
     short_circuit_points(parameters, options)  # an unstable grid point: refused before any work

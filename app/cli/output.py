@@ -27,9 +27,10 @@ def emit(args: argparse.Namespace, data: dict, table: str) -> None:
 
 
 def writable_path(text: str | None, option: str, *, suffixes: tuple[str, ...] = (),
-                  directory: bool = False) -> Path | None:
+                  directory: bool = False, parents: bool = False) -> Path | None:
     """The output ``text`` of ``option`` (``--out``), checked before any work: not empty, ending
-    in one of ``suffixes`` (any without), in an existing directory, not a directory itself (a
+    in one of ``suffixes`` (any without), in an existing directory (``parents``: the command
+    creates the missing ones, the nearest existing one is checked), not a directory itself (a
     file) or not a file (``directory``: a folder the command fills, created if missing), and
     writable — a temporary file is created there and removed at once (a permission check
     alone says yes to root on a read-only or virtual file system such as /proc).  None
@@ -38,10 +39,12 @@ def writable_path(text: str | None, option: str, *, suffixes: tuple[str, ...] = 
         return None
     if not text.strip():
         raise UsageError(f"{option}: the path is empty")
-    path = Path(text)
+    path = Path(text).expanduser()
     if suffixes and path.suffix.lower() not in suffixes:
         raise UsageError(f"{option} '{text}': the file name must end in {' or '.join(suffixes)}")
     folder = path.parent
+    while parents and not folder.exists() and folder != folder.parent:
+        folder = folder.parent
     if not folder.is_dir():
         raise UsageError(f"{option} '{text}': directory '{folder}' does not exist")
     if path.exists():

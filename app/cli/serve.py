@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 
 from app.cli.options import PARAMETER_FILE, bounded, non_negative_int, number, positive_int
+from app.cli.output import writable_path
 from app.results.cache import DEFAULT_CACHE_MB
 from app.services.settings import DEFAULT_BACKGROUND_WORKERS, MAX_CACHE_MB, MIN_CACHE_MB
 
@@ -66,6 +67,7 @@ def cmd_serve(args: argparse.Namespace) -> None:
     from app.server.serve import serve
     from app.services.settings import ServerSettings
 
+    writable_path(args.studies_dir, "--studies-dir", directory=True, parents=True)
     settings = ServerSettings.from_options(
         scheduler=args.scheduler, studies_dir=args.studies_dir,
         max_study_points=args.max_study_points, max_running_studies=args.max_running_studies,

@@ -202,6 +202,8 @@ def test_bad_values_give_one_line_naming_the_option(words, option, tmp_path, cap
         said = f"bogie {' '.join(argv)}"
         assert "Traceback" not in err, f"{said}:\n{err}"
         assert code in (0, 2), f"{said}: exit {code}\n{err}"
+        if value is not None and _is_output(action) and (not value or value.startswith("/proc/")):
+            assert code == 2, f"{said}: an output it cannot write was accepted"
         if code == 2:
             assert err.endswith("\n"), f"{said}: not one line:\n{err}"
             assert err.count("\n") == 1, f"{said}: not one line:\n{err}"
