@@ -640,6 +640,27 @@ def output_names(args: argparse.Namespace) -> list[str] | None:
     return names
 
 
+def checked_output_names(args: argparse.Namespace, model, op, loads_only: bool = False
+                         ) -> list[str] | None:
+    """The names of ``--outputs`` (None: all loads), each a load of the model
+    (:func:`model.mechanics.outputs.output_matrices`) or, unless ``loads_only`` (nonlinear creep,
+    the frequency responses), a DOF name; an unknown one is refused naming the option, before
+    any work."""
+    from model.mechanics.outputs import output_matrices
+
+    names = output_names(args)
+    if names is None:
+        return None
+    loads = output_matrices(model, op).names
+    known = set(loads) if loads_only else set(loads) | set(model.dofs.names)
+    for name in names:
+        if name not in known:
+            dofs = "" if loads_only else f" or a DOF name (e.g. {model.dofs.names[0]})"
+            raise UsageError(f"--outputs: unknown output '{name}': use a load "
+                             f"({', '.join(loads[:3])}, …){dofs}")
+    return names
+
+
 def check_sampling(args: argparse.Namespace, frequency_hz: float, what: str,
                    digits: str = "g") -> None:
     """Refuse ``--fs`` below 2.5 × ``frequency_hz`` [Hz]; ``what`` names that frequency in the

@@ -25,9 +25,9 @@ from app.cli.options import (
     UsageError,
     add_operating_point,
     bounded,
+    checked_output_names,
     input_file,
     load_model,
-    output_names,
     parse_range,
     parse_values,
     positive_int,
@@ -173,6 +173,14 @@ def _excitation(args: argparse.Namespace):
     return excitation
 
 
+def _check_input(model, name: str) -> None:
+    from model.analysis.frequency_response import input_names
+
+    known = input_names(model)
+    if name not in known:
+        raise UsageError(f"--input: unknown input '{name}'; known: {', '.join(known)}")
+
+
 def _check_motor_input(model, name: str) -> None:
     from model.analysis.frequency_response import input_names
 
@@ -246,8 +254,10 @@ def cmd_frf(args: argparse.Namespace) -> None:
     count = len(band)
     csv_path = _check_csv(args.csv)
     model, op, _ = load_model(args)
+    outputs = checked_output_names(args, model, op, loads_only=True)
+    _check_input(model, args.input)
     result = frequency_response(model, op, input=args.input, f_lo=float(band[0]),
-                                f_hi=float(band[-1]), points=count, outputs=output_names(args),
+                                f_hi=float(band[-1]), points=count, outputs=outputs,
                                 min_peak=args.min_peak)
     if not np.all(np.isfinite(result.H)):
         raise UsageError("an output drifts with the rigid-body motion: no finite static gain")
@@ -369,8 +379,9 @@ def _ripple(args: argparse.Namespace) -> None:
         ripple = parse_amplitudes(args.ripple)
     except ExcitationError as error:
         raise UsageError(f"--ripple: {error}") from None
+    outputs = checked_output_names(args, model, op, loads_only=True)
     result = ripple_response(model, op, speeds, ripple, _excitation(args), input=args.input,
-                             outputs=output_names(args))
+                             outputs=outputs)
 
     def listed(values: np.ndarray) -> list[float | None]:
         return [float(x) if np.isfinite(x) else None for x in values]

@@ -19,8 +19,8 @@ from app.cli.options import (
     check_creep_arguments,
     check_samples,
     check_sampling,
+    checked_output_names,
     load_model,
-    output_names,
     short_circuit_from,
 )
 
@@ -35,8 +35,8 @@ def history_from_args(args: argparse.Namespace):
     excitation = short_circuit_from(args)
     check_sampling(args, excitation.f, f"the excitation at f = {excitation.f:g} Hz")
     check_samples(args)
-    names = output_names(args)
     model, op, _ = load_model(args)
+    names = checked_output_names(args, model, op, loads_only=args.creep != "linear")
     if args.creep != "linear":
         from model.analysis.nonlinear import nonlinear_response
 
