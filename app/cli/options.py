@@ -152,6 +152,20 @@ def positive_int(label: str, high: int | None = None) -> Callable[[str], int]:
     return parse
 
 
+# --- a Dask scheduler's address ------------------------------------------------------------------
+
+_ADDRESS = re.compile(r"^(?:[a-z]+://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):([0-9]{1,5})$")
+
+
+def scheduler_address(text: str) -> str:
+    """argparse type: a Dask scheduler's address ``[tcp://]host:port`` (port 1…65535): a
+    malformed one is refused at once, not after a connection attempt."""
+    match = _ADDRESS.match(text.strip())
+    if match is None or not 0 < int(match.group(2)) < 65536:
+        raise argparse.ArgumentTypeError(f"'{text}' is not an address tcp://HOST:PORT")
+    return text.strip()
+
+
 # --- input files ---------------------------------------------------------------------------------
 
 def input_file(load: Callable[[str], object] | None = None) -> Callable[[str], str]:
@@ -678,7 +692,7 @@ EXIT_INTERRUPTED = 130  # Ctrl-C: the store keeps the finished chunks (resume wi
 
 def add_engine_options(p: argparse.ArgumentParser) -> None:
     """``--scheduler``, ``--workers``, ``--serial``, ``--connect-timeout``."""
-    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+    p.add_argument("--scheduler", type=scheduler_address, default=None, metavar="tcp://HOST:PORT",
                    help="attach to a running Dask scheduler (default: $DASK_SCHEDULER_ADDRESS, "
                         "else a local cluster)")
     p.add_argument("--workers", type=positive_int("--workers"), default=None,

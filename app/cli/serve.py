@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import argparse
 
-from app.cli.options import PARAMETER_FILE, bounded, non_negative_int, number, positive_int
+from app.cli.options import PARAMETER_FILE, bounded, non_negative_int, number, positive_int, scheduler_address
 from app.cli.output import writable_path
 from app.results.cache import DEFAULT_CACHE_MB
 from app.services.settings import DEFAULT_BACKGROUND_WORKERS, MAX_CACHE_MB, MIN_CACHE_MB
@@ -28,7 +28,7 @@ def register(subparsers) -> None:
                    help="host[:port] allowed to open the websocket (repeatable; environment: "
                         "BOGIE_ALLOWED_ORIGINS, comma-separated)")
     p.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE", help="parameter file (TOML)")
-    p.add_argument("--scheduler", default=None, metavar="ADDR",
+    p.add_argument("--scheduler", type=scheduler_address, default=None, metavar="ADDR",
                    help="Dask scheduler the dashboard's studies run on (tcp://host:port; "
                         "environment: BOGIE_SCHEDULER); default: one local cluster of this server, "
                         "started on the first study, one worker process per core, shared by all "

@@ -127,6 +127,13 @@ class StudyEngine:
         from distributed import Client, LocalCluster
 
         if self.scheduler:
+            from distributed.comm.addressing import parse_address, parse_host_port
+
+            try:  # a malformed address: refused before a client exists (its clean-up would hang)
+                parse_host_port(parse_address(self.scheduler)[1])
+            except ValueError as error:
+                raise EngineUnavailable(f"the Dask scheduler's address '{self.scheduler}' is not "
+                                        f"valid: {error}") from None
             try:
                 self.client = Client(self.scheduler, timeout=self.connect_timeout,
                                      set_as_default=False)

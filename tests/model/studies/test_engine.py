@@ -290,3 +290,17 @@ def test_a_local_cluster_starts_when_port_8787_is_taken(supervised):
         engine.close()
         if holder is not None:
             holder.close()
+
+
+@pytest.mark.parametrize("address", ["abc", "tcp://scheduler", "tcp://host:port"])
+def test_a_malformed_scheduler_address_is_refused_before_a_client_exists(address):
+    """No client is made for an address without a port (distributed's half-made client would
+    print a traceback while the interpreter exits): one-line EngineUnavailable at once."""
+    from model.studies.engine import EngineUnavailable, StudyEngine
+
+    engine = StudyEngine(address, connect_timeout=1.0)
+    start = time.monotonic()
+    with pytest.raises(EngineUnavailable, match="is not valid"):
+        engine.start()
+    assert engine.client is None
+    assert time.monotonic() - start < 1.0  # refused, not timed out
