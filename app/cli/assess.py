@@ -59,9 +59,11 @@ from app.cli.options import (
     anti_slip_from,
     bounded,
     case_lists,
+    check_sample_count,
     check_samples,
     input_file,
     load_parameters_from,
+    non_negative_int,
     quantity_values,
     short_circuit_from,
 )
@@ -127,8 +129,8 @@ def register(subparsers) -> None:
     samples.add_argument("--samples", type=int, default=None, metavar="N",
                          help="N scrambled Sobol' samples (a power of two) of the unknowns' "
                               "prior ranges, each a whole assessment")
-    samples.add_argument("--seed", type=int, default=12, help="the scrambling's seed "
-                                                             "(default %(default)s)")
+    samples.add_argument("--seed", type=non_negative_int("--seed"), default=12,
+                         help="the scrambling's seed (default %(default)s)")
     samples.add_argument("--indices", action="store_true",
                          help="first-order and total Sobol indices (N (d + 2) dynamics runs)")
     samples.add_argument("--ranges", type=input_file(_load_ranges), default=None, metavar="FILE",
@@ -238,6 +240,8 @@ def cmd_assess(args: argparse.Namespace) -> None:
     writable_path(args.write_samples, "--write-samples", directory=True,  # before any work
                   parents=True)
     writable_path(args.out, "--out", suffixes=(".json",))
+    if args.samples is not None:
+        check_sample_count(args.samples)
     parameters, options = options_from_args(args)
     short_circuit_points(parameters, options)  # an unstable grid point: refused before any work
     if args.samples is not None:
@@ -271,10 +275,6 @@ def assess_under_uncertainty(args: argparse.Namespace, parameters, options) -> N
     )
     from model.studies.verdict_uncertainty import run_verdict_uncertainty, save_sample_parameters
 
-    n = args.samples
-    if n < 2 or n & (n - 1):
-        raise UsageError(f"--samples = {n} is not allowed: must be a power of 2 >= 2 (the "
-                         "balance of the Sobol' points)")
     ranges = None if args.ranges is None else merge_ranges(load_ranges(args.ranges))
     check_ranges(parameters, relevant_ranges(default_ranges() if ranges is None else ranges,
                                              options)[0])  # refused before any work

@@ -29,6 +29,8 @@ from app.results.case import Case, Quantity
 from model.mechanics.parameters import load_parameters
 
 EXIT_BAD_INPUT = 2
+MAX_WORKERS = 256  # worker processes a command starts: more than the cores only queue, and each
+# holds a model (docs/memory.md)
 
 
 class UsageError(Exception):
@@ -121,16 +123,17 @@ def bounded(label: str, interval: str, unit: str = "") -> Callable[[str], float]
     return number(label, low, high, low_open=low_open, high_open=high_open, allowed=allowed)
 
 
-def non_negative_int(label: str) -> Callable[[str], int]:
-    """argparse type: a whole number >= 0, with a clear message otherwise."""
+def non_negative_int(label: str, high: int | None = None) -> Callable[[str], int]:
+    """argparse type: a whole number >= 0 (and <= ``high``), with a clear message otherwise."""
 
     def parse(text: str) -> int:
         try:
             value = int(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{label} must be a whole number, got '{text}'") from None
-        if value < 0:
-            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: must be >= 0")
+        if value < 0 or (high is not None and value > high):
+            allowed = ">= 0" if high is None else f"in [0, {high}]"
+            raise argparse.ArgumentTypeError(f"{label} = {text} is not allowed: must be {allowed}")
         return value
 
     return parse
@@ -590,6 +593,17 @@ def check_creep_arguments(args: argparse.Namespace) -> None:
 
 # --- the uncertainty study -----------------------------------------------------------------------
 
+MAX_SOBOL_SAMPLES = 2**16  # each sample is a model run or a whole assessment: days beyond
+
+
+def check_sample_count(n: int) -> None:
+    """``--samples``: a power of 2 >= 2 (the balance of the Sobol' points) and at most
+    :data:`MAX_SOBOL_SAMPLES` (refused before the points are drawn)."""
+    if n < 2 or n & (n - 1) or n > MAX_SOBOL_SAMPLES:
+        raise UsageError(f"--samples = {n} is not allowed: must be a power of 2 >= 2 (the "
+                         f"balance of the Sobol' points) and at most {MAX_SOBOL_SAMPLES}")
+
+
 def add_uncertainty_options(p: argparse.ArgumentParser) -> None:
     """--posterior, --no-indices, --speeds (shared with ``bogie study uncertainty``)."""
     p.add_argument("--posterior", action="store_true",
@@ -695,7 +709,7 @@ def add_engine_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scheduler", type=scheduler_address, default=None, metavar="tcp://HOST:PORT",
                    help="attach to a running Dask scheduler (default: $DASK_SCHEDULER_ADDRESS, "
                         "else a local cluster)")
-    p.add_argument("--workers", type=positive_int("--workers"), default=None,
+    p.add_argument("--workers", type=positive_int("--workers", MAX_WORKERS), default=None,
                    help="worker processes of the local cluster (default: one per core)")
     p.add_argument("--serial", action="store_true",
                    help="compute in this process, without Dask (the reference)")

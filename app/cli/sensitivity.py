@@ -25,7 +25,9 @@ from app.cli.options import (
     UsageError,
     add_operating_point,
     add_uncertainty_options,
+    check_sample_count,
     load_model,
+    non_negative_int,
     uncertainty_options,
 )
 from app.cli.output import emit, writable_path
@@ -48,7 +50,8 @@ def register(subparsers) -> None:
                               "of s0*, the ten modes and the peak loads (prior ranges)")
     p.add_argument("--samples", type=int, required=True,
                    help="base sample count n (a power of 2 >= 2); model runs: n (d + 2)")
-    p.add_argument("--seed", type=int, default=12, help="seed of the scrambled Sobol' sequence")
+    p.add_argument("--seed", type=non_negative_int("--seed"), default=12,
+                   help="seed of the scrambled Sobol' sequence")
     p.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
     add_uncertainty_options(p)
@@ -115,9 +118,7 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
     from model.studies.uncertainty import UncertaintyError, run_uncertainty
 
     n = args.samples
-    if n < 2 or n & (n - 1):
-        raise UsageError(f"--samples = {n} is not allowed: must be a power of 2 >= 2 "
-                         "(balance of the Sobol' sequence)")
+    check_sample_count(n)
     out = writable_path(args.out, "--out")
     options = uncertainty_options(args)
     parameters = load_parameters(args.params)

@@ -7,7 +7,15 @@ from __future__ import annotations
 
 import argparse
 
-from app.cli.options import PARAMETER_FILE, bounded, non_negative_int, number, positive_int, scheduler_address
+from app.cli.options import (
+    MAX_WORKERS,
+    PARAMETER_FILE,
+    bounded,
+    non_negative_int,
+    number,
+    positive_int,
+    scheduler_address,
+)
 from app.cli.output import writable_path
 from app.results.cache import DEFAULT_CACHE_MB
 from app.services.settings import DEFAULT_BACKGROUND_WORKERS, MAX_CACHE_MB, MIN_CACHE_MB
@@ -53,7 +61,7 @@ def register(subparsers) -> None:
                    help="memory the results every session shares may hold [MB]; beyond it the "
                         "least recently used go first (environment: BOGIE_CACHE_MB; default "
                         f"{DEFAULT_CACHE_MB}; docs/memory.md)")
-    p.add_argument("--background-workers", type=non_negative_int("--background-workers"),
+    p.add_argument("--background-workers", type=non_negative_int("--background-workers", MAX_WORKERS),
                    default=None, metavar="N",
                    help="worker processes, at a lower priority than the server, of the work no "
                         "slider waits for (the verdict's load cases, the reaction-time search); "

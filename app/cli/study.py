@@ -38,6 +38,8 @@ from app.cli.options import (
     add_uncertainty_options,
     bounded,
     case_lists,
+    check_sample_count,
+    non_negative_int,
     positive_int,
     uncertainty_options,
 )
@@ -84,7 +86,8 @@ def register(subparsers) -> None:
                        "(docs/sensitivity.md) on the same engine")
     u.add_argument("--samples", type=positive_int("--samples"), required=True,
                    help="base sample count n (a power of 2 >= 2); model runs: n (d + 2)")
-    u.add_argument("--seed", type=int, default=12, help="seed of the scrambled Sobol' sequence")
+    u.add_argument("--seed", type=non_negative_int("--seed"), default=12,
+                   help="seed of the scrambled Sobol' sequence")
     u.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
     u.add_argument("--out", required=True, metavar="U.json", help="JSON result to write")
@@ -131,9 +134,7 @@ def cmd_uncertainty(args: argparse.Namespace) -> None:
     from model.studies.uncertainty import UncertaintyError, run_uncertainty
 
     n = args.samples
-    if n < 2 or n & (n - 1):
-        raise UsageError(f"--samples = {n} is not allowed: must be a power of 2 >= 2 "
-                         "(balance of the Sobol' sequence)")
+    check_sample_count(n)
     out = writable_path(args.out, "--out")
     options = uncertainty_options(args)
     parameters = load_parameters(args.params)

@@ -253,3 +253,26 @@ def test_ripple_speeds_are_named_as_typed(capsys):
     assert err.count("\n") == 1
     assert "--ripple-v" in err
     assert "--v " not in err
+
+
+@pytest.mark.parametrize(("argv", "option"), [
+    (["uncertainty", "--samples", "2", "--seed", "-1"], "--seed"),  # numpy refuses it later
+    (["study", "uncertainty", "--samples", "2", "--seed", "-1", "--out", "u.json"], "--seed"),
+    (["assess", "--samples", "2", "--seed", "-1"], "--seed"),
+    (["uncertainty", "--samples", str(2**40)], "--samples"),  # the points would not fit memory
+    (["assess", "--samples", str(2**40)], "--samples"),
+    (["envelope", "--workers", "100000"], "--workers"),  # as many processes
+    (["serve", "--background-workers", "100000"], "--background-workers"),
+    (["study", "limit", "--v", "120", "--out", "s.zarr", "--scheduler", "abc"], "--scheduler"),
+    (["envelope", "--v", "0:1:1000000000"], "--v"),  # a billion values, made before the check
+])
+def test_values_the_computation_would_fail_on_are_refused_first(argv, option, capsys, stubbed,
+                                                                tmp_path, monkeypatch):
+    """Values the parser once accepted and the computation then failed on (a traceback, a
+    process per worker, memory): one line naming the option, before any work."""
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(argv, capsys)
+    assert code == 2, err
+    assert err.count("\n") == 1, err
+    assert option in err
+    assert out == ""
