@@ -44,13 +44,13 @@ import json
 import math
 import sys
 
+from app.cli.case_lists import add_case_lists, case_lists
 from app.cli.options import (
     MAX_SAMPLES,
     MIN_SAMPLES_PER_PERIOD,
     PARAMETER_FILE,
     UsageError,
     add_anti_slip_arguments,
-    add_case_lists,
     add_engine_options,
     add_rail,
     add_short_circuit,
@@ -58,7 +58,6 @@ from app.cli.options import (
     add_wheel_force_and_motor_slope,
     anti_slip_from,
     bounded,
-    case_lists,
     check_sample_count,
     check_samples,
     input_file,

@@ -29,17 +29,16 @@ from pathlib import Path
 
 import numpy as np
 
+from app.cli.case_lists import add_case_lists, case_lists
 from app.cli.options import (
     ANTI_SLIP_OPTIONS,
     PARAMETER_FILE,
     UsageError,
     add_anti_slip_arguments,
-    add_case_lists,
     add_engine_options,
     add_history_options,
     add_output_selection,
     add_time_grid,
-    case_lists,
     check_samples,
     check_sampling,
     output_names,

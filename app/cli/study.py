@@ -29,15 +29,14 @@ from pathlib import Path
 
 import numpy as np
 
+from app.cli.case_lists import add_case_lists, case_lists
 from app.cli.options import (
     PARAMETER_FILE,
     UsageError,
-    add_case_lists,
     add_engine_options,
     add_rail,
     add_uncertainty_options,
     bounded,
-    case_lists,
     check_sample_count,
     non_negative_int,
     positive_int,
