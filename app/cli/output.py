@@ -40,7 +40,7 @@ def writable_path(text: str | None, option: str, *, suffixes: tuple[str, ...] = 
     if not text.strip():
         raise UsageError(f"{option}: the path is empty")
     path = Path(text).expanduser()
-    if suffixes and path.suffix.lower() not in suffixes:
+    if suffixes and path.suffix not in suffixes:  # as the writers check it: case-sensitive
         raise UsageError(f"{option} '{text}': the file name must end in {' or '.join(suffixes)}")
     folder = path.parent
     while parents and not folder.exists() and folder != folder.parent:

@@ -48,7 +48,7 @@ def cmd_report(args: argparse.Namespace) -> None:
     from app.report.page import build_report
     from app.results.variants import VariantError, apply_variant, base_parameters, decode, set_key
 
-    out = writable_path(args.out, "--out", suffixes=(".html", ".htm"))
+    out = writable_path(args.out, "--out", suffixes=(".html", ".htm", ".HTML", ".HTM"))
     if args.s0 is None:
         raise UsageError("--s0 is required")
     base = str(Path(args.params).resolve()) if args.params else ""

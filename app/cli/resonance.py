@@ -329,7 +329,8 @@ def _polygon(args: argparse.Namespace) -> None:
 
     polygon = parse_polygon(args.wheel_polygon)
     model, op, speeds = _sweep_model(args)
-    result = polygon_response(model, op, speeds, polygon, outputs=output_names(args))
+    result = polygon_response(model, op, speeds, polygon,
+                              outputs=checked_output_names(args, model, op, loads_only=True))
 
     def listed(values: np.ndarray) -> list[float | None]:
         return [float(x) if np.isfinite(x) else None for x in values]
@@ -419,7 +420,8 @@ def cmd_track(args: argparse.Namespace) -> None:
 
     spectrum = track_spectrum(args.spectrum)
     model, op, _ = load_model(args)
-    result = random_response(model, op, spectrum, outputs=output_names(args))
+    result = random_response(model, op, spectrum,
+                             outputs=checked_output_names(args, model, op, loads_only=True))
     f_lo, f_hi = spectrum.band_hz(op.v)
     data = {"operating_point": op.as_dict(),
             "spectrum": {"name": spectrum.name, "A_v": spectrum.A_v, "omega_c": spectrum.omega_c,
