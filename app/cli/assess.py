@@ -49,6 +49,7 @@ from app.cli.options import (
     MAX_SAMPLES,
     MIN_SAMPLES_PER_PERIOD,
     PARAMETER_FILE,
+    WHEEL_POLYGON,
     UsageError,
     add_anti_slip_arguments,
     add_engine_options,
@@ -118,7 +119,7 @@ def register(subparsers) -> None:
                          help="creepages of the running case (default %(default)s)")
     running.add_argument("--running-v", default="20:200:10", metavar="LIST",
                          help="speeds [km/h] of the running case (default %(default)s)")
-    running.add_argument("--wheel-polygon", default="20=30", metavar="N=µm,…",
+    running.add_argument("--wheel-polygon", type=WHEEL_POLYGON, default="20=30", metavar="N=µm,…",
                          help="polygonal wheels: order = radial amplitude [µm] (default "
                               "%(default)s: an assumed amplitude, docs/resonance.md)")
     running.add_argument("--random-multiple", type=bounded("--random-multiple", "[0, 10]"),

@@ -205,6 +205,27 @@ def input_file(load: Callable[[str], object] | None = None) -> Callable[[str], s
 PARAMETER_FILE = input_file(load_parameters)  # a parameter file (TOML) it can read
 
 
+def parsed_text(module: str, function: str) -> Callable[[str], str]:
+    """argparse type: a text the model's ``module.function`` reads (a wheel polygon, a track
+    spectrum's name), checked by reading it — its input error said as the option's, one line;
+    returns the text as given (imported when an option is given: the parser stays light)."""
+
+    def parse(text: str) -> str:
+        import importlib
+
+        try:
+            getattr(importlib.import_module(module), function)(text)
+        except input_errors() as error:
+            message = str(error.args[0] if error.args else error).splitlines()[0]
+            raise argparse.ArgumentTypeError(message) from None
+        return text
+
+    return parse
+
+
+WHEEL_POLYGON = parsed_text("model.analysis.wheel_excitation", "parse_polygon")  # order=µm,…
+
+
 # --- the case's quantities: one option each, from its declaration --------------------------------
 
 def _unit(q: Quantity) -> str:

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from app.cli.options import (
+    WHEEL_POLYGON,
     UsageError,
     add_operating_point,
     bounded,
@@ -30,6 +31,7 @@ from app.cli.options import (
     load_model,
     parse_range,
     parse_values,
+    parsed_text,
     positive_int,
 )
 from app.cli.output import emit, writable_path
@@ -90,7 +92,7 @@ def register(subparsers) -> None:
     p.add_argument("--ripple", default=None, metavar="LIST",
                    help="order=amplitude [N m], e.g. el:6=250,el:12=120 (orders as --orders of "
                         "bogie campbell)")
-    p.add_argument("--wheel-polygon", default=None, metavar="LIST",
+    p.add_argument("--wheel-polygon", type=WHEEL_POLYGON, default=None, metavar="LIST",
                    help="instead of --ripple: polygonal wheels, order=radial amplitude [µm], e.g. "
                         "20=30 (every wheel; the rear wheelset a wheelbase later)")
     p.add_argument("--input", default=DEFAULT_INPUT, metavar="NAME",
@@ -104,7 +106,8 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("track", help="PSD and RMS of every output under the random "
                               "vertical track irregularity at one speed")
     add_operating_point(p)
-    p.add_argument("--spectrum", default="low", metavar="NAME",
+    p.add_argument("--spectrum", type=parsed_text("model.analysis.track_spectrum",
+                                                  "track_spectrum"), default="low", metavar="NAME",
                    help="the track spectrum: low (the German high-speed / ERRI B176 low level) "
                         "(default %(default)s)")
     p.add_argument("--outputs", default=None, metavar="LIST",

@@ -40,6 +40,8 @@ COMPUTING = (
     ("model.analysis.campbell", "campbell"),
     ("model.analysis.campbell", "ripple_response"),
     ("model.analysis.frequency_response", "frequency_response"),
+    ("model.analysis.wheel_excitation", "polygon_response"),
+    ("model.analysis.track_spectrum", "random_response"),
     ("model.studies.assessment", "assess"),
     ("model.studies.assessment", "short_circuit_points"),
     ("model.studies.verdict_uncertainty", "run_verdict_uncertainty"),
@@ -58,6 +60,7 @@ REQUIRED = {"s0": "0.005", "v": "120", "samples": "2", "ripple": "el:6=250"}
 # what a command refuses to run without though the parser does not require it (compare: its two
 # parameter files, given before the options)
 NEEDS = {"report": ["--s0", "0.005"], "locus": ["--s0-range", "0.001:0.01:3"],
+         "ripple": ["--ripple", "el:6=250"],
          "calibrate": ["--out", "calibrated.toml"],
          "compare": [str(CALIBRATED_FILE), str(ESTIMATE_FILE), "--s0", "0.005"]}
 
