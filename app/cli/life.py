@@ -24,7 +24,15 @@ import argparse
 import math
 import sys
 
-from app.cli.options import UsageError, add_rail, load_parameters_from
+from app.cli.options import (
+    PARAMETER_FILE,
+    UsageError,
+    add_rail,
+    input_errors,
+    input_file,
+    load_parameters_from,
+    number,
+)
 from app.cli.output import emit
 
 SOURCES = ("ripple", "polygon", "track", "short_circuit")
@@ -34,24 +42,34 @@ TOP_CONTRIBUTIONS = 3  # per section in the table
 def register(subparsers) -> None:
     p = subparsers.add_parser("life", help="fatigue life of every shaft section over a route: "
                               "damage a year, life in km and years, and where it comes from")
-    p.add_argument("--route", required=True, metavar="FILE",
+    p.add_argument("--route", type=input_file(_load_route), required=True, metavar="FILE",
                    help="route file (TOML; e.g. assets/routes/mixed_passenger_200.toml)")
     p.add_argument("--beyond-knee", choices=("haibach", "elementary", "limit"), default="haibach",
                    help="the S-N curve below the fatigue limit: Haibach's slope 2k-1, the slope "
                         "k continued, or no damage (default %(default)s)")
-    p.add_argument("--slope", type=float, default=None, metavar="K",
+    p.add_argument("--slope", type=number("--slope", 1.0, 50.0, low_open=False, high_open=False,
+                                          allowed="a slope k of 1 … 50"),
+                   default=None, metavar="K",
                    help="finite-life slope k of the shear S-N curve (default 8, FKM)")
-    p.add_argument("--knee-cycles", type=float, default=None, metavar="N",
+    p.add_argument("--knee-cycles", type=number("--knee-cycles", 1e3, 1e10, low_open=False,
+                                                high_open=False, allowed="1e3 … 1e10 cycles"),
+                   default=None, metavar="N",
                    help="cycles N_D at the knee (default 1e6, FKM)")
     p.add_argument("--sources", default=",".join(SOURCES), metavar="LIST",
                    help="load sources, of " + ", ".join(SOURCES) + " (default all)")
     p.add_argument("--ripple", default=None, metavar="ORDER=AMPLITUDE,…",
                    help="each converter's ripple [N m] per order (default: the set's)")
     add_rail(p)
-    p.add_argument("--params", default=None, metavar="FILE",
+    p.add_argument("--params", type=PARAMETER_FILE, default=None, metavar="FILE",
                    help="parameter file (TOML; default: the calibrated set)")
     p.add_argument("--json", action="store_true", help="machine-readable JSON output")
     p.set_defaults(func=cmd_life)
+
+
+def _load_route(path: str):
+    from model.studies.route import load_route
+
+    return load_route(path)
 
 
 def options_from_args(args: argparse.Namespace):
@@ -77,8 +95,11 @@ def options_from_args(args: argparse.Namespace):
     route = load_route(args.route)
     ripple = None
     if args.ripple is not None:
-        ripple = parse_amplitudes(args.ripple)
-        check_ripple(ripple)
+        try:
+            ripple = parse_amplitudes(args.ripple)
+            check_ripple(ripple)
+        except input_errors() as error:
+            raise UsageError(f"--ripple: {error}") from None
     defaults = LifeOptions()
     options = LifeOptions(
         knee_cycles=defaults.knee_cycles if args.knee_cycles is None else args.knee_cycles,

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import re
+from pathlib import Path
 
 import pytest
 
@@ -43,6 +44,7 @@ COMPUTING = (
     ("model.analysis.wheel_excitation", "polygon_response"),
     ("model.analysis.track_spectrum", "random_response"),
     ("model.studies.assessment", "assess"),
+    ("model.studies.life", "route_life"),
     ("model.studies.assessment", "short_circuit_points"),
     ("model.studies.verdict_uncertainty", "run_verdict_uncertainty"),
     ("model.studies.calibration", "run"),
@@ -56,7 +58,9 @@ COMPUTING = (
 )
 
 # a good value of an option a command requires, so that the others can be tried
-REQUIRED = {"s0": "0.005", "v": "120", "samples": "2", "ripple": "el:6=250"}
+REQUIRED = {"s0": "0.005", "v": "120", "samples": "2", "ripple": "el:6=250",
+            "route": str(Path(__file__).resolve().parents[3] / "assets" / "routes"
+                         / "mixed_passenger_200.toml")}
 # what a command refuses to run without though the parser does not require it (compare: its two
 # parameter files, given before the options)
 NEEDS = {"report": ["--s0", "0.005"], "locus": ["--s0-range", "0.001:0.01:3"],
