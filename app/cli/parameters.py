@@ -5,9 +5,11 @@
 One row per parameter in schema order: name, value, SI unit, the note of the file (where the
 value comes from), and for the parameters the calibration fits
 (:data:`model.studies.calibration_bounds.FREE_PARAMETERS`) its bounds and whether the value sits on
-one (within 0.1 %, :func:`model.studies.calibration_bounds.on_bound`).  ``--json`` prints
-``{"parameters": [{"name", "value", "unit", "note", "lower", "upper", "on_bound"}]}`` (``lower``,
-``upper``, ``on_bound`` null for parameters the calibration does not fit).  Bad input (a file
+one (within 0.1 %, :func:`model.studies.calibration_bounds.on_bound`), and where the bounds come
+from (the published data on real vehicles of this class, after ``bounds:`` at the end of the
+row).  ``--json`` prints ``{"parameters": [{"name", "value", "unit", "note", "lower", "upper",
+"on_bound", "bounds_source"}]}`` (``lower``, ``upper``, ``on_bound``, ``bounds_source`` null for
+parameters the calibration does not fit).  Bad input (a file
 that is missing or not a valid set): one line on stderr, exit status 2.
 """
 
@@ -37,12 +39,13 @@ def parameter_table(rows: list[dict], source: str) -> str:
                  f"{'on bound':8}  note"]
     for row in rows:
         if row["lower"] is None:
-            lower = upper = bound = ""
+            lower = upper = bound = source = ""
         else:
             lower, upper = f"{row['lower']:>10.4g}", f"{row['upper']:>10.4g}"
             bound = "YES" if row["on_bound"] else "no"
+            source = f" | bounds: {row['bounds_source']}"
         lines.append(f"{row['name']:34} {row['value']:>12.6g} {row['unit']:9} {lower:>10} "
-                     f"{upper:>10} {bound:8}  {row['note']}")
+                     f"{upper:>10} {bound:8}  {row['note']}{source}")
     return "\n".join(lines)
 
 

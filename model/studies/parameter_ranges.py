@@ -20,14 +20,23 @@ BOUND_TOLERANCE = 1e-3  # a value this close to an end sits on it (relative; of 
 @dataclass(frozen=True)
 class ParameterRange:
     """``low`` … ``high`` [the parameter's schema unit] for the parameter ``name``; ``reason``
-    names the source of the ends; ``log``: a scale parameter, searched on its logarithm and
-    sampled log-uniformly (False: on its value, uniformly, e.g. a height)."""
+    says why the ends are where they are; ``log``: a scale parameter, searched on its logarithm
+    and sampled log-uniformly (False: on its value, uniformly, e.g. a height); ``source``: the
+    published data on real vehicles the ends come from, or that the range is an engineering
+    estimate for want of such data (empty where the range is not a hardware range, e.g. a prior
+    around a calibrated value)."""
 
     name: str
     low: float
     high: float
     reason: str
     log: bool = True
+    source: str = ""
+
+    @property
+    def bounds_source(self) -> str:
+        """The reason for the ends and, where declared, the data they come from."""
+        return f"{self.reason} [{self.source}]" if self.source else self.reason
 
     def on_bound(self, value: float) -> bool:
         """Whether ``value`` sits on one of the ends: within 0.1 % of it (log ranges), or within

@@ -88,7 +88,10 @@ MISSED_PATTERN = ("unstable among the first ten at s0 = 0.014: pairs 2, 3, 9, 10
                   "9.70 Hz, +0.14 at 11.22 Hz); the wheelsets' longitudinal modes stay damped "
                   "(-2.12 at 8.52 Hz, -0.84 at 9.66 Hz)")
 MISSED_ON_BOUNDS = ("three calibrated parameters on a bound: polach_A (its lower 0.2), "
-                    "yaw_damping (its upper 1 MN s/m), yaw_damper_height (0.60 m)")
+                    "yaw_damping (its upper 1 MN s/m), yaw_damper_height (0.60 m); the vertical "
+                    "dampers (primary 0.20, secondary 0.21 kN s/m) below their hardware bounds "
+                    "(10 kN s/m: docs/validation.md, 'Which published numbers a bogie can "
+                    "reach')")
 
 
 @pytest.fixture(scope="module")
