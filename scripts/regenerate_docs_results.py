@@ -72,6 +72,8 @@ STEPS = (
          "docs/results/memory.json (the results cache's entries, docs/memory.md)"),
     Step("validation", (_python("validation_table.py"),),
          "docs/results/validation.json (Table 1 by rank, targets, real eigenvalues)"),
+    Step("reachability", (_python("reachability.py"),),
+         "docs/results/reachability.json (the reduced models of the study's contradictions)"),
     Step("response", (_python("figures_response.py"),),
          "docs/results/response.json, assets/figures/response_*.png"),
     Step("response-accuracy", (_python("response_accuracy.py"),),
