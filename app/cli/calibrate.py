@@ -3,8 +3,19 @@
 stage J, bounded least squares on the analytic Jacobian) and write the set to FILE; progress on
 stderr, the table of the targets (or ``--json``) on stdout.  ``--out`` is required: the command
 writes only where it is told, and replacing the bundled default set
-(``assets/parameters/calibrated.toml``) is said on stderr.  Bad input: one line on stderr, exit
-status 2.
+(``assets/parameters/calibrated.toml``) is said on stderr.
+
+    bogie calibrate --out FILE [--from FILE] [--max-evaluations M] [--json]
+    bogie calibrate --starts [N] --out FILE [--scheduler tcp://HOST:PORT | --workers W | --serial]
+    bogie calibrate --start K --out FILE
+
+``--starts N`` (default 16) is the global calibration (:mod:`model.studies.global_calibration`):
+the same least squares from N points of a scrambled Sobol' sequence within the bounds, on the
+study engine (a local cluster by default); it writes the best start's set to FILE and prints
+every start (cost, frequency and divergence errors, the front between them) and the spread of
+the best starts per parameter.  ``--start K`` runs start K alone in this process and writes its
+set: the same bytes the global search writes when K is its best.  Bad input: one line on stderr,
+exit status 2.
 """
 
 from __future__ import annotations
@@ -12,43 +23,117 @@ from __future__ import annotations
 import argparse
 import sys
 
-from app.cli.options import PARAMETER_FILE, UsageError, positive_int
+from app.cli.options import (
+    PARAMETER_FILE,
+    UsageError,
+    add_engine_options,
+    non_negative_int,
+    positive_int,
+)
 from app.cli.output import emit, writable_path
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("calibrate", help="fit the uncertain parameters to the published results")
-    p.add_argument("--start", type=PARAMETER_FILE, default=None, metavar="FILE",
-                   help="starting set (default: estimate.toml)")
+    p.add_argument("--from", dest="from_file", type=PARAMETER_FILE, default=None, metavar="FILE",
+                   help="the estimate: the prior, and the start of the single calibration "
+                        "(default: estimate.toml)")
     p.add_argument("--out", default=None, metavar="FILE",
                    help="where to write the calibrated set (required; the bundled default set is "
                         "assets/parameters/calibrated.toml)")
+    starts = p.add_mutually_exclusive_group()
+    starts.add_argument("--starts", type=positive_int("--starts"), nargs="?", const=16,
+                        default=None, metavar="N",
+                        help="global calibration from N Sobol' starts within the bounds "
+                             "(default N: 16) on the study engine; writes the best start's set")
+    starts.add_argument("--start", type=non_negative_int("--start"), default=None, metavar="K",
+                        help="run start K of the global calibration alone and write its set")
     p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=None,
                    help="trial parameter sets of each least-squares phase at most (default: "
                         "the calibration's own, as for the bundled set; smaller for a quick "
                         "check)")
     p.add_argument("--json", action="store_true", help="machine-readable JSON output (progress "
                                                        "goes to stderr either way)")
+    add_engine_options(p)
     p.set_defaults(func=cmd_calibrate)
+
+
+def _rows_json(rows) -> list[dict]:
+    return [{"name": row.name, "published": row.target, "achieved": row.achieved,
+             "unit": row.unit, "error": row.error} for row in rows]
+
+
+def starts_table(result) -> str:
+    """Every start (cost, the two errors, on the front) and the spread of the best starts."""
+    lines = [f"{'start':>5} {'cost':>10} {'max |ΔIm|':>10} {'ranks ≤5%':>9} {'characters':>10} "
+             f"{'λmax(0.014)':>12} {'Δ(+7.031)':>10} {'s':>6}  front"]
+    for r in result.results:
+        mark = "best" if r.index == result.best else ""
+        lines.append(f"{r.index:>5} {r.cost:>10.4g} {100 * r.frequency_error:>9.1f}% "
+                     f"{r.ranks_within:>9} {r.characters:>10} {r.largest_real_unstable:>+12.3f} "
+                     f"{100 * r.divergence_error:>9.1f}% {r.seconds:>6.0f}  "
+                     f"{'yes' if r.index in result.front else ''} {mark}".rstrip())
+    lines += ["", "spread of the best starts (share of the bounds; identified if at most 25 %):",
+              f"{'parameter':34} {'low':>11} {'high':>11} {'share':>7}  identified"]
+    for s in result.spread:
+        lines.append(f"{s.name:34} {s.low:>11.4g} {s.high:>11.4g} {100 * s.share:>6.0f}%  "
+                     f"{'yes' if s.identified else 'no'}")
+    lines.append(f"\n{len(result.results)} starts in {result.seconds:.0f} s on {result.where}; "
+                 f"best: start {result.best}")
+    return "\n".join(lines)
 
 
 def cmd_calibrate(args: argparse.Namespace) -> None:
     from pathlib import Path
 
     from model.mechanics.parameters import CALIBRATED_FILE, ESTIMATE_FILE
-    from model.studies.calibration import PHASES, run
 
     if not args.out:
         raise UsageError("--out FILE is required: where to write the calibrated set (the bundled "
                          f"default set is {CALIBRATED_FILE.relative_to(CALIBRATED_FILE.parents[2])})")
-    start = Path(args.start) if args.start else ESTIMATE_FILE
+    start = Path(args.from_file) if args.from_file else ESTIMATE_FILE
     out = writable_path(args.out, "--out")
     if out.resolve() == CALIBRATED_FILE.resolve():
         print(f"bogie calibrate: replacing the bundled default set {CALIBRATED_FILE}", file=sys.stderr)
+    from model.studies.calibration import PHASES, run
+
     phases = PHASES if args.max_evaluations is None else tuple(
         (min(count, args.max_evaluations), weights) for count, weights in PHASES)
-    rows, table = run(start, out, phases=phases,
-                      progress=lambda text: print(text, file=sys.stderr, flush=True))
-    emit(args, {"out": str(out), "targets": [
-        {"name": row.name, "published": row.target, "achieved": row.achieved, "unit": row.unit,
-         "error": row.error} for row in rows]}, table)
+
+    def progress(text: str) -> None:
+        print(text, file=sys.stderr, flush=True)
+
+    if args.starts is not None:
+        _global(args, start, out, phases, progress)
+        return
+    if args.start is not None:
+        from model.studies.global_calibration import run_start, write_start
+
+        progress(f"calibrating from start {args.start} of the global calibration …")
+        result = run_start(args.start, start, phases)
+        rows, table = write_start(result, out, start)
+        progress(f"wrote {out}")
+        emit(args, {"out": str(out), "start": args.start, "cost": result.cost,
+                    "targets": _rows_json(rows)}, table)
+        return
+    rows, table = run(start, out, phases=phases, progress=progress)
+    emit(args, {"out": str(out), "targets": _rows_json(rows)}, table)
+
+
+def _global(args, start, out, phases, progress) -> None:
+    from app.cli.runs import study_engine
+    from model.studies.global_calibration import global_search, write_start
+
+    def done(result) -> None:
+        progress(f"  start {result.index}: cost {result.cost:.5g}, max |ΔIm| "
+                 f"{100 * result.frequency_error:.1f} %, largest real at 0.014 "
+                 f"{result.largest_real_unstable:+.3f} 1/s ({result.seconds:.0f} s)")
+
+    with study_engine(args, "calibrate") as (mapper, where):
+        progress(f"global calibration: {args.starts} starts on {where} …")
+        result = global_search(args.starts, mapper, start, phases, done, where)
+    best = next(r for r in result.results if r.index == result.best)
+    rows, table = write_start(best, out, start)
+    progress(f"wrote {out} (start {result.best})")
+    data = {"out": str(out), **result.as_dict(), "targets": _rows_json(rows)}
+    emit(args, data, starts_table(result) + "\n\nbest start's targets:\n" + table)

@@ -479,18 +479,20 @@ def _phase(x0: np.ndarray, start: Parameters, free, x_prior: np.ndarray, weights
 
 def jacobian_stage(start: Parameters, progress: Callable = print,
                    free: tuple[ParameterRange, ...] | None = None,
-                   phases: tuple = PHASES) -> Parameters:
+                   phases: tuple = PHASES, initial: Parameters | None = None) -> Parameters:
     """Stage J (see above) from ``start`` (its values are the prior; stage A is solved inside
     every evaluation): for each of ``phases`` (trial sets, :class:`Weights`) scipy's bounded
     trust-region-reflective least squares with a soft-L1 loss on the residuals of
     :func:`_evaluate_j`.  The Jacobian at a set is that of the modes its own assignment gives
     the characters (fixed within a step); a trial set is judged with the characters assigned
     anew (a step that swaps them for the worse is rejected by the trust region's reduction
-    ratio, and the region shrinks).  Deterministic."""
+    ratio, and the region shrinks).  ``initial``: the set the search starts from (default
+    ``start``; the global calibration's starts, :mod:`model.studies.global_calibration`) — the
+    prior stays ``start``.  Deterministic."""
     free = SEARCH_PARAMETERS if free is None else free
     low, high = _bounds(free)
     x_prior = np.clip(_to_x(start, free), low, high)
-    x = x_prior.copy()
+    x = x_prior.copy() if initial is None else np.clip(_to_x(initial, free), low, high)
     began = time.perf_counter()
     for number, (evaluations, weights) in enumerate(phases, start=1):
         x = _phase(x, start, free, x_prior, weights, evaluations, progress,
@@ -498,24 +500,46 @@ def jacobian_stage(start: Parameters, progress: Callable = print,
     return _from_x(x, start, free)
 
 def calibrate(start: Parameters, progress: Callable = print,
-              phases: tuple = PHASES) -> tuple[Parameters, list[TargetRow]]:
+              phases: tuple = PHASES, initial: Parameters | None = None
+              ) -> tuple[Parameters, list[TargetRow]]:
     """Stage A fits the creep law and the gear ratio to the operating data (exactly, inside
     every evaluation); stage J (:func:`jacobian_stage`) fits the creep shape, the structure, the
     dampers and the motor slope to Table 1 by rank with its characters, the real parts, the
     driving-shaft mode and the divergences, on the analytic Jacobian.  Returns the calibrated set
     and all its targets.  Deterministic: no random numbers, no time limits (run it with one BLAS
-    thread, as :func:`run` does: another thread count rounds differently)."""
+    thread, as :func:`run` does: another thread count rounds differently).  ``initial``: the
+    set stage J starts from (default: ``start``, which is the prior either way)."""
     stage_a = fit_operating_data(with_constraints(start))
     progress(f"  stage A: μ0 {stage_a['polach_mu0']:.5g}, A {stage_a['polach_A']:.5g}, "
              f"B {stage_a['polach_B']:.5g} s/m, p {stage_a['gear_ratio']:.5g}")
-    fitted = fit_operating_data(with_constraints(jacobian_stage(stage_a, progress,
-                                                                 phases=phases)))
+    origin = None if initial is None else fit_operating_data(with_constraints(initial))
+    fitted = fit_operating_data(with_constraints(jacobian_stage(stage_a, progress, phases=phases,
+                                                                 initial=origin)))
+    calibrated = calibrated_set(fitted.values, start)
+    return calibrated, evaluate(calibrated)
+
+
+def calibrated_set(values: dict, start: Parameters) -> Parameters:
+    """The calibrated set of ``values`` with each fitted parameter's note (its bounds and the
+    estimate of ``start``)."""
     notes = dict(start.notes)
     for f in FREE_PARAMETERS:
         notes[f.name] = (f"calibrated by `bogie calibrate` within [{f.low:g}, {f.high:g}] "
                          f"({f.reason}); estimate {start[f.name]:g}")
-    calibrated = Parameters(dict(fitted.values), notes, "calibrated")
-    return calibrated, evaluate(calibrated)
+    return Parameters(dict(values), notes, "calibrated")
+
+
+def stage_j_cost(parameters: Parameters, start: Parameters, weights: Weights = PHASES[-1][1]
+                 ) -> float:
+    """Stage J's cost (soft-L1, the last phase's weights) of ``parameters`` with ``start``'s
+    values as the prior — the measure by which the global calibration ranks its starts."""
+    free = SEARCH_PARAMETERS
+    low, high = _bounds(free)
+    prior = fit_operating_data(with_constraints(start))
+    x = np.clip(_to_x(parameters, free), low, high)
+    residual = _evaluate_j(x, prior, free, np.clip(_to_x(prior, free), low, high),
+                           weights).residual
+    return float(np.sum(np.sqrt(1 + (residual / LOSS_SCALE) ** 2) - 1))
 
 
 def run(start_file=ESTIMATE_FILE, out_file=CALIBRATED_FILE, phases: tuple = PHASES,

@@ -176,7 +176,7 @@ def test_bad_export_target(capsys, tmp_path, monkeypatch, arguments):
     pytest.param(["--out", "set.toml", "--max-evaluations", "x"], "--max-evaluations",
                  id="not a number"),
     pytest.param(["--out", "/no/such/directory/set.toml"], "does not exist", id="missing dir"),
-    pytest.param(["--out", "set.toml", "--start", "/no/such/start.toml"], "does not exist",
+    pytest.param(["--out", "set.toml", "--from", "/no/such/start.toml"], "does not exist",
                  id="missing start"),
 ])
 def test_bad_calibrate_arguments_change_nothing(capsys, tmp_path, monkeypatch, arguments,

@@ -1,0 +1,112 @@
+"""``bogie calibrate --starts N`` and ``--start K``: the global calibration's options (fast, with
+a stubbed least squares), their bad input, and the reproduction of a start alone (slow: real
+least squares on a budget of one trial set per phase)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from app.cli.main import main
+from model.studies import global_calibration as gc
+from model.studies.calibration_bounds import SEARCH_PARAMETERS
+
+
+def run(argv: list[str], capsys) -> tuple[int, str, str]:
+    try:
+        code = main(argv)
+    except SystemExit as exit_:
+        code = exit_.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def stubbed(monkeypatch):
+    """run_start and write_start without the least squares: start k costs (k − 1)² + 1."""
+    values = {f.name: f.low for f in SEARCH_PARAMETERS}
+    written = []
+
+    def fake_start(k, start_file=None, phases=None):
+        return gc.StartResult(k, gc.start_values(k), values, float((k - 1) ** 2 + 1), 0.1 * k,
+                              10 - k, 10, 7.0 + k, k / 7.031, 0.5)
+
+    def fake_write(result, out, start_file=None):
+        out.write_text(f"start {result.index}\n", encoding="utf-8")
+        written.append(result.index)
+        return [], "targets table"
+
+    monkeypatch.setattr(gc, "run_start", fake_start)
+    monkeypatch.setattr(gc, "write_start", fake_write)
+    return written
+
+
+def test_starts_serial_writes_the_best_start_and_reports_every_start(capsys, tmp_path, stubbed):
+    out = tmp_path / "best.toml"
+    code, stdout, err = run(["calibrate", "--starts", "3", "--serial", "--out", str(out),
+                             "--json"], capsys)
+    assert code == 0, err
+    data = json.loads(stdout)
+    assert data["starts"] == 3
+    assert data["best"] == 1  # cost (k − 1)² + 1
+    assert [r["index"] for r in data["results"]] == [0, 1, 2]
+    assert data["front"] == [0]  # the smallest frequency and divergence errors
+    assert {row["name"] for row in data["spread"]} == {f.name for f in SEARCH_PARAMETERS}
+    assert out.read_text(encoding="utf-8") == "start 1\n"
+    assert stubbed == [1]
+    assert "global calibration: 3 starts on this process (serial)" in err
+
+
+def test_starts_without_a_number_means_sixteen_and_the_table(capsys, tmp_path, stubbed):
+    code, stdout, err = run(["calibrate", "--starts", "--serial", "--out",
+                             str(tmp_path / "best.toml")], capsys)
+    assert code == 0, err
+    assert "16 starts" in stdout
+    assert "spread of the best starts" in stdout
+    assert "best: start 1" in stdout
+
+
+def test_start_k_runs_that_start_alone(capsys, tmp_path, stubbed):
+    out = tmp_path / "s4.toml"
+    code, stdout, err = run(["calibrate", "--start", "4", "--out", str(out), "--json"], capsys)
+    assert code == 0, err
+    assert json.loads(stdout)["start"] == 4
+    assert out.read_text(encoding="utf-8") == "start 4\n"
+
+
+@pytest.mark.parametrize(("arguments", "mention"), [
+    pytest.param(["--starts", "2", "--start", "1"], "not allowed with", id="both"),
+    pytest.param(["--starts", "0"], "--starts", id="no starts"),
+    pytest.param(["--start", "-1"], "--start", id="negative start"),
+    pytest.param(["--start", "x"], "--start", id="start not a number"),
+    pytest.param(["--starts", "2", "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout",
+                  "0.5"], "cannot reach", id="unreachable scheduler"),
+])
+def test_bad_global_arguments_one_line_exit_2(capsys, tmp_path, stubbed, arguments, mention):
+    out = tmp_path / "set.toml"
+    code, stdout, err = run(["calibrate", "--out", str(out), *arguments], capsys)
+    assert code == 2
+    assert stdout == ""
+    assert err.strip().count("\n") == 0, err
+    assert "Traceback" not in err
+    assert mention in err
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_start_alone_reproduces_the_global_searchs_best_byte_for_byte(capsys, tmp_path):
+    """The real least squares (one trial set per phase): ``--starts 2`` on the default local
+    cluster writes its best start's set; ``--start K`` of that start in this process writes the
+    same bytes (one BLAS thread either way)."""
+    best = tmp_path / "best.toml"
+    code, stdout, err = run(["calibrate", "--starts", "2", "--max-evaluations", "1", "--workers",
+                             "2", "--out", str(best), "--json"], capsys)
+    assert code == 0, err
+    k = json.loads(stdout)["best"]
+    alone = tmp_path / "alone.toml"
+    code, _, err = run(["calibrate", "--start", str(k), "--max-evaluations", "1", "--out",
+                        str(alone)], capsys)
+    assert code == 0, err
+    assert alone.read_bytes() == best.read_bytes()
+    assert f"start {k} of the global calibration" in alone.read_text(encoding="utf-8")

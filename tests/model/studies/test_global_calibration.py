@@ -1,0 +1,93 @@
+"""The global calibration's pieces (model/studies/global_calibration.py): the Sobol' starts, the
+front, the spread and the search's bookkeeping with a stubbed least squares (the real starts:
+tests/app/cli/test_cli_calibrate.py, slow)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from model.studies import global_calibration as gc
+from model.studies.calibration_bounds import SEARCH_PARAMETERS
+from model.studies.engine import serial_map_unordered
+
+
+def test_start_k_is_the_same_point_whatever_the_number_of_starts():
+    """Start k is the k-th point of one scrambled Sobol' sequence (fast_forward): a start
+    re-runs alone; the first points are the sequence's, inside every bound."""
+    from scipy.stats import qmc
+
+    first = qmc.Sobol(len(SEARCH_PARAMETERS), scramble=True, seed=gc.SOBOL_SEED).random(8)
+    for k in range(8):
+        assert gc.sobol_unit_point(k, len(SEARCH_PARAMETERS)) == pytest.approx(first[k], abs=0)
+    for k in (0, 5, 17):
+        values = gc.start_values(k)
+        assert values == gc.start_values(k)
+        for f in SEARCH_PARAMETERS:
+            assert f.low <= values[f.name] <= f.high, f.name
+    assert gc.start_values(0) != gc.start_values(1)
+    with pytest.raises(ValueError, match="start index"):
+        gc.sobol_unit_point(-1, 3)
+
+
+def test_log_parameters_are_spread_log_uniformly():
+    u = gc.sobol_unit_point(3, len(SEARCH_PARAMETERS))
+    values = gc.start_values(3)
+    for f, ui in zip(SEARCH_PARAMETERS, u, strict=True):
+        if f.log:
+            assert math.log(values[f.name] / f.low) / math.log(f.high / f.low) == pytest.approx(ui)
+        else:
+            assert (values[f.name] - f.low) / (f.high - f.low) == pytest.approx(ui)
+
+
+def _result(index, cost, frequency, divergence, values=None):
+    return gc.StartResult(index, {}, values or {}, cost, frequency, 0, 0, 7.0, divergence, 1.0)
+
+
+def test_front_keeps_the_starts_no_other_beats_in_both_errors():
+    results = [_result(0, 5.0, 0.10, 0.50), _result(1, 4.0, 0.30, 0.05), _result(2, 3.0, 0.20, 0.60),
+               _result(3, 6.0, 0.10, 0.40), _result(4, 7.0, 0.05, 0.90)]
+    # 0 is beaten by 3 (same frequency error, smaller divergence error); 2 by 0 and 3
+    assert gc.front(results) == [1, 3, 4]
+
+
+def test_spread_over_the_best_quarter_as_a_share_of_the_bounds():
+    f = SEARCH_PARAMETERS[0]
+    names = [g.name for g in SEARCH_PARAMETERS]
+    base = {name: g.low for name, g in zip(names, SEARCH_PARAMETERS, strict=True)}
+    results = []
+    for k in range(8):  # costs 0…7: the best quarter is 2 starts, at least MIN_BEST = 4
+        values = dict(base)
+        values[f.name] = f.low * (f.high / f.low) ** (0.1 * k)  # starts 0…3: 0 … 0.3 of the bounds
+        results.append(_result(k, float(k), 0.1, 0.1, values))
+    assert [r.index for r in gc.best_starts(results)] == [0, 1, 2, 3]
+    rows = {row.name: row for row in gc.spread(results)}
+    assert rows[f.name].share == pytest.approx(0.3)
+    assert not rows[f.name].identified
+    assert rows[names[1]].share == 0.0
+    assert rows[names[1]].identified
+
+
+def test_global_search_runs_every_start_and_picks_the_lowest_cost(monkeypatch):
+    """Stubbed least squares: the search maps every start, orders them by index, picks the
+    lowest cost (ties: the lowest index) and reports its front and spread."""
+    costs = {0: 3.0, 1: 1.0, 2: 1.0, 3: 2.0}
+    values = {g.name: g.low for g in SEARCH_PARAMETERS}
+
+    def fake(k, start_file=None, phases=None):
+        return _result(k, costs[k], 0.1 * k, 0.4 - 0.1 * k, values)
+
+    monkeypatch.setattr(gc, "run_start", fake)
+    seen = []
+    result = gc.global_search(4, serial_map_unordered, progress=lambda r: seen.append(r.index))
+    assert seen == [0, 1, 2, 3]
+    assert [r.index for r in result.results] == [0, 1, 2, 3]
+    assert result.best == 1
+    assert result.front == [0, 1, 2, 3]
+    assert len(result.spread) == len(SEARCH_PARAMETERS)
+    data = result.as_dict()
+    assert data["starts"] == 4
+    assert data["best"] == 1
+    with pytest.raises(ValueError, match="starts"):
+        gc.global_search(0, serial_map_unordered)
