@@ -529,14 +529,17 @@ def calibrated_set(values: dict, start: Parameters) -> Parameters:
     return Parameters(dict(values), notes, "calibrated")
 
 
-def stage_j_cost(parameters: Parameters, start: Parameters, weights: Weights = PHASES[-1][1]
-                 ) -> float:
+def stage_j_cost(parameters: Parameters, start: Parameters, weights: Weights = PHASES[-1][1],
+                 clip: bool = True) -> float:
     """Stage J's cost (soft-L1, the last phase's weights) of ``parameters`` with ``start``'s
-    values as the prior — the measure by which the global calibration ranks its starts."""
+    values as the prior — the measure by which the global calibration ranks its starts.
+    ``clip=False``: a set outside the bounds is judged as it is (default: at the nearest point
+    within them, as the search sees it)."""
     free = SEARCH_PARAMETERS
     low, high = _bounds(free)
     prior = fit_operating_data(with_constraints(start))
-    x = np.clip(_to_x(parameters, free), low, high)
+    x = _to_x(parameters, free)
+    x = np.clip(x, low, high) if clip else x
     residual = _evaluate_j(x, prior, free, np.clip(_to_x(prior, free), low, high),
                            weights).residual
     return float(np.sum(np.sqrt(1 + (residual / LOSS_SCALE) ** 2) - 1))

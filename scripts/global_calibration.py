@@ -1,0 +1,141 @@
+"""The numbers, tables and figure of docs/validation.md's "Global calibration" from a stored run
+of ``bogie calibrate --starts N --json`` (the search takes tens of minutes; its output is kept
+in ``assets/data/``), and the comparison of its best set with the bundled one.
+
+    bogie calibrate --starts 16 --out assets/parameters/global_best.toml --json \\
+        > assets/data/global_calibration_n16.json
+    .venv/bin/python scripts/global_calibration.py      # docs/results/global_calibration.json,
+                                                        # assets/figures/global_calibration_front.png
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from docs_numbers import write_results  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+from model import load_parameters  # noqa: E402
+from model.mechanics.parameters import ESTIMATE_FILE  # noqa: E402
+from model.studies.calibration import stage_j_cost  # noqa: E402
+from model.studies.calibration_bounds import SEARCH_PARAMETERS  # noqa: E402
+from model.studies.calibration_targets import TABLE1_IM_HZ, evaluate  # noqa: E402
+from model.studies.global_calibration import target_measures  # noqa: E402
+
+RUN = ROOT / "assets" / "data" / "global_calibration_n16.json"
+FIGURE = ROOT / "assets" / "figures" / "global_calibration_front.png"
+
+
+def starts_block(run: dict) -> str:
+    lines = ["| start | stage J cost | largest \\|ΔIm\\| by rank | ranks within 5 % | characters "
+             "| largest real at 0.014 [1/s] | its error against +7.031 | front |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in sorted(run["results"], key=lambda r: r["cost"]):
+        mark = ("yes" if r["index"] in run["front"] else "") + (" (best)" if r["index"] == run["best"] else "")
+        lines.append(f"| {r['index']} | {r['cost']:.1f} | {100 * r['frequency_error']:.1f} % | "
+                     f"{r['ranks_within_5_percent']} | {r['characters']} | "
+                     f"{r['largest_real_at_0.014']:+.2f} | {100 * r['divergence_error']:.1f} % | "
+                     f"{mark.strip()} |")
+    return "\n".join(lines)
+
+
+def spread_block(run: dict) -> str:
+    lines = ["| parameter | lowest | highest | share of the bounds | identified |", "|---|---|---|---|---|"]
+    for s in run["spread"]:
+        lines.append(f"| `{s['name']}` | {s['low']:.4g} | {s['high']:.4g} | "
+                     f"{100 * s['share']:.0f} % | {'yes' if s['identified'] else 'no'} |")
+    return "\n".join(lines)
+
+
+def comparison(run: dict) -> dict:
+    bundled = load_parameters()
+    estimate = load_parameters(ESTIMATE_FILE)
+    with threadpool_limits(1):
+        rows = evaluate(bundled)
+        cost = stage_j_cost(bundled, estimate, clip=False)
+    best = next(r for r in run["results"] if r["index"] == run["best"])
+    measures = target_measures(rows)
+    bundled_rows = {row.name.split(" [")[0].replace(" OTHER CHARACTER:", ""): row for row in rows}
+    best_rows = {row["name"].split(" [")[0].replace(" OTHER CHARACTER:", ""): row
+                 for row in run["targets"]}
+    table = ["| target | published | bundled set | global best |", "|---|---|---|---|"]
+    for name, row in bundled_rows.items():
+        other = best_rows.get(name)
+        if other is None:
+            continue
+        table.append(f"| {name} | {row.target:.5g} | {row.achieved:.5g} ({100 * row.error:+.1f} %) | "
+                     f"{other['achieved']:.5g} ({100 * other['error']:+.1f} %) |")
+    on_bound = {}
+    for label, values in (("bundled", bundled.values), ("best", best["values"])):
+        on_bound[label] = [f.name for f in SEARCH_PARAMETERS if f.on_bound(values[f.name])
+                           or not f.low <= values[f.name] <= f.high]
+    return {"bundled": {"cost": cost, **measures, "outside_or_on_bound": on_bound["bundled"]},
+            "best": {"cost": best["cost"], "frequency_error": best["frequency_error"],
+                     "ranks_within": best["ranks_within_5_percent"],
+                     "characters": best["characters"],
+                     "largest_real_unstable": best["largest_real_at_0.014"],
+                     "divergence_error": best["divergence_error"],
+                     "outside_or_on_bound": on_bound["best"]},
+            "block": "\n".join(table)}
+
+
+def figure(run: dict) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=110)
+    for r in run["results"]:
+        on_front = r["index"] in run["front"]
+        ax.scatter(100 * r["frequency_error"], 100 * r["divergence_error"],
+                   color="tab:red" if on_front else "tab:blue", zorder=3)
+        ax.annotate(str(r["index"]), (100 * r["frequency_error"], 100 * r["divergence_error"]),
+                    textcoords="offset points", xytext=(4, 3), fontsize=8)
+    front = sorted((r for r in run["results"] if r["index"] in run["front"]),
+                   key=lambda r: r["frequency_error"])
+    ax.plot([100 * r["frequency_error"] for r in front], [100 * r["divergence_error"] for r in front],
+            color="tab:red", lw=1, label="front")
+    ax.axvline(5, color="grey", ls=":", lw=1, label="5 % (Table 1 by rank)")
+    ax.axhline(10, color="grey", ls="--", lw=1, label="10 % of +7.031 1/s")
+    ax.set_xlabel("largest |ΔIm| of the ten pairs by rank at s0 = 0.005 [%]")
+    ax.set_ylabel("largest real at s0 = 0.014 against +7.031 1/s [%]")
+    ax.set_title(f"global calibration: {run['starts']} starts (number: start index)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    FIGURE.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(FIGURE)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--run", default=str(RUN), help="stored output of bogie calibrate --starts N --json")
+    args = parser.parse_args()
+    run = json.loads(Path(args.run).read_text(encoding="utf-8"))
+    compared = comparison(run)
+    best = next(r for r in run["results"] if r["index"] == run["best"])
+    identified = [s["name"] for s in run["spread"] if s["identified"]]
+    data = {"starts": run["starts"], "best": run["best"], "front": run["front"],
+            "seconds": run["seconds"], "minutes": run["seconds"] / 60, "where": run["where"],
+            "per_start_seconds_mean": sum(r["seconds"] for r in run["results"]) / run["starts"],
+            "identified": identified, "identified_count": len(identified),
+            "parameters": len(run["spread"]), "front_count": len(run["front"]),
+            "best_start": {k: best[k] for k in best if k not in ("start", "values")},
+            "comparison": {k: v for k, v in compared.items() if k != "block"},
+            "ranks_published": len(TABLE1_IM_HZ),
+            "blocks": {"starts": starts_block(run), "spread": spread_block(run),
+                       "comparison": compared["block"]}}
+    path = write_results("global_calibration", data, "scripts/global_calibration.py")
+    figure(run)
+    print(f"wrote {path} and {FIGURE}")
+
+
+if __name__ == "__main__":
+    main()
