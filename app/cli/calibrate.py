@@ -68,6 +68,9 @@ def starts_table(result) -> str:
     lines = [f"{'start':>5} {'cost':>10} {'max |ΔIm|':>10} {'ranks ≤5%':>9} {'characters':>10} "
              f"{'λmax(0.014)':>12} {'Δ(+7.031)':>10} {'s':>6}  front"]
     for r in result.results:
+        if r.failed:
+            lines.append(f"{r.index:>5} failed: {r.failed}")
+            continue
         mark = "best" if r.index == result.best else ""
         lines.append(f"{r.index:>5} {r.cost:>10.4g} {100 * r.frequency_error:>9.1f}% "
                      f"{r.ranks_within:>9} {r.characters:>10} {r.largest_real_unstable:>+12.3f} "
@@ -111,6 +114,8 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
 
         progress(f"calibrating from start {args.start} of the global calibration …")
         result = run_start(args.start, start, phases)
+        if result.failed:
+            raise UsageError(f"start {args.start} cannot be calibrated: {result.failed}")
         rows, table = write_start(result, out, start)
         progress(f"wrote {out}")
         emit(args, {"out": str(out), "start": args.start, "cost": result.cost,
@@ -125,6 +130,9 @@ def _global(args, start, out, phases, progress) -> None:
     from model.studies.global_calibration import global_search, write_start
 
     def done(result) -> None:
+        if result.failed:
+            progress(f"  start {result.index}: failed: {result.failed}")
+            return
         progress(f"  start {result.index}: cost {result.cost:.5g}, max |ΔIm| "
                  f"{100 * result.frequency_error:.1f} %, largest real at 0.014 "
                  f"{result.largest_real_unstable:+.3f} 1/s ({result.seconds:.0f} s)")

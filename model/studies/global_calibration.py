@@ -89,13 +89,18 @@ class StartResult:
     largest_real_unstable: float  # [1/s] the largest real eigenvalue at s0 = 0.014
     divergence_error: float  # [-] |largest real − 7.031| / 7.031
     seconds: float  # wall time of the start [s]
+    failed: str = ""  # why the start could not be calibrated (its cost and errors are inf)
 
     def as_dict(self) -> dict:
-        return {"index": self.index, "cost": self.cost, "frequency_error": self.frequency_error,
+        def finite(x):
+            return x if math.isfinite(x) else None
+
+        return {"index": self.index, "cost": finite(self.cost),
+                "frequency_error": finite(self.frequency_error),
                 "ranks_within_5_percent": self.ranks_within, "characters": self.characters,
-                "largest_real_at_0.014": self.largest_real_unstable,
-                "divergence_error": self.divergence_error, "seconds": self.seconds,
-                "start": self.start, "values": self.values}
+                "largest_real_at_0.014": finite(self.largest_real_unstable),
+                "divergence_error": finite(self.divergence_error), "seconds": self.seconds,
+                "failed": self.failed, "start": self.start, "values": self.values}
 
 
 def target_measures(rows: list[TargetRow]) -> dict:
@@ -118,10 +123,15 @@ def run_start(k: int, start_file: str | Path | None = None, phases: tuple = PHAS
     began = time.perf_counter()
     estimate = load_parameters(ESTIMATE_FILE if start_file is None else start_file)
     values = start_values(k)
-    with threadpool_limits(1):
-        calibrated, rows = calibrate(estimate, lambda _text: None, phases,
-                                     initial=estimate.replace(**values))
-        cost = stage_j_cost(calibrated, estimate)
+    try:
+        with threadpool_limits(1):
+            calibrated, rows = calibrate(estimate, lambda _text: None, phases,
+                                         initial=estimate.replace(**values))
+            cost = stage_j_cost(calibrated, estimate)
+    except (ValueError, np.linalg.LinAlgError) as error:  # a start the model cannot analyse
+        # (e.g. a creep shape whose law has no maximum below s = 1 for any μ0, A, B, p)
+        return StartResult(k, values, {}, math.inf, math.inf, 0, 0, math.nan, math.inf,
+                           time.perf_counter() - began, failed=str(error))
     return StartResult(k, values, {name: float(v) for name, v in calibrated.values.items()},
                        float(cost), **target_measures(rows),
                        seconds=time.perf_counter() - began)
@@ -136,7 +146,7 @@ def start_set(result: StartResult, start_file: str | Path | None = None) -> Para
 def front(results: Iterable[StartResult]) -> list[int]:
     """Indices of the starts that no other start beats in both the frequency error and the
     divergence error (the trade between Table 1 by rank and the +7.031 1/s divergence)."""
-    results = list(results)
+    results = [r for r in results if not r.failed]
     return sorted(r.index for r in results
                   if not any((o.frequency_error <= r.frequency_error
                               and o.divergence_error <= r.divergence_error)
@@ -156,7 +166,7 @@ class SpreadRow:
 
 def best_starts(results: Iterable[StartResult]) -> list[StartResult]:
     """The best quarter of the starts by cost (at least :data:`MIN_BEST`, at most all)."""
-    ranked = sorted(results, key=lambda r: (r.cost, r.index))
+    ranked = sorted((r for r in results if not r.failed), key=lambda r: (r.cost, r.index))
     count = min(len(ranked), max(MIN_BEST, math.ceil(BEST_SHARE * len(ranked))))
     return ranked[:count]
 
@@ -212,6 +222,8 @@ def global_search(starts: int, map_unordered: Callable[[Callable, list], Iterato
         results[result.index] = result
         progress(result)
     ordered = [results[k] for k in sorted(results)]
+    if all(r.failed for r in ordered):
+        raise ValueError(f"no start could be calibrated: {ordered[0].failed}")
     best = min(ordered, key=lambda r: (r.cost, r.index)).index
     return GlobalResult(ordered, best, front(ordered), spread(ordered),
                         time.perf_counter() - began, where)

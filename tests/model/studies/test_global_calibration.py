@@ -91,3 +91,25 @@ def test_global_search_runs_every_start_and_picks_the_lowest_cost(monkeypatch):
     assert data["best"] == 1
     with pytest.raises(ValueError, match="starts"):
         gc.global_search(0, serial_map_unordered)
+
+
+def test_a_start_the_model_cannot_analyse_is_reported_not_fatal(monkeypatch):
+    """Start 7's creep shape leaves the creep law without a maximum below s = 1 for any (μ0,
+    A, B, p) within their bounds: the start is reported as failed, and the search goes on
+    without it (not in the front, the spread or the best)."""
+    failed = gc.run_start(7, phases=((1, gc.PHASES[0][1]), (1, gc.PHASES[1][1])))
+    assert "no maximum" in failed.failed
+    assert math.isinf(failed.cost)
+    assert failed.as_dict()["cost"] is None
+    values = {g.name: g.low for g in SEARCH_PARAMETERS}
+
+    def fake(k, start_file=None, phases=None):
+        if k == 1:
+            return failed
+        return _result(k, float(k), 0.1 * k, 0.1 * k, values)
+
+    monkeypatch.setattr(gc, "run_start", fake)
+    result = gc.global_search(3, serial_map_unordered)
+    assert result.best == 0
+    assert result.front == [0]
+    assert [r.index for r in gc.best_starts(result.results)] == [0, 2]
