@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -27,7 +28,7 @@ from model.mechanics.parameters import ESTIMATE_FILE  # noqa: E402
 from model.studies.calibration import stage_j_cost  # noqa: E402
 from model.studies.calibration_bounds import SEARCH_PARAMETERS  # noqa: E402
 from model.studies.calibration_targets import TABLE1_IM_HZ, evaluate  # noqa: E402
-from model.studies.global_calibration import target_measures  # noqa: E402
+from model.studies.global_calibration import StartResult, spread, target_measures  # noqa: E402
 
 RUN = ROOT / "assets" / "data" / "global_calibration_n16.json"
 FIGURE = ROOT / "assets" / "figures" / "global_calibration_front.png"
@@ -37,20 +38,25 @@ def starts_block(run: dict) -> str:
     lines = ["| start | stage J cost | largest \\|ΔIm\\| by rank | ranks within 5 % | characters "
              "| largest real at 0.014 [1/s] | its error against +7.031 | front |",
              "|---|---|---|---|---|---|---|---|"]
-    for r in sorted(run["results"], key=lambda r: r["cost"]):
+    done = [r for r in run["results"] if not r["failed"]]
+    for r in sorted(done, key=lambda r: r["cost"]):
         mark = ("yes" if r["index"] in run["front"] else "") + (" (best)" if r["index"] == run["best"] else "")
         lines.append(f"| {r['index']} | {r['cost']:.1f} | {100 * r['frequency_error']:.1f} % | "
                      f"{r['ranks_within_5_percent']} | {r['characters']} | "
                      f"{r['largest_real_at_0.014']:+.2f} | {100 * r['divergence_error']:.1f} % | "
                      f"{mark.strip()} |")
+    for r in run["results"]:
+        if r["failed"]:
+            lines.append(f"| {r['index']} | failed: {r['failed']} | | | | | | |")
     return "\n".join(lines)
 
 
 def spread_block(run: dict) -> str:
     lines = ["| parameter | lowest | highest | share of the bounds | identified |", "|---|---|---|---|---|"]
     for s in run["spread"]:
+        verdict = "no (held on a bound)" if s["on_bound"] else ("yes" if s["identified"] else "no")
         lines.append(f"| `{s['name']}` | {s['low']:.4g} | {s['high']:.4g} | "
-                     f"{100 * s['share']:.0f} % | {'yes' if s['identified'] else 'no'} |")
+                     f"{100 * s['share']:.0f} % | {verdict} |")
     return "\n".join(lines)
 
 
@@ -93,7 +99,7 @@ def figure(run: dict) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=110)
-    for r in run["results"]:
+    for r in (r for r in run["results"] if not r["failed"]):
         on_front = r["index"] in run["front"]
         ax.scatter(100 * r["frequency_error"], 100 * r["divergence_error"],
                    color="tab:red" if on_front else "tab:blue", zorder=3)
@@ -119,13 +125,28 @@ def main() -> None:
     parser.add_argument("--run", default=str(RUN), help="stored output of bogie calibrate --starts N --json")
     args = parser.parse_args()
     run = json.loads(Path(args.run).read_text(encoding="utf-8"))
+    # the spread by the module's rule as it stands (a parameter held on a bound by every best
+    # start is not identified), from the stored starts
+    starts = [StartResult(r["index"], r["start"], r["values"],
+                          math.inf if r["cost"] is None else r["cost"],
+                          math.inf if r["frequency_error"] is None else r["frequency_error"],
+                          r["ranks_within_5_percent"], r["characters"],
+                          math.nan if r["largest_real_at_0.014"] is None else r["largest_real_at_0.014"],
+                          math.inf if r["divergence_error"] is None else r["divergence_error"],
+                          r["seconds"], r["failed"]) for r in run["results"]]
+    run["spread"] = [{"name": s.name, "low": s.low, "high": s.high, "share": s.share,
+                      "identified": s.identified, "on_bound": s.on_bound} for s in spread(starts)]
     compared = comparison(run)
     best = next(r for r in run["results"] if r["index"] == run["best"])
     identified = [s["name"] for s in run["spread"] if s["identified"]]
+    held = [s["name"] for s in run["spread"] if s["on_bound"]]
     data = {"starts": run["starts"], "best": run["best"], "front": run["front"],
             "seconds": run["seconds"], "minutes": run["seconds"] / 60, "where": run["where"],
             "per_start_seconds_mean": sum(r["seconds"] for r in run["results"]) / run["starts"],
+            "failed": [r["index"] for r in run["results"] if r["failed"]],
+            "failed_count": sum(bool(r["failed"]) for r in run["results"]),
             "identified": identified, "identified_count": len(identified),
+            "held_on_bound": held, "held_count": len(held),
             "parameters": len(run["spread"]), "front_count": len(run["front"]),
             "best_start": {k: best[k] for k in best if k not in ("start", "values")},
             "comparison": {k: v for k, v in compared.items() if k != "block"},

@@ -72,6 +72,10 @@ STEPS = (
          "docs/results/memory.json (the results cache's entries, docs/memory.md)"),
     Step("validation", (_python("validation_table.py"),),
          "docs/results/validation.json (Table 1 by rank, targets, real eigenvalues)"),
+    Step("global-calibration", (_python("global_calibration.py"),),
+         "docs/results/global_calibration.json, assets/figures/global_calibration_front.png (from "
+         "the stored run assets/data/global_calibration_n16.json; the search itself: bogie "
+         "calibrate --starts 16, docs/validation.md)"),
     Step("reachability", (_python("reachability.py"),),
          "docs/results/reachability.json (the reduced models of the study's contradictions)"),
     Step("response", (_python("figures_response.py"),),

@@ -20,7 +20,8 @@ over the calibration bounds and compares where they land:
   +7.031 1/s); the starts that no other start beats in both form the front (:func:`front`).
 * **Spread**: over the best quarter of the starts (at least four), each parameter's range as a
   share of its bounds (on the log scale for log parameters): a parameter whose best starts span
-  at most :data:`IDENTIFIED_SHARE` of its bounds is identified by the targets (:func:`spread`).
+  at most :data:`IDENTIFIED_SHARE` of its bounds is identified by the targets (:func:`spread`),
+  unless they all sit on the same bound (then the bound holds it, not the targets).
 
 Plain dataclasses; the engine is passed in as a ``map_unordered`` function.
 """
@@ -161,7 +162,8 @@ class SpreadRow:
     low: float  # [SI] the smallest value among the best starts
     high: float  # [SI] the largest
     share: float  # [-] (high − low) as a share of the bounds (log scale for log parameters)
-    identified: bool  # share <= IDENTIFIED_SHARE
+    identified: bool  # share <= IDENTIFIED_SHARE and not held on a bound
+    on_bound: bool = False  # every best start on the same bound: the bound, not the targets
 
 
 def best_starts(results: Iterable[StartResult]) -> list[StartResult]:
@@ -182,8 +184,9 @@ def spread(results: Iterable[StartResult], free=SEARCH_PARAMETERS) -> list[Sprea
             share = math.log(high / low) / math.log(f.high / f.low)
         else:
             share = (high - low) / (f.high - f.low)
+        held = all(f.on_bound(v) for v in values) and share <= IDENTIFIED_SHARE
         rows.append(SpreadRow(f.name, float(low), float(high), float(share),
-                              bool(share <= IDENTIFIED_SHARE)))
+                              bool(share <= IDENTIFIED_SHARE and not held), bool(held)))
     return rows
 
 
@@ -202,7 +205,8 @@ class GlobalResult:
                 "seconds": self.seconds, "where": self.where, "sobol_seed": SOBOL_SEED,
                 "results": [r.as_dict() for r in self.results],
                 "spread": [{"name": s.name, "low": s.low, "high": s.high, "share": s.share,
-                            "identified": s.identified} for s in self.spread]}
+                            "identified": s.identified, "on_bound": s.on_bound}
+                           for s in self.spread]}
 
 
 def global_search(starts: int, map_unordered: Callable[[Callable, list], Iterator[tuple]],

@@ -56,6 +56,8 @@ def test_spread_over_the_best_quarter_as_a_share_of_the_bounds():
     f = SEARCH_PARAMETERS[0]
     names = [g.name for g in SEARCH_PARAMETERS]
     base = {name: g.low for name, g in zip(names, SEARCH_PARAMETERS, strict=True)}
+    middle = SEARCH_PARAMETERS[2]
+    base[middle.name] = math.sqrt(middle.low * middle.high)  # the same, inside the bounds
     results = []
     for k in range(8):  # costs 0…7: the best quarter is 2 starts, at least MIN_BEST = 4
         values = dict(base)
@@ -65,8 +67,12 @@ def test_spread_over_the_best_quarter_as_a_share_of_the_bounds():
     rows = {row.name: row for row in gc.spread(results)}
     assert rows[f.name].share == pytest.approx(0.3)
     assert not rows[f.name].identified
-    assert rows[names[1]].share == 0.0
-    assert rows[names[1]].identified
+    assert rows[names[1]].share == 0.0  # all on the lower bound: held there, not identified
+    assert rows[names[1]].on_bound
+    assert not rows[names[1]].identified
+    assert rows[middle.name].share == 0.0
+    assert rows[middle.name].identified
+    assert not rows[middle.name].on_bound
 
 
 def test_global_search_runs_every_start_and_picks_the_lowest_cost(monkeypatch):
