@@ -6,7 +6,7 @@ writes only where it is told, and replacing the bundled default set
 (``assets/parameters/calibrated.toml``) is said on stderr.
 
     bogie calibrate --out FILE [--from FILE] [--max-evaluations M] [--json]
-    bogie calibrate --starts [N] --out FILE [--scheduler tcp://HOST:PORT | --workers W | --serial]
+    bogie calibrate --starts N --out FILE [--scheduler tcp://HOST:PORT | --workers W | --serial]
     bogie calibrate --start K --out FILE
 
 ``--starts N`` (default 16) is the global calibration (:mod:`model.studies.global_calibration`):
@@ -42,10 +42,10 @@ def register(subparsers) -> None:
                    help="where to write the calibrated set (required; the bundled default set is "
                         "assets/parameters/calibrated.toml)")
     starts = p.add_mutually_exclusive_group()
-    starts.add_argument("--starts", type=positive_int("--starts"), nargs="?", const=16,
-                        default=None, metavar="N",
+    starts.add_argument("--starts", type=positive_int("--starts"), default=None, metavar="N",
                         help="global calibration from N Sobol' starts within the bounds "
-                             "(default N: 16) on the study engine; writes the best start's set")
+                             "(the bundled runs: 16) on the study engine; writes the best "
+                             "start's set")
     starts.add_argument("--start", type=non_negative_int("--start"), default=None, metavar="K",
                         help="run start K of the global calibration alone and write its set")
     p.add_argument("--max-evaluations", type=positive_int("--max-evaluations"), default=None,

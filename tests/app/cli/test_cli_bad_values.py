@@ -48,6 +48,8 @@ COMPUTING = (
     ("model.studies.assessment", "short_circuit_points"),
     ("model.studies.verdict_uncertainty", "run_verdict_uncertainty"),
     ("model.studies.calibration", "run"),
+    ("model.studies.global_calibration", "global_search"),
+    ("model.studies.global_calibration", "run_start"),
     ("model.studies.compare", "compare_designs"),
     ("model.studies.uncertainty", "run_uncertainty"),
     ("model.studies.store", "run_into_store"),

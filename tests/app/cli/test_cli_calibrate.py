@@ -58,8 +58,8 @@ def test_starts_serial_writes_the_best_start_and_reports_every_start(capsys, tmp
     assert "global calibration: 3 starts on this process (serial)" in err
 
 
-def test_starts_without_a_number_means_sixteen_and_the_table(capsys, tmp_path, stubbed):
-    code, stdout, err = run(["calibrate", "--starts", "--serial", "--out",
+def test_sixteen_starts_and_the_table(capsys, tmp_path, stubbed):
+    code, stdout, err = run(["calibrate", "--starts", "16", "--serial", "--out",
                              str(tmp_path / "best.toml")], capsys)
     assert code == 0, err
     assert "16 starts" in stdout
