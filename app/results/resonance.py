@@ -1,8 +1,10 @@
 """What the Resonances view and the report compute (:mod:`model.analysis.campbell`,
-:mod:`model.analysis.frequency_response`), kept in the results cache, as plain data.
+:mod:`model.analysis.frequency_response`, :mod:`model.analysis.wheel_excitation`,
+:mod:`model.analysis.track_spectrum`), kept in the results cache, as plain data.
 
 Arguments are a case record (:class:`app.results.case.Case`) and the view's settings; orders
-and ripples are their command-line texts (``"wheel:1,el:6"``, ``"el:6=250"``), parsed here (a
+and ripples are their command-line texts (``"wheel:1,el:6"``, ``"el:6=250"``), a wheel polygon
+``bogie ripple --wheel-polygon``'s (``"20=30"``: order = radial amplitude in µm), parsed here (a
 bad text raises the model's one-line :class:`ValueError`).  The Campbell diagram spans the
 dashboard's speeds and names its modes at the middle of them, so it does not depend on the
 speed slider (the slider only moves the FRF's operating point and the line marking it).
@@ -22,7 +24,10 @@ from model.analysis.frequency_response import (
     MODEL_FREQUENCY_LIMIT_HZ,
     FrequencyResponse,
     frequency_response,
+    input_names,
 )
+from model.analysis.track_spectrum import LOW, RandomResponse, random_response
+from model.analysis.wheel_excitation import PolygonResponse, parse_polygon, polygon_response
 from model.mechanics.excitation import (
     DEFAULT_ORDERS,
     MAX_ORDERS,
@@ -31,11 +36,16 @@ from model.mechanics.excitation import (
     parse_amplitudes,
     parse_orders,
 )
+from model.mechanics.irregularity import is_irregularity
+from model.mechanics.operating_point import KMH
 from model.mechanics.outputs import output_matrices
 
 SPEEDS_KMH = Case.quantity("v").bounds  # the dashboard's speed range [km/h]
 CAMPBELL_SPEEDS = 200  # speeds of the diagram
 RIPPLE_SPEEDS = 241  # speeds of the forced response (1 km/h apart)
+POLYGON_SPEEDS = 49  # speeds of the polygon's response (5 km/h apart; its resonances are
+# refined in speed by the model, so a coarser grid loses no peak and keeps the view's wait short)
+TRACK_POINTS = 300  # frequencies of the random track's PSD (plus the resonances' points)
 FRF_POINTS = 2000  # log-spaced frequencies of the FRF (plus the resonances' points)
 # an illustrative ripple [N m]: 2 % and 1 % of the published pre-fault torque M = 12 800 N m
 # at 6 and 12 times the electrical frequency (the harmonics an inverter-fed motor's air-gap
@@ -147,6 +157,37 @@ def ripple_result(case: CaseBase, ripple: str = DEFAULT_RIPPLE,
     return compute.cached("ripple", point, compute_ripple, ripple, input)
 
 
+def polygon_result(case: CaseBase, polygon: str) -> PolygonResponse:
+    """The steady response over :data:`SPEEDS_KMH` to polygonal wheels (``polygon``: the text
+    ``order=µm,…``; every wheel, the rear wheelset a wheelbase later) at the case's creepage,
+    wheel force, motor slope and set (:func:`model.analysis.wheel_excitation.polygon_response`)."""
+    point = case.point().without("v")
+
+    def compute_polygon() -> PolygonResponse:
+        wheels = parse_polygon(polygon)
+        op = point.replace(v=SPEEDS_KMH[0]).operating_point()
+        return polygon_response(compute.model_for(point), op,
+                                speeds_kmh(*SPEEDS_KMH, POLYGON_SPEEDS) * KMH, wheels)
+    return compute.cached("polygon", point, compute_polygon, polygon)
+
+
+def track_result(case: CaseBase) -> RandomResponse:
+    """Every output's PSD and RMS at the case's point under the random vertical track, the
+    ERRI/ORE low-level spectrum (:data:`model.analysis.track_spectrum.LOW`)."""
+    point = case.point()
+    return compute.cached("track", point, lambda: random_response(
+        compute.model_for(point), point.operating_point(), LOW, points=TRACK_POINTS))
+
+
+def frf_inputs(set_key: str) -> tuple[str, ...]:
+    """The FRF's inputs the view offers: each motor's torque [N m], then each wheel's rail–wheel
+    surface deviation ``IDk.rimNN.irregularity`` [m] (the set's model)."""
+    point = Case(set_key=set_key, **Case.defaults(compute.parameters(set_key))).point()
+    names = input_names(compute.model_for(point))
+    return (tuple(n for n in names if n.endswith(".motor.torque"))
+            + tuple(n for n in names if is_irregularity(n)))
+
+
 def output_names(set_key: str) -> tuple[tuple[str, str], ...]:
     """(name, unit) of every named output of the set's model (the calibrated creep law)."""
     point = Case(set_key=set_key, **Case.defaults(compute.parameters(set_key))).point()
@@ -174,3 +215,11 @@ def parse_fixed(text: str) -> tuple[float, ...]:
                              f"{MODEL_FREQUENCY_LIMIT_HZ:g}] Hz (the model's validity)")
         values.append(value)
     return tuple(values)
+
+
+def check_polygon(text: str) -> str:
+    """The polygon text if the model takes it (empty: none); else the model's one-line
+    ValueError."""
+    if text.strip():
+        parse_polygon(text)
+    return text.strip()

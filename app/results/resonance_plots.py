@@ -1,5 +1,6 @@
 """Bokeh figures of the resonances (dashboard and report alike): the Campbell diagram, the
-frequency response of one output, the forced response to a ripple over speed.  Built once, then
+frequency response of one output, the forced response to a ripple or to polygonal wheels over
+speed, the power spectral density under the random track.  Built once, then
 fed with the plain results of :mod:`app.results.resonance`; nothing here computes physics.
 """
 
@@ -20,6 +21,8 @@ from bokeh.palettes import Category10_10, Viridis256
 from app.results.plots import UNSTABLE, new_figure
 from app.results.resonance import CampbellView, RippleView
 from model.analysis.frequency_response import MODEL_FREQUENCY_LIMIT_HZ, FrequencyResponse
+from model.analysis.track_spectrum import RandomResponse
+from model.analysis.wheel_excitation import PolygonResponse
 
 ZETA_RANGE = (0.0, 0.1)  # colour scale of the damping ratio [-]; below 0 (growing): red
 F_RANGE = (1.0, MODEL_FREQUENCY_LIMIT_HZ)  # [Hz] the diagram's frequency axis (log)
@@ -175,3 +178,76 @@ class RipplePlot:
 
     def mark_speed(self, v_kmh: float) -> None:
         self.speed.location = float(v_kmh)
+
+
+class PolygonPlot:
+    """Steady amplitude of one output over speed under polygonal wheels: each order and their
+    sum (figure ``polygon-response``, source ``polygon``)."""
+
+    def __init__(self):
+        self.figure = new_figure("forced response to polygonal wheels", "speed v [km/h]",
+                                 "amplitude")
+        self.figure.name = "polygon-response"
+        self.source = ColumnDataSource({"xs": [], "ys": [], "label": [], "color": []},
+                                       name="polygon")
+        self.figure.multi_line("xs", "ys", source=self.source, color="color", line_width=2,
+                               legend_field="label")
+        self.figure.legend.location = "top_left"
+        self.speed = Span(location=np.nan, dimension="height", line_color="black",
+                          line_dash="dotted")
+        self.figure.add_layout(self.speed)
+
+    def clear(self, title: str) -> None:
+        """No polygon: an empty plot whose title says why (``title``)."""
+        self.source.data = {"xs": [], "ys": [], "label": [], "color": []}
+        self.figure.title.text = title
+        self.figure.yaxis.axis_label = "steady amplitude"
+
+    def update(self, polygon: PolygonResponse, output: str) -> None:
+        row = polygon.names.index(output)
+        v = polygon.v_kmh
+        series = [polygon.total[row]] + [polygon.by_order[k, row]
+                                         for k in range(len(polygon.orders))]
+        labels = ["sum (largest steady peak)"] + [
+            f"order {n}: {a * 1e6:g} µm" for n, a in zip(polygon.orders, polygon.amplitudes,
+                                                        strict=True)]
+        colors = ["black"] + [Category10_10[k % 10] for k in range(len(polygon.orders))]
+        self.source.data = {"xs": [v] * len(series), "ys": series, "label": labels,
+                            "color": colors}
+        unstable = ("" if not polygon.unstable_kmh else
+                    " — running system unstable at " + ", ".join(
+                        f"{x:.0f}" for x in polygon.unstable_kmh) + " km/h: no steady state")
+        self.figure.title.text = (f"{output} under polygonal wheels (every wheel, the rear "
+                                  f"wheelset a wheelbase later), s0 = "
+                                  f"{polygon.operating_point.s0:g}{unstable}")
+        self.figure.yaxis.axis_label = f"steady amplitude [{polygon.units[row]}]"
+
+    def mark_speed(self, v_kmh: float) -> None:
+        self.speed.location = float(v_kmh)
+
+
+class TrackPlot:
+    """Power spectral density of one output under the random vertical track at one operating
+    point, log–log (figure ``track-psd``, source ``track``); its RMS in the title."""
+
+    def __init__(self):
+        self.figure = new_figure("random track: power spectral density", "frequency [Hz]",
+                                 "PSD", x_axis_type="log", y_axis_type="log")
+        self.figure.name = "track-psd"
+        self.source = ColumnDataSource({"f": [], "psd": []}, name="track")
+        self.figure.line("f", "psd", source=self.source, color="#2ca02c", line_width=1.5)
+        self.figure.add_tools(HoverTool(tooltips=[("f", "@f{0.000} Hz"), ("PSD", "@psd")]))
+
+    def update(self, track: RandomResponse, output: str) -> None:
+        row = track.output(output)
+        unit = track.units[row]
+        squared = f"({unit})²" if (" " in unit or "/" in unit) else f"{unit}²"
+        shown = track.psd[row] > 0  # a log axis: the band's zeros (none inside) left out
+        self.source.data = {"f": track.f_hz[shown], "psd": track.psd[row][shown]}
+        op = track.operating_point
+        self.figure.title.text = (
+            f"{output} on the random track ({track.spectrum.name} level) at s0 = {op.s0:g}, "
+            f"v = {op.v_kmh:g} km/h: RMS {track.rms[row]:.4g} {unit}"
+            + ("" if track.stable else
+               " — running system unstable: no stationary response"))
+        self.figure.yaxis.axis_label = f"PSD [{squared}/Hz]"

@@ -6,11 +6,13 @@ and a Campbell diagram takes seconds: slow."""
 
 from __future__ import annotations
 
+import html
+
 import numpy as np
 import pytest
 from bokeh.document import Document
 
-from app.results import resonance
+from app.results import compute, resonance
 from model.mechanics.excitation import DEFAULT_ORDERS
 
 pytestmark = pytest.mark.slow
@@ -92,3 +94,105 @@ def test_tapping_a_campbell_point_opens_its_mode(dash):
     assert "tapped on the Campbell diagram" in dash.click.detail.object
     assert dash.click.shown.im_hz == pytest.approx(data["im"][index] / (2 * np.pi), rel=1e-6)
     assert "driving shaft 1" in dash.click.shown.description
+
+
+def test_frf_input_offers_the_wheels_irregularities(dash):
+    from model.analysis.frequency_response import frequency_response
+    from model.mechanics.irregularity import irregularity_inputs
+
+    view = dash.resonances
+    dash.tabs.active = dash.view_tabs.names.index("resonances")
+    state = dash.state()
+    model = compute.model_for(state.point())
+    wheels = irregularity_inputs(model)
+    assert len(wheels) == 4
+    assert list(view.frf_input.options) == ["ID1.motor.torque", "ID2.motor.torque", *wheels]
+    view.frf_input.value = wheels[0]
+    assert view.frf.input == wheels[0]
+    assert view.frf is resonance.frf_result(state.point(), wheels[0])
+    assert view.frf_plot.magnitude.yaxis.axis_label == f"|H| [N m/m] from {wheels[0]}"
+    # the model's answer for the same input and grid, computed afresh
+    expected = frequency_response(model, state.point().operating_point(), input=wheels[0],
+                                  points=resonance.FRF_POINTS)
+    row = expected.output(resonance.DEFAULT_OUTPUT)
+    np.testing.assert_allclose(view.frf_plot.source.data["abs"], expected.magnitude[row, 1:],
+                               rtol=1e-9)
+    # the rippling motor (tab closed: nothing recomputed): a wheel's input stays, a motor's follows
+    dash.tabs.active = 0
+    view.input.value = "ID2.motor.torque"
+    assert view.frf_input.value == wheels[0]
+    view.frf_input.value = "ID2.motor.torque"
+    view.input.value = "ID1.motor.torque"
+    assert view.frf_input.value == "ID1.motor.torque"
+
+
+def test_wheel_polygon_response_is_the_models(dash):
+    from dataclasses import replace
+
+    from app.dashboard.resonance_view import NO_POLYGON
+    from model.analysis.wheel_excitation import combined_response, polygon_frequency_hz
+
+    view = dash.resonances
+    dash.tabs.active = dash.view_tabs.names.index("resonances")
+    view.polygon.value = ""
+    assert view.polygon_view is None  # no default polygon: the model has no sourced amplitude
+    assert view.polygon_plot.figure.title.text == NO_POLYGON
+    assert view.polygon_plot.source.data["xs"] == []
+    view.polygon.value = "20=30"
+    state = dash.state()
+    polygon = view.polygon_view
+    assert polygon is resonance.polygon_result(state.point().without("v"), "20=30")
+    assert polygon.orders == (20,)
+    assert polygon.amplitudes[0] == pytest.approx(30e-6, rel=1e-12)
+    row = polygon.names.index(resonance.DEFAULT_OUTPUT)
+    np.testing.assert_array_equal(view.polygon_plot.source.data["ys"][0], polygon.total[row])
+    assert view.polygon_plot.figure.yaxis.axis_label == "steady amplitude [N m]"
+    # the amplitude at a speed of the grid is a |Σ_j H_j e^(iφ_j)| solved afresh at that speed
+    model = compute.model_for(state.point())
+    i = int(np.nanargmax(polygon.total[row]))
+    v = float(polygon.v[i])
+    op = replace(state.point().operating_point(), v=v)
+    f = float(polygon_frequency_hz(20, v, model.parameters["wheel_radius"]))
+    H, _ = combined_response(model, op, f)
+    assert polygon.total[row, i] == pytest.approx(30e-6 * abs(H[row]), rel=1e-9)
+    # the running system's growth is stated where the model finds it
+    title = view.polygon_plot.figure.title.text
+    assert ("no steady state" in title) == bool(polygon.unstable_kmh)
+    # a bad polygon: the notice, the response kept
+    for text in ("20", "0=30", "20=abc", "20=9000"):
+        dash.input_notice.visible = False
+        view.polygon.value = text
+        assert dash.input_notice.visible
+        assert "previous settings are kept" in dash.input_notice.object
+        assert view.settings["polygon"] == "20=30"
+        assert view.polygon_view is polygon
+    view.polygon.value = ""
+    assert not dash.input_notice.visible
+    assert view.polygon_view is None
+
+
+def test_random_track_psd_is_the_models(dash):
+    from model.analysis.track_spectrum import LOW
+    from model.analysis.wheel_excitation import combined_response
+
+    view = dash.resonances
+    dash.tabs.active = dash.view_tabs.names.index("resonances")
+    state = dash.state()
+    track = view.track
+    assert track is resonance.track_result(state.point())
+    assert track.spectrum is LOW
+    row = track.output(resonance.DEFAULT_OUTPUT)
+    np.testing.assert_array_equal(view.track_plot.source.data["psd"],
+                                  track.psd[row][track.psd[row] > 0])
+    title = view.track_plot.figure.title.text
+    assert f"RMS {track.rms[row]:.4g} N m" in title
+    assert ("no stationary response" in title) == (not track.stable)
+    assert view.track_plot.figure.yaxis.axis_label == "PSD [(N m)²/Hz]"
+    # a point of the PSD is G(f) |Σ_j H_j e^(iφ_j)|², solved afresh
+    model = compute.model_for(state.point())
+    k = len(track.f_hz) // 2
+    f = float(track.f_hz[k])
+    H, _ = combined_response(model, state.point().operating_point(), f)
+    expected = LOW.temporal(f, state.point().operating_point().v) * abs(H[row]) ** 2
+    assert track.psd[row, k] == pytest.approx(float(expected), rel=1e-9)
+    assert LOW.source in html.unescape(view.track_source.object)
