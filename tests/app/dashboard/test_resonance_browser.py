@@ -1,7 +1,9 @@
 """The Resonances tab in the served dashboard (headless Chromium): opened by its link
 (``tab=resonances``), the Campbell diagram, its crossings table, the FRF and the forced response
-arrive; a bad order typed in gives the notice and keeps the diagram; a tapped point of the
-driving-shaft mode opens the Modes tab on that mode; no console errors.  A screenshot goes to
+arrive, and the random track's PSD with its source; a wheel polygon typed in gives its forced
+response over speed, a bad one the notice (the response kept); a bad order typed in gives the
+notice and keeps the diagram; a tapped point of the driving-shaft mode opens the Modes tab on
+that mode; no console errors.  A screenshot goes to
 test-artifacts/."""
 
 from __future__ import annotations
@@ -46,8 +48,30 @@ def test_resonances_tab_in_the_browser(app_server, chromium):
         page.wait_for_function(f"() => ({COLUMN})(['frf', 'f']).length > 2000", timeout=120_000)
         page.wait_for_function(f"() => ({COLUMN})(['ripple', 'label']).length == 3",
                                timeout=120_000)
+        # the random track's PSD at this point (a minute or two on two cores), its source named
+        page.wait_for_function(f"() => ({COLUMN})(['track', 'psd']).length > 100",
+                               timeout=600_000)
+        assert "Guo" in _text(page, "resonance-track-source")
+        assert all(x > 0 for x in page.evaluate(COLUMN, ["track", "psd"]))
+        # a wheel polygon: its response over speed (the sum and the one order)
+        polygon = page.locator(".ctl-resonance-polygon input")
+        polygon.fill("20=30")
+        polygon.press("Enter")
+        page.wait_for_function(f"() => ({COLUMN})(['polygon', 'label']).length == 2",
+                               timeout=600_000)
+        assert page.evaluate(COLUMN, ["polygon", "label"])[1] == "order 20: 30 µm"
         page.wait_for_timeout(1000)
         page.screenshot(path=str(ARTIFACTS / "resonances_tab.png"), full_page=True)
+        # a bad polygon: the notice, the response kept
+        polygon.fill("20=")
+        polygon.press("Enter")
+        page.locator(".input-notice", has_text="previous settings are kept").wait_for(
+            timeout=60_000)
+        assert page.evaluate(COLUMN, ["polygon", "label"])[1] == "order 20: 30 µm"
+        polygon.fill("20=30")  # taken again: the notice goes
+        polygon.press("Enter")
+        page.locator(".input-notice", has_text="previous settings are kept").wait_for(
+            state="hidden", timeout=60_000)
         # a negative order: the notice, the diagram kept
         box = page.locator(".ctl-resonance-orders input")
         box.fill("el:-6")
