@@ -37,7 +37,6 @@ from model.mechanics.excitation import (
     parse_orders,
 )
 from model.mechanics.irregularity import is_irregularity
-from model.mechanics.operating_point import KMH
 from model.mechanics.outputs import output_matrices
 
 SPEEDS_KMH = Case.quantity("v").bounds  # the dashboard's speed range [km/h]
@@ -167,7 +166,7 @@ def polygon_result(case: CaseBase, polygon: str) -> PolygonResponse:
         wheels = parse_polygon(polygon)
         op = point.replace(v=SPEEDS_KMH[0]).operating_point()
         return polygon_response(compute.model_for(point), op,
-                                speeds_kmh(*SPEEDS_KMH, POLYGON_SPEEDS) * KMH, wheels)
+                                speeds_kmh(*SPEEDS_KMH, POLYGON_SPEEDS), wheels)
     return compute.cached("polygon", point, compute_polygon, polygon)
 
 

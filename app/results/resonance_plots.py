@@ -215,10 +215,9 @@ class PolygonPlot:
         self.source.data = {"xs": [v] * len(series), "ys": series, "label": labels,
                             "color": colors}
         unstable = ("" if not polygon.unstable_kmh else
-                    " — running system unstable at " + ", ".join(
+                    "\nrunning system unstable at " + ", ".join(
                         f"{x:.0f}" for x in polygon.unstable_kmh) + " km/h: no steady state")
-        self.figure.title.text = (f"{output} under polygonal wheels (every wheel, the rear "
-                                  f"wheelset a wheelbase later), s0 = "
+        self.figure.title.text = (f"{output} under polygonal wheels at s0 = "
                                   f"{polygon.operating_point.s0:g}{unstable}")
         self.figure.yaxis.axis_label = f"steady amplitude [{polygon.units[row]}]"
 
@@ -246,8 +245,8 @@ class TrackPlot:
         self.source.data = {"f": track.f_hz[shown], "psd": track.psd[row][shown]}
         op = track.operating_point
         self.figure.title.text = (
-            f"{output} on the random track ({track.spectrum.name} level) at s0 = {op.s0:g}, "
-            f"v = {op.v_kmh:g} km/h: RMS {track.rms[row]:.4g} {unit}"
+            f"{output}: RMS {track.rms[row]:.4g} {unit} on the random track "
+            f"({track.spectrum.name} level)\nat s0 = {op.s0:g}, v = {op.v_kmh:g} km/h"
             + ("" if track.stable else
-               " — running system unstable: no stationary response"))
+               "; running system unstable: no stationary response"))
         self.figure.yaxis.axis_label = f"PSD [{squared}/Hz]"

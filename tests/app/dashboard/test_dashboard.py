@@ -296,10 +296,12 @@ def test_render_whole_layout(dash):
     # locus, creep, 2 torques, forces, M_C, side and top view, Fig. 6 (Im, Re, real), variant s0*,
     # sensitivity tornado, study heat map; design loads: worst case ID1 and ID2, load
     # collective, rainflow matrix ID1 and ID2, envelope heat map; resonances: Campbell diagram,
-    # FRF magnitude and phase, forced response to the ripple; the verdicts' safety factors
-    assert len(plots) == 25
+    # FRF magnitude and phase, forced response to the ripple and to polygonal wheels, the random
+    # track's PSD; the verdicts' safety factors
+    assert len(plots) == 27
     assert {"root-locus", "fig6-im", "fig6-re", "fig6-real", "variant-limits", "campbell",
-            "frf-magnitude", "frf-phase", "ripple-response"} <= {p.name for p in plots}
+            "frf-magnitude", "frf-phase", "ripple-response", "polygon-response",
+            "track-psd"} <= {p.name for p in plots}
     titled = {model.title for model in models if getattr(model, "css_classes", None)
               and "ctl-s0" in model.css_classes}
     assert titled == {"creepage s0 [-]"}

@@ -143,6 +143,7 @@ def test_wheel_polygon_response_is_the_models(dash):
     polygon = view.polygon_view
     assert polygon is resonance.polygon_result(state.point().without("v"), "20=30")
     assert polygon.orders == (20,)
+    assert polygon.v_kmh[[0, -1]] == pytest.approx(resonance.SPEEDS_KMH, rel=1e-12)
     assert polygon.amplitudes[0] == pytest.approx(30e-6, rel=1e-12)
     row = polygon.names.index(resonance.DEFAULT_OUTPUT)
     np.testing.assert_array_equal(view.polygon_plot.source.data["ys"][0], polygon.total[row])
