@@ -5,7 +5,9 @@
 
 ``bogie serve`` on a free port; the page opens at the study's stable case on the Resonances tab
 (``?s0=0.005&v=120&tab=resonances``), waits for the Campbell diagram with its crossings, the
-frequency response and the forced response, and saves the whole page (≈ 30 s on two cores).
+frequency response, the forced response and the random track's PSD, types the illustrative wheel
+polygon ``20=30`` (order 20, 30 µm: docs/resonance.md, no measured amplitude) and waits for its
+response, and saves the whole page (≈ 2 min on two cores).
 """
 
 from __future__ import annotations
@@ -23,8 +25,9 @@ ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-f
         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 TEXT = """(cls) => { const m = [...Bokeh.documents[0].all_models]
   .find(m => (m.css_classes || []).includes(cls)); return m ? m.text || '' : ''; }"""
-LENGTH = """(name) => { const d = Bokeh.documents[0].get_model_by_name(name).data;
-  const v = d instanceof Map ? d.get('label') : d.label; return v ? v.length : 0; }"""
+LENGTH = """([name, col]) => { const d = Bokeh.documents[0].get_model_by_name(name).data;
+  const v = d instanceof Map ? d.get(col) : d[col]; return v ? v.length : 0; }"""
+POLYGON = "20=30"  # the illustrative polygon of docs/resonance.md's examples
 
 
 def main() -> None:
@@ -50,7 +53,14 @@ def main() -> None:
                                    timeout=timeout)
             page.wait_for_function(f"() => ({TEXT})('resonance-crossings').includes('Crossings')",
                                    timeout=timeout)
-            page.wait_for_function(f"() => ({LENGTH})('ripple') > 0", timeout=timeout)
+            page.wait_for_function(f"() => ({LENGTH})(['ripple', 'label']) > 0",
+                                   timeout=timeout)
+            page.wait_for_function(f"() => ({LENGTH})(['track', 'psd']) > 0", timeout=timeout)
+            polygon = page.locator(".ctl-resonance-polygon input")
+            polygon.fill(POLYGON)
+            polygon.press("Enter")
+            page.wait_for_function(f"() => ({LENGTH})(['polygon', 'label']) > 0",
+                                   timeout=timeout)
             page.wait_for_timeout(3000)  # the last changes drawn
             page.screenshot(path=args.out, full_page=True)
             if errors:
