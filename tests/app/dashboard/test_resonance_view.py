@@ -7,6 +7,7 @@ and a Campbell diagram takes seconds: slow."""
 from __future__ import annotations
 
 import html
+import json
 
 import numpy as np
 import pytest
@@ -96,7 +97,20 @@ def test_tapping_a_campbell_point_opens_its_mode(dash):
     assert "driving shaft 1" in dash.click.shown.description
 
 
-def test_frf_input_offers_the_wheels_irregularities(dash):
+def _cli(argv, capsys) -> dict:
+    """``bogie … --json``'s answer (the command line in this process)."""
+    from app.cli.main import main
+
+    try:
+        code = main([*argv, "--json"])
+    except SystemExit as exit_:
+        code = exit_.code
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return json.loads(out)
+
+
+def test_frf_input_offers_the_wheels_irregularities(dash, capsys):
     from model.analysis.frequency_response import frequency_response
     from model.mechanics.irregularity import irregularity_inputs
 
@@ -117,6 +131,13 @@ def test_frf_input_offers_the_wheels_irregularities(dash):
     row = expected.output(resonance.DEFAULT_OUTPUT)
     np.testing.assert_allclose(view.frf_plot.source.data["abs"], expected.magnitude[row, 1:],
                                rtol=1e-9)
+    # and the command line's for the same input and point (the motor slope as the dashboard
+    # holds it: the set's value rounded to the slider's step)
+    answer = _cli(["frf", "--s0", repr(state.s0), "--v", repr(state.v), "--bm", repr(state.b_M),
+                   "--input", wheels[0]], capsys)
+    assert answer["operating_point"]["N0"] == state.point().operating_point().N0
+    (cli,) = [o for o in answer["outputs"] if o["name"] == resonance.DEFAULT_OUTPUT]
+    np.testing.assert_allclose(view.frf_plot.source.data["abs"], cli["abs"][1:], rtol=1e-9)
     # the rippling motor (tab closed: nothing recomputed): a wheel's input stays, a motor's follows
     dash.tabs.active = 0
     view.input.value = "ID2.motor.torque"
@@ -126,7 +147,7 @@ def test_frf_input_offers_the_wheels_irregularities(dash):
     assert view.frf_input.value == "ID1.motor.torque"
 
 
-def test_wheel_polygon_response_is_the_models(dash):
+def test_wheel_polygon_response_is_the_models(dash, capsys):
     from dataclasses import replace
 
     from app.dashboard.resonance_view import NO_POLYGON
@@ -156,6 +177,15 @@ def test_wheel_polygon_response_is_the_models(dash):
     f = float(polygon_frequency_hz(20, v, model.parameters["wheel_radius"]))
     H, _ = combined_response(model, op, f)
     assert polygon.total[row, i] == pytest.approx(30e-6 * abs(H[row]), rel=1e-9)
+    # the command line's answer for the same polygon, point and speeds
+    answer = _cli(["ripple", "--v", f"{resonance.SPEEDS_KMH[0]:g}:{resonance.SPEEDS_KMH[1]:g}:"
+                   f"{resonance.POLYGON_SPEEDS}", "--s0", repr(state.s0), "--bm", repr(state.b_M),
+                   "--wheel-polygon", "20=30"], capsys)
+    (cli,) = [o for o in answer["outputs"] if o["name"] == resonance.DEFAULT_OUTPUT]
+    np.testing.assert_allclose(answer["v_kmh"], polygon.v_kmh, rtol=1e-12)
+    np.testing.assert_allclose([np.nan if x is None else x for x in cli["amplitude"]],
+                               polygon.total[row], rtol=1e-9)
+    assert answer["unstable_v_kmh"] == pytest.approx(list(polygon.unstable_kmh), rel=1e-12)
     # the running system's growth is stated where the model finds it
     title = view.polygon_plot.figure.title.text
     assert ("no steady state" in title) == bool(polygon.unstable_kmh)
