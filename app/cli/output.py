@@ -45,6 +45,9 @@ def writable_path(text: str | None, option: str, *, suffixes: tuple[str, ...] = 
     folder = path.parent
     while parents and not folder.exists() and folder != folder.parent:
         folder = folder.parent
+    if folder.exists() and not folder.is_dir():
+        raise UsageError(f"{option} '{text}' cannot be used: '{folder}' is a file, not a "
+                         "directory")
     if not folder.is_dir():
         raise UsageError(f"{option} '{text}': directory '{folder}' does not exist")
     if path.exists():
