@@ -66,6 +66,7 @@ SERVED_MODULES = {
     "tests/app/dashboard/test_review_browser.py",
     "tests/app/dashboard/test_uncertainty_band_browser.py",
     "tests/app/dashboard/test_verdicts_browser.py",
+    "tests/app/dashboard/test_verdicts_life_browser.py",
     "tests/app/dashboard/test_tables_browser.py",
 }
 OWN_SERVER_MODULES = {"tests/app/server/test_reliability.py"}

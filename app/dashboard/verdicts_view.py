@@ -9,7 +9,15 @@ state of the dashboard (:class:`app.dashboard.jobs.ViewJob`), asked for when the
 and started once that state's follow-ups (dense root locus, s0*(v)) have ended, whatever their
 outcome, and the state has stayed for a moment (:data:`VERDICT_QUIET_MS`); it takes a few
 seconds (the short-circuit case's grid over every fault instant, the ripple case's speed sweep),
-so the indicator says "computing" meanwhile.
+so the indicator says "computing" meanwhile.  The "running case" checkbox adds the running load
+case (``bogie assess --running``'s defaults, about 40 s) to the same assessment.
+
+Once a verdict is shown, each shaft section's fatigue life over the bundled route
+(:mod:`app.results.life`, 25 s to 2 min) is computed in a background worker process, its thread
+of the :data:`~app.services.thread_pools.LIFE_POOL`, never on a slider's path: the table's life
+column says "computing…" meanwhile and the result is kept in the results cache; it stops at the
+next checkpoint when no view of a live session wants it any more.  Not served (tests without a
+server), it waits for :meth:`VerdictsView.compute_life`.
 """
 
 from __future__ import annotations
@@ -17,12 +25,16 @@ from __future__ import annotations
 import html
 import json
 import logging
+import weakref
+from functools import partial
 
 import panel as pn
 
 from app.dashboard import layout
 from app.dashboard.jobs import ViewJob
 from app.dashboard.session import served_document
+from app.results import life as route_life
+from app.results.cache import Superseded
 from app.results.case import Case
 from app.results.verdicts import (
     assessment_result,
@@ -31,7 +43,7 @@ from app.results.verdicts import (
     safety_factor_figure,
 )
 from app.services import background
-from app.services.thread_pools import SIDE_VIEW_POOL
+from app.services.thread_pools import LIFE_POOL, SIDE_VIEW_POOL
 from model.mechanics.parameters import ASSESSMENT_SCHEMA, ParameterError, parse_entries
 
 log = logging.getLogger(__name__)
@@ -46,7 +58,19 @@ TEXT, NUMBER = "object", "float64"
 # the table's columns and their types (text drawn as text, numbers with their decimals)
 COLUMNS = {"component": TEXT, "check": TEXT, "load case": TEXT, "load [kN m]": NUMBER,
            "capacity [kN m]": NUMBER, "safety factor": NUMBER, "band 5–95 %": TEXT,
-           "required": NUMBER, "verdict": TEXT, "where": TEXT, "note": TEXT}
+           "required": NUMBER, "verdict": TEXT, "life [km]": TEXT, "where": TEXT, "note": TEXT}
+PENDING = "computing…"  # a fatigue row's life while it is computed
+RUNNING_LABEL = "running case (track, wheels, ripple; ≈ 40 s)"
+_LIFE_VIEWS: weakref.WeakSet = weakref.WeakSet()  # the views that may want a route life
+
+
+class LifeSuperseded(Superseded):
+    """A route life stopped because no view of a live session wants it any more."""
+
+
+def _stop_unless_life_wanted(key: tuple) -> None:
+    if not any(view.wants_life(key) for view in list(_LIFE_VIEWS)):
+        raise LifeSuperseded(key)
 
 
 def strength_from_toml(data: bytes, base) -> tuple:
@@ -78,6 +102,19 @@ class VerdictsView:
     def __init__(self, dashboard):
         self.dashboard = dashboard
         self._job = ViewJob(SIDE_VIEW_POOL, dashboard.alive, "verdict")
+        self._life_job = ViewJob(LIFE_POOL, dashboard.alive, "route life")
+        self.life_route = str(route_life.ROUTE)  # the route file the life column is over
+        self.life_sources = route_life.SOURCES  # its load sources
+        self.life = None  # the route life on screen (model.studies.life.LifeResult)
+        self.life_for: tuple | None = None  # its key
+        self._life_waiting: tuple | None = None  # not served: the key compute_life computes
+        _LIFE_VIEWS.add(self)
+        self.running = pn.widgets.Checkbox(label=RUNNING_LABEL, value=False,
+                                           css_classes=["ctl-verdict-running"])
+        self.running.param.watch(lambda _e: self.request(self.dashboard.state()), "value")
+        self.life_text = pn.pane.Markdown("", css_classes=["verdict-life-text"],
+                                          sizing_mode="stretch_width")
+        self.life_chart = pn.pane.Bokeh(sizing_mode="stretch_width", css_classes=["life-chart"])
         self.strength: tuple = ()  # uploaded strength data ((name, value), …)
         self.result = None  # the assessment on screen
         self.shown_for = None  # its point and short circuit (a case record)
@@ -118,10 +155,15 @@ class VerdictsView:
                 "static; a ripple row opens the Resonances tab at its speed). "
                 "Strength data (TOML, entries as in the parameter file, e.g. "
                 "`wheel_seat_friction_min = { value = 0.1, unit = \"1\" }`) replace the set's; "
-                "docs/assessment.md."),
-            pn.Row(pn.pane.Markdown("**strength data (TOML):**"), self.upload),
+                "docs/assessment.md. The running case (mean traction with the converters' "
+                "ripple, a polygon of order 20 and 30 µm on every wheel and 3 × the RMS under "
+                "the low-level track spectrum, 20–200 km/h) is added on request. Each shaft "
+                "section's fatigue row gets its life over the bundled route in km (years in "
+                "the note), computed after the verdict (25 s to 2 min)."),
+            pn.Row(pn.pane.Markdown("**strength data (TOML):**"), self.upload, self.running),
             pn.Row(self.uncertainty_select, self.uncertainty_open, self.uncertainty_refresh),
-            self.notice, self.cases, self.table, self.chart, sizing_mode="stretch_width")
+            self.notice, self.cases, self.table, self.life_text, self.chart, self.life_chart,
+            sizing_mode="stretch_width")
 
     @staticmethod
     def _frame(rows):
@@ -132,7 +174,7 @@ class VerdictsView:
     def _key(self, case: Case) -> tuple:
         """What the assessment of ``case`` depends on: its point and short circuit (every
         fault instant, the load cases' horizons) and the strength data."""
-        return (case.without("dt", "t_end"), self.strength)
+        return (case.without("dt", "t_end"), self.strength, bool(self.running.value))
 
     def request(self, case: Case, after=None) -> None:
         """Assess ``case``'s operating point (served: on a worker thread, started once
@@ -152,8 +194,9 @@ class VerdictsView:
             return  # asked for already (its answer, or the one on screen, stands)
         self.indicator.object = indicator_html(None, "computing…")
         # served: the assessment in a background worker process (app.services.background)
-        self._job.start(key, lambda: assessment_result(*key, runner=background.run), self._show,
-                        self._failed, after=after, delay_ms=VERDICT_QUIET_MS)
+        self._job.start(key, lambda: assessment_result(key[0], key[1], runner=background.run,
+                                                       running=key[2]),
+                        self._show, self._failed, after=after, delay_ms=VERDICT_QUIET_MS)
 
     def on_shown(self, shown: bool) -> None:
         """The Verdicts tab opened (``shown``) or closed; not served, the assessment waiting
@@ -163,7 +206,7 @@ class VerdictsView:
             self.refresh_results()
         if shown and self._waiting is not None:
             key, self._waiting = self._waiting, None
-            self._show(key, assessment_result(*key))
+            self._show(key, assessment_result(key[0], key[1], running=key[2]))
 
     def _failed(self, _key, error: BaseException) -> None:
         self.indicator.object = indicator_html(None, f"not assessed: {error}")
@@ -172,14 +215,73 @@ class VerdictsView:
         self.result = result
         self.shown_for = key[0]  # the point and short circuit of the result on screen
         uncertainty = self._matching_uncertainty()
-        self.rows = check_rows(result, uncertainty)
         self.indicator.object = indicator_html(result, uncertainty=uncertainty)
-        self.table.value = self._frame(self.rows)
+        self._fill_table()
         self.cases.object = "<ul>" + "".join(
             f"<li><b>{c.name}</b> ({'steady' if c.horizon is None else f'horizon {c.horizon:g} s'}"
             f"): {html.escape(c.description)}</li>" for c in result.cases) + "</ul>"
         self.chart.object = safety_factor_figure(result)
         self.dashboard.resonances.show_crossings()
+        if len(key) > 1:  # a new assessment (not new bands): the life of its set
+            self._request_life(key[0])
+
+    def _fill_table(self) -> None:
+        """The checks' rows with each fatigue row's life (computing…, or the life on screen
+        when it is of the verdict's set)."""
+        rows = check_rows(self.result, self._matching_uncertainty())
+        life = self.life if self.life_for == self._life_key(self.shown_for) else None
+        self.rows = route_life.with_life(rows, life)
+        self.table.value = self._frame(self.rows)
+
+    # --- the life over the route --------------------------------------------------------------
+
+    def _life_key(self, case) -> tuple:
+        return (route_life.life_key(case), self.strength, self.life_route,
+                tuple(self.life_sources))
+
+    def wants_life(self, key: tuple) -> bool:
+        """Whether this view still waits for the route life ``key`` (any thread)."""
+        return key == self._life_job.wanted and self.dashboard.alive()
+
+    def _request_life(self, case) -> None:
+        """The life of ``case``'s set over the route: at once if kept, else in a background
+        worker process (served) or by :meth:`compute_life` (not served)."""
+        key = self._life_key(case)
+        if key == self.life_for:
+            return
+        kept = route_life.known_life(*key)
+        if kept is not None:
+            self._life_job.want(key)
+            return self._show_life(key, kept)
+        self.life_text.object = (f"**Life over the route:** {PENDING} (25 s to 2 min, "
+                                 "in the background)")
+        if served_document() is None:
+            self._life_waiting = key
+            return
+        if key == self._life_job.wanted:
+            return
+        stop = partial(_stop_unless_life_wanted, key)
+        self._life_job.start(
+            key, lambda: route_life.life_result(*key, runner=partial(background.run, stop=stop),
+                                           checkpoint=background.checkpoint),
+            self._show_life, self._life_failed)
+
+    def compute_life(self) -> None:
+        """Not served: compute the route life the verdict on screen waits for, and show it."""
+        key, self._life_waiting = self._life_waiting, None
+        if key is not None:
+            self._life_job.start(key, lambda: route_life.life_result(*key), self._show_life,
+                                 self._life_failed)
+
+    def _show_life(self, key, result) -> None:
+        self.life, self.life_for = result, key
+        self.life_text.object = route_life.description(result, key[2])
+        self.life_chart.object = route_life.damage_figure(result)
+        if self.result is not None:
+            self._fill_table()
+
+    def _life_failed(self, _key, error: BaseException) -> None:
+        self.life_text.object = f"**Life over the route:** not computed: {html.escape(str(error))}"
 
     # --- the verdict under uncertainty --------------------------------------------------------
 

@@ -22,19 +22,21 @@ from app.results.tables import order_name
 from model.analysis.assessment import KIND_NAMES, VERDICT_WORDS, verdict_colour
 from model.mechanics.operating_point import KMH
 from model.studies.assessment import (
+    LOAD_CASES,
     Assessment,
     AssessmentOptions,
     LoadCase,
     assessed_outputs,
     assessment_of,
     ripple_case,
+    running_case,
     short_circuit_case,
     starting_case,
     unstable_adhesion_case,
 )
 
 CASE_COLOURS = {"short_circuit": "#1f77b4", "unstable_adhesion": "#d62728", "starting": "#2ca02c",
-                "ripple": "#9467bd"}
+                "ripple": "#9467bd", "running": "#8c564b"}
 
 
 def _parameters(case: CaseBase, strength: tuple):
@@ -46,7 +48,8 @@ def _in_this_thread(function, *args):
     return function(*args)
 
 
-def assessment_result(case: CaseBase, strength: tuple = (), runner=_in_this_thread):
+def assessment_result(case: CaseBase, strength: tuple = (), runner=_in_this_thread,
+                      running: bool = False):
     """The assessment at the case's point and short circuit (its Δt and horizon do not count:
     every fault instant, the horizons of the load cases), with the strength data ``strength``
     ((name, value) pairs) replacing the set's.  The same as
@@ -55,15 +58,20 @@ def assessment_result(case: CaseBase, strength: tuple = (), runner=_in_this_thre
     point the unstable case is the default one, and the ripple case, steady running over every
     speed, is always at the assessment's default creepages (``AssessmentOptions().s0``, as
     ``bogie assess`` takes them); a step of the creepage or the speed leaves both as they
-    were.  ``runner(function, *args)`` computes it when the cache does not hold it (the served
-    dashboard: :func:`app.services.background.run`, a worker process)."""
+    were.  ``running``: with the running case as ``bogie assess --running`` computes it by
+    default (:func:`running_load_case`).  ``runner(function, *args)`` computes it when the cache
+    does not hold it (the served dashboard: :func:`app.services.background.run`, a worker
+    process)."""
     key = case.without("dt", "t_end")
     strength = tuple(strength)
+    if running:
+        return compute.cached("assessment", key,
+                              lambda: runner(_assessment, key, strength, True), strength, True)
     return compute.cached("assessment", key, lambda: runner(_assessment, key, strength),
                           strength)
 
 
-def _assessment(key: CaseBase, strength: tuple) -> Assessment:
+def _assessment(key: CaseBase, strength: tuple, running: bool = False) -> Assessment:
     """The assessment of :func:`assessment_result` (in a background worker when served: its load
     cases are cached in that worker)."""
     from model.analysis.eigen import bogie_system
@@ -83,9 +91,26 @@ def _assessment(key: CaseBase, strength: tuple) -> Assessment:
     unstable = unstable_case(key.replace(s0=options.unstable_s0,
                                          v=round(options.unstable_v / KMH, 9)), strength)
     ripple = ripple_load_case(key, strength)
+    running_cases = [running_load_case(key, strength)] if running else []
     return assessment_of(parameters, [short_circuit_case(parameters, outputs, options),
                                       unstable, starting_case(parameters, outputs, options),
-                                      ripple])
+                                      ripple, *running_cases])
+
+
+def running_load_case(case: CaseBase, strength: tuple = ()) -> LoadCase:
+    """The running case (:func:`model.studies.assessment.running_case`) at the case's set, wheel
+    force and motor slope with ``bogie assess --running``'s defaults (its creepages, speeds,
+    wheel polygon, track and random multiple): a step of the creepage, the speed or the short
+    circuit leaves it as it was."""
+    key = case.without("dt", "t_end", "v", "M0", "f", "D", "s0")
+    strength = tuple(strength)
+
+    def compute_case() -> LoadCase:
+        parameters = _parameters(key, strength)
+        op = key.replace(s0=AssessmentOptions().s0[0], v=120.0).operating_point()
+        options = AssessmentOptions(N0=op.N0, b_M=op.b_M, cases=(*LOAD_CASES, "running"))
+        return running_case(parameters, assessed_outputs(parameters), options)
+    return compute.cached("running case", key, compute_case, strength)
 
 
 def ripple_load_case(case: CaseBase, strength: tuple = ()) -> LoadCase:
@@ -221,11 +246,12 @@ def safety_factor_figure(result: Assessment):
     source = ColumnDataSource({"x": x, "top": top, "colour": colours, "case": cases,
                                "component": names})
     fig = figure(x_range=FactorRange(*[(n, case) for n in components
-                                       for case in CASE_COLOURS]),
+                                       for case in CASE_COLOURS if case in set(cases)]),
                  y_axis_type="log", height=400, sizing_mode="stretch_width",
                  y_axis_label="safety factor = capacity / load [-]", name="verdict-bars",
                  title="Safety factor of every check, per load case (blue short circuit, red "
-                       "unstable adhesion, green starting)", toolbar_location="above")
+                       "unstable adhesion, green starting, purple ripple, brown running)",
+                 toolbar_location="above")
     fig.vbar(x="x", top="top", bottom=0.05, width=0.8, color="colour", source=source)
     for required in sorted({c.required for c in result.checks}):
         fig.add_layout(Span(location=required, dimension="width", line_dash="dashed",

@@ -40,6 +40,9 @@ SIDE_VIEW_POOL = prioritized_pool(2, SIDE_VIEW, "bogie-side-view")
 # next nonlinear history
 NONLINEAR_POOL = prioritized_pool(1, FOLLOW_UP, "bogie-nonlinear")
 SEARCH_POOL = prioritized_pool(1, SEARCH, "bogie-reaction")
+# the life over a route (25 s to 2 min in a background worker process): a thread of its own that
+# waits for it, so that it never holds up a side view's thread
+LIFE_POOL = prioritized_pool(1, SEARCH, "bogie-life")
 # a dragged slider's previews (app.results.preview: at most one reduced eigenproblem each) yield
 # the cores to the first answers, so a preview never delays the answer to the release
 PREVIEW_POOL = prioritized_pool(2, FOLLOW_UP, "bogie-preview")
