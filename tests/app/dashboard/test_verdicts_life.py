@@ -85,9 +85,12 @@ def test_the_life_column_is_bogie_life_over_the_same_route(dash, cli_life):
     view.compute_life()
     assert view.life is not None
     cli = {s["name"]: s for s in cli_life["sections"]}
-    # the same computation in two processes: the same numbers to rounding
+    # the same computation in two processes; the dashboard's model is the results cache's, which
+    # keeps the decompositions of its last operating points, so the floating-point operations
+    # differ in order: 1.2e-8 relative was seen on the smallest damage (ID2's axle, 5e28 km);
+    # 1e-6 is far below the table's three digits and far above that rounding
     for section in view.life.sections:
-        assert section.life_km == pytest.approx(cli[section.section.name]["life_km"], rel=1e-9)
+        assert section.life_km == pytest.approx(cli[section.section.name]["life_km"], rel=1e-6)
     fatigue = [row for row in view.rows if row["check"] == FATIGUE_CHECK]
     assert {row["component"] for row in fatigue} == set(cli)
     for row in fatigue:

@@ -23,6 +23,8 @@ pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 T_END = 2.7  # the page's simulated time [s]: this module's session among the server's
 LIFE_WAIT_S = 900.0  # the life over the bundled route, and the running case [s]
+TEXT = """(cls) => { const m = [...Bokeh.documents[0].all_models]
+  .find(m => (m.css_classes || []).includes(cls)); return m ? m.text || '' : ''; }"""
 CELLS = """(row) => Object.fromEntries([...row.querySelectorAll('.tabulator-cell')].map(
     c => [c.getAttribute('tabulator-field'), c.innerText]))"""
 
@@ -93,7 +95,7 @@ def test_life_cells_show_the_life_computed(app_server, chromium, tmp_path):
         page.wait_for_function(
             "() => [...Bokeh.documents[0].all_models].some(m => m.name === 'life-damage')",
             timeout=60_000)
-        text = page.locator(".verdict-life-text").inner_text()
+        text = page.evaluate(TEXT, "verdict-life-text")
         assert "Life over the route" in text
         assert "mixed passenger duty" in text
         page.locator(".life-chart canvas").first.scroll_into_view_if_needed()
