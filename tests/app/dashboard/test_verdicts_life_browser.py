@@ -102,10 +102,10 @@ def test_life_cells_show_the_life_computed(app_server, chromium, tmp_path):
         page.screenshot(path=str(tmp_path / "verdicts-life.png"), full_page=True)
 
         # the running case, on request
-        box = page.locator(".ctl-verdict-running input[type=checkbox]")
-        assert "running case (track, wheels, ripple; ≈ 40 s)" in page.locator(
-            ".ctl-verdict-running").inner_text()
-        box.check()
+        label = page.evaluate("""() => [...Bokeh.documents[0].all_models].find(
+            m => (m.css_classes || []).includes('ctl-verdict-running')).label""")
+        assert label == "running case (track, wheels, ripple; ≈ 40 s)"
+        page.locator(".ctl-verdict-running input").check()
         _until(lambda: any(r["load case"] == "running" for r in view.rows),
                "the running case's checks", LIFE_WAIT_S)
         running = _until(lambda: {k: v for k, v in rendered_rows(page).items()
