@@ -28,7 +28,7 @@ ROUTE = Path(__file__).resolve().parents[2] / "assets" / "routes" / "mixed_passe
 SOURCES = ("ripple", "polygon", "track", "short_circuit")  # the route's sources, in this order
 SPEED_SOURCES = ("ripple", "polygon", "track")  # the sources over speed (the plot's lines)
 SOURCE_COLOURS = {"ripple": "#9467bd", "polygon": "#ff7f0e", "track": "#2ca02c"}
-LOWEST_SHOWN = 1e-15  # the plot's lowest damage a year, relative to the largest [-]
+LOWEST_SHOWN = 1e-25  # the plot's lowest damage a year, relative to the largest [-]
 FATIGUE_CHECK = "torsional fatigue"  # the rows of the Verdicts table a life belongs to
 
 
@@ -132,7 +132,10 @@ def description(result, route_file: str = str(ROUTE)) -> str:
     events = ("" if route.short_circuit is None else
               f", {route.short_circuit.per_year:g} short circuits a year")
     notes = "".join(f" {note}." for note in result.notes)
-    return (f"**Life over the route** (column *life [km]*, the years in the note): "
+    least = result.least_life
+    first = ("" if least.damage <= 0 else f" Least life: **{least.section.name}**, "
+             f"{least.life_km:.3g} km ({least.life_years:.3g} years).")
+    return (f"**Life over the route** (column *life [km]*, the years in the note):{first} "
             f"{route.name}, {route.annual_distance / 1e3:g} km a year{events}; sources: "
             f"{', '.join(result.sources)}; Miner's sum with the FKM guideline's shear S–N curve "
             f"through DIN 743's fatigue limit (N_D = {result.options.knee_cycles:g}, k = "
@@ -176,12 +179,12 @@ def damage_figure(result):
     life = ("no damage" if not math.isfinite(least.life_km) else
             f"{least.life_km:.3g} km = {least.life_years:.3g} years")
     largest = max((d for v, damage in lines.values() for d in damage), default=0.0)
-    # the tails far from the resonances reach 1e-50: the axis shows 15 decades below the largest
+    # the tails far from the resonances reach 1e-50: the axis shows 25 decades below the largest
     y_range = (Range1d(largest * LOWEST_SHOWN, largest * 10.0) if largest > 0 else
                Range1d(1e-20, 1.0))
     fig = figure(y_axis_type="log", y_range=y_range, height=330, sizing_mode="stretch_width", name="life-damage",
                  x_axis_label="speed [km/h] (the route's bin centres)",
-                 y_axis_label="damage a year [1/year] (15 decades below the largest)", toolbar_location="above",
+                 y_axis_label="damage a year [1/year] (25 decades below the largest)", toolbar_location="above",
                  title=f"Damage a year over speed: {least.section.name} (least life, {life}); "
                        f"short circuits ({per_year:g} a year, not over speed): {events:.3g} "
                        "1/year")

@@ -25,8 +25,9 @@ T_END = 2.7  # the page's simulated time [s]: this module's session among the se
 LIFE_WAIT_S = 900.0  # the life over the bundled route, and the running case [s]
 TEXT = """(cls) => { const m = [...Bokeh.documents[0].all_models]
   .find(m => (m.css_classes || []).includes(cls)); return m ? m.text || '' : ''; }"""
-CELLS = """(row) => Object.fromEntries([...row.querySelectorAll('.tabulator-cell')].map(
-    c => [c.getAttribute('tabulator-field'), c.innerText]))"""
+ROWS = """(holder) => [...holder.querySelectorAll('.tabulator-row')].map(
+    row => Object.fromEntries([...row.querySelectorAll('.tabulator-cell')].map(
+        c => [c.getAttribute('tabulator-field'), c.innerText])))"""
 
 
 def _dashboard():
@@ -49,18 +50,23 @@ def _until(condition, what: str, timeout: float = 300.0):
 
 def rendered_rows(page) -> dict[tuple, dict]:
     """Every row of the Verdicts table as drawn, by (component, check, load case): the table is
-    virtual (only the rows in view exist), so it is scrolled through."""
+    virtual (only the rows in view exist), so it is scrolled through; {} if the table is redrawn
+    meanwhile (the caller asks again)."""
+    from playwright.sync_api import Error
+
     holder = page.locator(".verdict-table .tabulator-tableholder")
-    height = holder.evaluate("h => h.scrollHeight")
     rows: dict[tuple, dict] = {}
-    for top in range(0, int(height) + 200, 150):
-        holder.evaluate("(h, y) => { h.scrollTop = y }", top)
-        page.wait_for_timeout(100)
-        for row in page.locator(".verdict-table .tabulator-row").all():
-            cells = row.evaluate(CELLS)
-            if "component" in cells:
-                rows[(cells["component"], cells["check"], cells["load case"])] = cells
-    holder.evaluate("h => { h.scrollTop = 0 }")
+    try:
+        height = holder.evaluate("h => h.scrollHeight", timeout=10_000)
+        for top in range(0, int(height) + 200, 150):
+            holder.evaluate("(h, y) => { h.scrollTop = y }", top, timeout=10_000)
+            page.wait_for_timeout(100)
+            for cells in holder.evaluate(ROWS, timeout=10_000):
+                if "component" in cells:
+                    rows[(cells["component"], cells["check"], cells["load case"])] = cells
+        holder.evaluate("h => { h.scrollTop = 0 }", timeout=10_000)
+    except Error:
+        return {}
     return rows
 
 
