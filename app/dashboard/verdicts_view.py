@@ -108,6 +108,7 @@ class VerdictsView:
         self.life = None  # the route life on screen (model.studies.life.LifeResult)
         self.life_for: tuple | None = None  # its key
         self._life_waiting: tuple | None = None  # not served: the key compute_life computes
+        self._chart_pending = False  # the life's plot waits for the tab to be shown
         _LIFE_VIEWS.add(self)
         self.running = pn.widgets.Checkbox(label=RUNNING_LABEL, value=False,
                                            css_classes=["ctl-verdict-running"])
@@ -204,6 +205,9 @@ class VerdictsView:
         self._tab_open = shown
         if shown:
             self.refresh_results()
+        if shown and self._chart_pending and self.life is not None:
+            self._chart_pending = False
+            self.life_chart.object = route_life.damage_figure(self.life)
         if shown and self._waiting is not None:
             key, self._waiting = self._waiting, None
             self._show(key, assessment_result(key[0], key[1], running=key[2]))
@@ -276,7 +280,11 @@ class VerdictsView:
     def _show_life(self, key, result) -> None:
         self.life, self.life_for = result, key
         self.life_text.object = route_life.description(result, key[2])
-        self.life_chart.object = route_life.damage_figure(result)
+        # a new figure only while the tab is drawn: replaced in a tab the page has left, its
+        # models were unknown to the page ("reference … isn't known")
+        self._chart_pending = not self._tab_open and served_document() is not None
+        if not self._chart_pending:
+            self.life_chart.object = route_life.damage_figure(result)
         if self.result is not None:
             self._fill_table()
 
