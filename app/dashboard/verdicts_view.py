@@ -12,7 +12,7 @@ seconds (the short-circuit case's grid over every fault instant, the ripple case
 so the indicator says "computing" meanwhile.  The "running case" checkbox adds the running load
 case (``bogie assess --running``'s defaults, about 40 s) to the same assessment.
 
-Once a verdict is shown, each shaft section's fatigue life over the bundled route
+Once a verdict is shown and the tab is open, each shaft section's fatigue life over the bundled route
 (:mod:`app.results.life`, 25 s to 2 min) is computed in a background worker process, its thread
 of the :data:`~app.services.thread_pools.LIFE_POOL`, never on a slider's path: the table's life
 column says "computing…" meanwhile and the result is kept in the results cache; it stops at the
@@ -109,6 +109,7 @@ class VerdictsView:
         self.life_for: tuple | None = None  # its key
         self._life_waiting: tuple | None = None  # not served: the key compute_life computes
         self._chart_pending = False  # the life's plot waits for the tab to be shown
+        self._life_pending = False  # the life of the verdict on screen waits for the tab
         _LIFE_VIEWS.add(self)
         self.running = pn.widgets.Checkbox(label=RUNNING_LABEL, value=False,
                                            css_classes=["ctl-verdict-running"])
@@ -205,6 +206,9 @@ class VerdictsView:
         self._tab_open = shown
         if shown:
             self.refresh_results()
+        if shown and self._life_pending and self.shown_for is not None:
+            self._life_pending = False
+            self._request_life(self.shown_for)
         if shown and self._chart_pending and self.life is not None:
             self._chart_pending = False
             self.life_chart.object = route_life.damage_figure(self.life)
@@ -226,8 +230,12 @@ class VerdictsView:
             f"): {html.escape(c.description)}</li>" for c in result.cases) + "</ul>"
         self.chart.object = safety_factor_figure(result)
         self.dashboard.resonances.show_crossings()
-        if len(key) > 1:  # a new assessment (not new bands): the life of its set
-            self._request_life(key[0])
+        if len(key) > 1:  # a new assessment (not new bands): the life of its set, asked for
+            # while the tab is open (minutes of CPU in a background worker: not for a session
+            # that never looks at it)
+            self._life_pending = not self._tab_open
+            if self._tab_open:
+                self._request_life(key[0])
 
     def _fill_table(self) -> None:
         """The checks' rows with each fatigue row's life (computing…, or the life on screen
