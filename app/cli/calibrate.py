@@ -5,7 +5,7 @@ stderr, the table of the targets (or ``--json``) on stdout.  ``--out`` is requir
 writes only where it is told, and replacing the bundled default set
 (``assets/parameters/calibrated.toml``) is said on stderr.
 
-    bogie calibrate --out FILE [--from FILE] [--max-evaluations M] [--json]
+    bogie calibrate --out FILE [--from FILE] [--divergence-weight W] [--max-evaluations M] [--json]
     bogie calibrate --starts N --out FILE [--scheduler tcp://HOST:PORT | --workers W | --serial]
     bogie calibrate --start K --out FILE
 
@@ -14,7 +14,9 @@ the same least squares from N points of a scrambled Sobol' sequence within the b
 study engine (a local cluster by default); it writes the best start's set to FILE and prints
 every start (cost, frequency and divergence errors, the front between them) and the spread of
 the best starts per parameter.  ``--start K`` runs start K alone in this process and writes its
-set: the same bytes the global search writes when K is its best.  Bad input: one line on stderr,
+set: the same bytes the global search writes when K is its best.  ``--divergence-weight W``
+weighs the two divergence rates at s0 = 0.014 in the last phase (default 1): the knob of the
+trade between Table 1's frequencies and the divergence (docs/validation.md).  Bad input: one line on stderr,
 exit status 2.
 """
 
@@ -28,6 +30,7 @@ from app.cli.options import (
     UsageError,
     add_engine_options,
     non_negative_int,
+    number,
     positive_int,
 )
 from app.cli.output import emit, writable_path
@@ -52,6 +55,11 @@ def register(subparsers) -> None:
                    help="trial parameter sets of each least-squares phase at most (default: "
                         "the calibration's own, as for the bundled set; smaller for a quick "
                         "check)")
+    p.add_argument("--divergence-weight", type=number("--divergence-weight", 0.0, 1000.0,
+                                                       allowed="a weight in (0, 1000)"),
+                   default=None, metavar="W",
+                   help="weight of the two divergence rates at s0 = 0.014 in the last phase "
+                        "(default 1; the bundled set: see its header)")
     p.add_argument("--json", action="store_true", help="machine-readable JSON output (progress "
                                                        "goes to stderr either way)")
     add_engine_options(p)
@@ -102,6 +110,11 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
 
     phases = PHASES if args.max_evaluations is None else tuple(
         (min(count, args.max_evaluations), weights) for count, weights in PHASES)
+    if args.divergence_weight is not None:
+        from dataclasses import replace
+
+        count, weights = phases[-1]
+        phases = phases[:-1] + ((count, replace(weights, divergence=args.divergence_weight)),)
 
     def progress(text: str) -> None:
         print(text, file=sys.stderr, flush=True)
