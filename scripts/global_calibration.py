@@ -2,8 +2,8 @@
 of ``bogie calibrate --starts N --json`` (the search takes tens of minutes; its output is kept
 in ``assets/data/``), and the comparison of its best set with the bundled one.
 
-    bogie calibrate --starts 16 --out assets/parameters/global_best.toml --json \\
-        > assets/data/global_calibration_n16.json
+    bogie calibrate --starts 16 --divergence-weight 10 --out assets/parameters/global_best.toml \\
+        --json > assets/data/global_calibration_n16.json
     .venv/bin/python scripts/global_calibration.py      # docs/results/global_calibration.json,
                                                         # assets/figures/global_calibration_front.png
 """
@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import replace
 import math
 import sys
 from pathlib import Path
@@ -25,7 +26,7 @@ from threadpoolctl import threadpool_limits  # noqa: E402
 
 from model import load_parameters  # noqa: E402
 from model.mechanics.parameters import ESTIMATE_FILE  # noqa: E402
-from model.studies.calibration import stage_j_cost  # noqa: E402
+from model.studies.calibration import PHASES, stage_j_cost  # noqa: E402
 from model.studies.calibration_bounds import SEARCH_PARAMETERS  # noqa: E402
 from model.studies.calibration_targets import TABLE1_IM_HZ, evaluate  # noqa: E402
 from model.studies.global_calibration import StartResult, spread, target_measures  # noqa: E402
@@ -63,9 +64,10 @@ def spread_block(run: dict) -> str:
 def comparison(run: dict) -> dict:
     bundled = load_parameters()
     estimate = load_parameters(ESTIMATE_FILE)
+    weights = replace(PHASES[-1][1], divergence=run.get("divergence_weight", 1.0))
     with threadpool_limits(1):
         rows = evaluate(bundled)
-        cost = stage_j_cost(bundled, estimate, clip=False)
+        cost = stage_j_cost(bundled, estimate, weights, clip=False)
     best = next(r for r in run["results"] if r["index"] == run["best"])
     measures = target_measures(rows)
     bundled_rows = {row.name.split(" [")[0].replace(" OTHER CHARACTER:", ""): row for row in rows}
@@ -142,6 +144,7 @@ def main() -> None:
     held = [s["name"] for s in run["spread"] if s["on_bound"]]
     data = {"starts": run["starts"], "best": run["best"], "front": run["front"],
             "seconds": run["seconds"], "minutes": run["seconds"] / 60, "where": run["where"],
+            "divergence_weight": run.get("divergence_weight", 1.0),
             "per_start_seconds_mean": sum(r["seconds"] for r in run["results"]) / run["starts"],
             "failed": [r["index"] for r in run["results"] if r["failed"]],
             "failed_count": sum(bool(r["failed"]) for r in run["results"]),

@@ -129,7 +129,7 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
         result = run_start(args.start, start, phases)
         if result.failed:
             raise UsageError(f"start {args.start} cannot be calibrated: {result.failed}")
-        rows, table = write_start(result, out, start)
+        rows, table = write_start(result, out, start, args.divergence_weight)
         progress(f"wrote {out}")
         emit(args, {"out": str(out), "start": args.start, "cost": result.cost,
                     "targets": _rows_json(rows)}, table)
@@ -154,7 +154,7 @@ def _global(args, start, out, phases, progress) -> None:
         progress(f"global calibration: {args.starts} starts on {where} …")
         result = global_search(args.starts, mapper, start, phases, done, where)
     best = next(r for r in result.results if r.index == result.best)
-    rows, table = write_start(best, out, start)
+    rows, table = write_start(best, out, start, args.divergence_weight)
     progress(f"wrote {out} (start {result.best})")
     data = {"out": str(out), **result.as_dict(), "targets": _rows_json(rows)}
     emit(args, data, starts_table(result) + "\n\nbest start's targets:\n" + table)

@@ -13,8 +13,9 @@ over the calibration bounds and compares where they land:
   estimate (``start_file``).
 * **Each start** is a pure function of its index (:func:`run_start`; one BLAS thread): the study
   engine (:mod:`model.studies.engine`) runs them on its workers.
-* **Ranking**: by stage J's own cost at full weights (:func:`model.studies.calibration.stage_j_cost`);
-  the best start is the one with the lowest cost.
+* **Ranking**: by stage J's own cost at its last phase's weights
+  (:func:`model.studies.calibration.stage_j_cost`, with ``--divergence-weight`` where given); the
+  best start is the one with the lowest cost.
 * **The trade**: per start the largest frequency error of the ten pairs by rank at s0 = 0.005
   (Table 1) and the divergence error (the largest real eigenvalue at s0 = 0.014 against
   +7.031 1/s); the starts that no other start beats in both form the front (:func:`front`).
@@ -128,7 +129,7 @@ def run_start(k: int, start_file: str | Path | None = None, phases: tuple = PHAS
         with threadpool_limits(1):
             calibrated, rows = calibrate(estimate, lambda _text: None, phases,
                                          initial=estimate.replace(**values))
-            cost = stage_j_cost(calibrated, estimate)
+            cost = stage_j_cost(calibrated, estimate, phases[-1][1])
     except (ValueError, np.linalg.LinAlgError) as error:  # a start the model cannot analyse
         # (e.g. a creep shape whose law has no maximum below s = 1 for any μ0, A, B, p)
         return StartResult(k, values, {}, math.inf, math.inf, 0, 0, math.nan, math.inf,
@@ -202,6 +203,7 @@ class GlobalResult:
 
     def as_dict(self) -> dict:
         return {"starts": len(self.results), "best": self.best, "front": self.front,
+                **self.extra,
                 "seconds": self.seconds, "where": self.where, "sobol_seed": SOBOL_SEED,
                 "results": [r.as_dict() for r in self.results],
                 "spread": [{"name": s.name, "low": s.low, "high": s.high, "share": s.share,
@@ -230,11 +232,12 @@ def global_search(starts: int, map_unordered: Callable[[Callable, list], Iterato
         raise ValueError(f"no start could be calibrated: {ordered[0].failed}")
     best = min(ordered, key=lambda r: (r.cost, r.index)).index
     return GlobalResult(ordered, best, front(ordered), spread(ordered),
-                        time.perf_counter() - began, where)
+                        time.perf_counter() - began, where,
+                        {"divergence_weight": phases[-1][1].divergence})
 
 
-def write_start(result: StartResult, out_file: str | Path, start_file: str | Path | None = None
-                ) -> tuple[list[TargetRow], str]:
+def write_start(result: StartResult, out_file: str | Path, start_file: str | Path | None = None,
+                divergence_weight: float | None = None) -> tuple[list[TargetRow], str]:
     """Write a start's calibrated set to ``out_file`` with its targets and the stability limit
     in the header (one BLAS thread: ``--start K`` and the best of ``--starts N`` write the same
     bytes); returns the target rows and their table."""
@@ -252,9 +255,10 @@ def write_start(result: StartResult, out_file: str | Path, start_file: str | Pat
                                 parameters["motor_slope"]).s0_limit
     table = format_table(rows, limit)
     name = Path(ESTIMATE_FILE if start_file is None else start_file).name
+    how = "" if divergence_weight is None else f" --divergence-weight {divergence_weight:g}"
     header = (f"Calibrated parameter set of start {result.index} of the global calibration "
               f"(scrambled Sobol' sequence, seed {SOBOL_SEED}, within the calibration bounds).\n"
-              f"Produced by `bogie calibrate --start {result.index} --from {name}`; "
+              f"Produced by `bogie calibrate --start {result.index} --from {name}{how}`; "
               f"`bogie calibrate --starts N` writes the same file\nwhen start {result.index} is "
               f"its best. Stage J's cost {result.cost:.6g}. Targets and results:\n" + table)
     save_parameters(parameters, out_file, header)

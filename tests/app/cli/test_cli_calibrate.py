@@ -32,7 +32,7 @@ def stubbed(monkeypatch):
         return gc.StartResult(k, gc.start_values(k), values, float((k - 1) ** 2 + 1), 0.1 * k,
                               10 - k, 10, 7.0 + k, k / 7.031, 0.5)
 
-    def fake_write(result, out, start_file=None):
+    def fake_write(result, out, start_file=None, divergence_weight=None):
         out.write_text(f"start {result.index}\n", encoding="utf-8")
         written.append(result.index)
         return [], "targets table"
