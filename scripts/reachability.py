@@ -11,6 +11,7 @@ vertical dampers at their hardware bounds, and the dampers each published real p
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from pathlib import Path
@@ -73,9 +74,13 @@ def suspension_numbers(parameters) -> dict:
             "re_at_set": m.re_at_set, "re_at_lower_bounds": m.re_at_lower_bounds,
             "zeta_at_lower_bounds": m.zeta_at_lower_bounds, "slopes": m.slopes,
             "re_without_dampers": m.re_without_dampers, "scale_needed": m.scale_needed,
-            "factor_below_bounds": m.factor_below_bounds,
+            # null: no positive damper rate gives the published Re (the mode is damped more than
+            # that with both vertical dampers at zero)
+            "factor_below_bounds": (m.factor_below_bounds if math.isfinite(m.factor_below_bounds)
+                                    else None),
             "damping_needed": {d: m.scale_needed * proof.lower_bounds[d] for d in proof.lower_bounds},
-            "re_first_order": m.re_first_order, "reachable": m.reachable}
+            "re_at_half_bounds": m.re_at_half_bounds, "re_first_order": m.re_first_order,
+            "reachable": m.reachable}
     return {"lower_bounds": proof.lower_bounds, "set_values": proof.set_values, "modes": modes}
 
 

@@ -223,10 +223,12 @@ class SuspensionMode:
     re_at_set: float  # [1/s] the set's
     re_at_lower_bounds: float  # [1/s] both vertical dampers at their lower bounds
     zeta_at_lower_bounds: float
-    slopes: dict  # dRe/dc [1/(N s)] per damper (first order, from the full solves)
+    slopes: dict  # dRe/dc [1/(N s)] per damper between half its lower bound and the bound (the
+    # other at its lower bound), from the full solves
     re_without_dampers: float  # [1/s] the first-order model with both vertical dampers at zero
     scale_needed: float  # both dampers at this share of their lower bounds give the published Re
-    re_first_order: float  # the first-order model at the lower bounds (check of linearity)
+    re_at_half_bounds: float  # [1/s] the full solve with both dampers at half their lower bounds
+    re_first_order: float  # the first-order model there (check of linearity)
 
     @property
     def factor_below_bounds(self) -> float:
@@ -265,26 +267,28 @@ def _zeta(lam: complex) -> float:
 
 def suspension_proof(parameters: Parameters) -> SuspensionProof:
     """The suspension modes of ``parameters`` (matched by Table 2's characters) with its
-    vertical dampers, with each one at its lower bound, and with both there; the rate each
-    published real part needs (first order: Re linear in each damper's rate between the set
-    and its lower bound)."""
+    vertical dampers, with both at their lower bounds, each at half its bound (the other at its
+    bound) and both at half; the rate each published real part needs (first order about the
+    lower bounds: Re linear in each damper's rate below them, checked at half the bounds)."""
     lower = {name: _BOUNDS[name].low for name in DAMPERS}
     base = {name: float(parameters[name]) for name in DAMPERS}
     at_set = _by_character(parameters)
-    one = {name: _by_character(parameters.replace(**{name: lower[name]})) for name in DAMPERS}
     both = _by_character(parameters.replace(**lower))
+    half = {name: _by_character(parameters.replace(**{**lower, name: 0.5 * lower[name]}))
+            for name in DAMPERS}
+    both_half = _by_character(parameters.replace(**{d: 0.5 * lower[d] for d in DAMPERS}))
     modes = []
     for row, name in SUSPENSION_MODES.items():
         published = TABLE1_RE[row - 1]
-        slopes = {d: (one[d][row].real - at_set[row].real) / (lower[d] - base[d]) for d in DAMPERS}
-        first = at_set[row].real + sum(slopes[d] * (lower[d] - base[d]) for d in DAMPERS)
+        slopes = {d: (both[row].real - half[d][row].real) / (0.5 * lower[d]) for d in DAMPERS}
         share = sum(slopes[d] * lower[d] for d in DAMPERS)  # the dampers at their bounds [1/s]
         without = both[row].real - share
+        first = both[row].real - 0.5 * share
         scale = (published - without) / share if share < 0 else math.inf
         published_lam = complex(published, 2 * math.pi * TABLE1_IM_HZ[row - 1])
         modes.append(SuspensionMode(row, name, published, _zeta(published_lam), at_set[row].real,
                                     both[row].real, _zeta(both[row]), slopes, without, scale,
-                                    first))
+                                    both_half[row].real, first))
     return SuspensionProof(modes, lower, base)
 
 
