@@ -77,32 +77,32 @@ class UncertaintyError(ValueError):
 
 
 UNCERTAIN_PARAMETERS: tuple[ParameterRange, ...] = (
-    ParameterRange("creep_slope", 530.0, 1060.0, "the calibrated creep shape (kA 0.35, kS "
-                   "0.29) needs ~800 (docs/validation.md); Hertz+Kalker would give ~130, "
+    ParameterRange("creep_slope", 640.0, 1280.0, "the calibrated creep shape (kA 0.38, kS "
+                   "0.27) needs ~960 (docs/validation.md); Hertz+Kalker would give ~130, "
                    "so ±1/3 around the fit"),
     # over this box (a grid of 7 values each of slope, A and B, geometric) the creep law has a
     # maximum below s = 1 everywhere at 40–250 km/h (the response at 120 km/h needs it for M_ad)
-    ParameterRange("polach_A", 0.2, 0.3, "Polach's presets 0.4; calibrated 0.20, on the "
-                   "calibration's lower bound: that bound … × 1.5"),
-    ParameterRange("polach_B", 0.1, 0.24, "Polach's presets 0.2–0.6 s/m; calibrated 0.157: "
+    ParameterRange("polach_A", 0.53, 0.9, "Polach's presets 0.4; calibrated 0.80: ÷ 1.5 … the "
+                   "calibration's upper bound 0.9"),
+    ParameterRange("polach_B", 0.6, 1.36, "Polach's presets 0.2–0.6 s/m; calibrated 0.91: "
                    "÷ 1.5 … × 1.5"),
     ParameterRange("motor_slope", 1000.0, 12000.0, "torque falls 12.8 kN m over 0.5–6 % of "
-                   "213 rad/s (converter control unknown); calibrated 2 460"),
+                   "213 rad/s (converter control unknown); calibrated 1 210"),
     ParameterRange("rubber_loss_time", 1e-4, 4e-4, "rubber loss factor 0.05–0.2 at ~80 Hz",
                    log=False),
     ParameterRange("disc_clutch_torsional_stiffness", 3.5e4, 1e5, "rubber disc clutch; "
-                   "calibrated 5.2e4 from the 2.7 Hz mode"),
-    ParameterRange("driving_shaft_stiffness", 6e6, 1.2e7, "quill shaft; calibrated 8.1e6 "
+                   "calibrated 4.0e4 from the 2.7 Hz mode"),
+    ParameterRange("driving_shaft_stiffness", 6e6, 1.2e7, "quill shaft; calibrated 7.5e6 "
                    "from the 298 Hz mode"),
-    ParameterRange("rotor_inertia", 8.0, 18.0, "550 kg rotor, radius of gyration 0.12–0.18 m"),
-    ParameterRange("silent_block_stiffness_x", 5.9e6, 2.4e7, "rubber-metal block, "
-                   "calibrated 1.18e7 (×/÷ 2; up to the calibration's bound 2.4e7)"),
-    ParameterRange("primary_stiffness_x", 1.7e6, 6.6e6, "longitudinal guide, calibrated "
-                   "3.3e6 (×/÷ 2)"),
-    ParameterRange("yaw_damping", 5e5, 1e6, "yaw damper, calibrated 1e6, on the calibration's "
-                   "bound 1 MN s/m: ÷ 2 … that bound"),
-    ParameterRange("yaw_damper_series_stiffness", 9.4e6, 3e7, "the yaw dampers' end bushes, "
-                   "calibrated 1.87e7: ÷ 2 … the calibration's bound 3e7"),
+    ParameterRange("rotor_inertia", 6.0, 18.0, "550 kg rotor, radius of gyration 0.10–0.18 m; "
+                   "calibrated 7.5"),
+    ParameterRange("silent_block_stiffness_x", 7.5e6, 2.4e7, "rubber-metal block, "
+                   "calibrated 1.5e7 (÷ 2 … the calibration's bound 2.4e7)"),
+    ParameterRange("primary_stiffness_x", 1.7e6, 6.0e6, "longitudinal guide, calibrated "
+                   "3.0e6 (the calibration's bound 1.7e6 … × 2)"),
+    ParameterRange("yaw_damping", 2.4e5, 9.6e5, "yaw damper, calibrated 4.8e5: ÷ 2 … × 2"),
+    ParameterRange("yaw_damper_series_stiffness", 1.2e7, 3e7, "the yaw dampers' end bushes, "
+                   "calibrated 2.43e7: ÷ 2 … the calibration's bound 3e7"),
     ParameterRange("gear_mesh_stiffness", 7.5e8, 3e9, "~7–30 N/(µm mm) × 100 mm face width"),
 )
 
