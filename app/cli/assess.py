@@ -24,8 +24,8 @@ ripple amplitudes or ``--ripple`` (as ``bogie ripple``), over ``--ripple-v`` (de
 km/h, refined at every resonance).  ``--running`` adds the running case: mean traction, the
 ripple, polygonal wheels (``--wheel-polygon``, default 20=30: order 20, 30 µm, an assumed
 amplitude) and ``--random-multiple`` (default 3) times the RMS under the random track, over
-``--running-v`` (default 20:200:10 km/h) at ``--running-s0`` (default 0.002; the running system
-must be stable there).  ``--samples N`` (a power of two) runs the assessment for N
+``--running-v`` (default 20:200:10 km/h) at ``--running-s0`` (default 0.002,0.005, the ripple
+case's; the running system must be stable there).  ``--samples N`` (a power of two) runs the assessment for N
 scrambled Sobol' samples of the unknowns' prior ranges (model.studies.verdict_priors; ``--ranges``
 a TOML file of others) on the study engine, every sample a work item, and prints each check's
 5/50/95 % band and probability of falling below its required factor; ``--indices`` adds the
@@ -115,7 +115,7 @@ def register(subparsers) -> None:
     running = p.add_argument_group("running (mean traction, ripple, wheel polygon, random track)")
     running.add_argument("--running", action="store_true",
                          help="add the running load case (docs/assessment.md)")
-    running.add_argument("--running-s0", default="0.002", metavar="LIST",
+    running.add_argument("--running-s0", default="0.002,0.005", metavar="LIST",
                          help="creepages of the running case (default %(default)s)")
     running.add_argument("--running-v", default="20:200:10", metavar="LIST",
                          help="speeds [km/h] of the running case (default %(default)s)")
