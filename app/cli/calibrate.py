@@ -114,7 +114,7 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
         from dataclasses import replace
 
         count, weights = phases[-1]
-        phases = phases[:-1] + ((count, replace(weights, divergence=args.divergence_weight)),)
+        phases = (*phases[:-1], (count, replace(weights, divergence=args.divergence_weight)))
 
     def progress(text: str) -> None:
         print(text, file=sys.stderr, flush=True)
