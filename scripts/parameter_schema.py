@@ -67,15 +67,18 @@ EXAMPLE_NOTE = "30 % softer quill shaft (drawing 123)"
 
 def example_output() -> str:
     """What ``bogie parameters --params my_bogie.toml`` prints for the worked example (the bundled
-    set with the driving shaft at 5.98 MN m/rad): the first line, the heading and its row."""
+    set with the driving shaft 30 % softer, as scripts/model_facts.py's variant): the first line,
+    the heading and its row."""
     import tempfile
 
     from app.cli.parameters import parameter_table
     from model.mechanics.parameters import Parameters, load_parameters, save_parameters
     from model.studies.calibration_bounds import parameter_rows
 
+    from model_facts import SOFTER
+
     base = load_parameters()
-    variant = base.replace(driving_shaft_stiffness=5.98e6)
+    variant = base.replace(driving_shaft_stiffness=round(SOFTER * base["driving_shaft_stiffness"], -4))
     variant = Parameters(variant.values, {**base.notes, "driving_shaft_stiffness": EXAMPLE_NOTE})
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "my_bogie.toml"
