@@ -110,7 +110,7 @@ def test_life_cells_show_the_life_computed(app_server, chromium, tmp_path):
         # the running case, on request
         label = page.evaluate("""() => [...Bokeh.documents[0].all_models].find(
             m => (m.css_classes || []).includes('ctl-verdict-running')).label""")
-        assert label == "running case (track, wheels, ripple; ≈ 40 s)"
+        assert label == "running case (track, wheels, ripple; ≈ 20 s)"
         page.locator(".ctl-verdict-running input").check()
         _until(lambda: any(r["load case"] == "running" for r in view.rows),
                "the running case's checks", LIFE_WAIT_S)
