@@ -76,6 +76,9 @@ STEPS = (
          "docs/results/global_calibration.json, assets/figures/global_calibration_front.png (from "
          "the stored run assets/data/global_calibration_n16.json; the search itself: bogie "
          "calibrate --starts 16, docs/validation.md)"),
+    Step("bundled-set", (_python("bundled_set.py"),),
+         "docs/results/bundled_set.json, assets/figures/divergence_trade.png (the calibration by "
+         "divergence weight, the rule's choice, the previous bundled set against the bundled one)"),
     Step("reachability", (_python("reachability.py"),),
          "docs/results/reachability.json (the reduced models of the study's contradictions)"),
     Step("response", (_python("figures_response.py"),),

@@ -43,6 +43,8 @@ from model.studies.calibration_targets import (
     MOTOR_TORQUE,
     RE_MODES,
     STABILITY_LIMIT,
+    SUSPENSION_MODES,
+    SUSPENSION_ZETA,
     TABLE1_IM_HZ,
     TABLE1_RE,
     TABLE1_UNSTABLE,
@@ -56,52 +58,47 @@ RE_TOLERANCE, RE_ABSOLUTE = 0.30, 0.05  # [-] relative; [1/s] where |Re_publishe
 
 # documented misses of the calibrated set (see docs/validation.md); value achieved in the reason
 MISSED_IM: dict[int, str] = {
-    1: "rank 1, the car body's bounce, at 1.560 Hz (+23.6 %): the calibration on the model whose "
-       "motor slope measures against the vehicle's speed trades it for the real parts and the "
-       "divergence (docs/validation.md)",
-    7: "rank 7, the wheelsets' longitudinal mode, at 9.300 Hz (+8.3 %)",
-    9: "rank 9, the wheelsets' yaw mode, at 11.173 Hz (-8.5 %)",
-    10: "rank 10, the wheelsets' yaw mode, at 11.931 Hz (-5.2 %)",
+    9: "rank 9, wheelset 2's longitudinal-yaw mode, at 10.741 Hz (-12.0 %): the bundled set "
+       "weighs the divergence at s0 = 0.014 (+7.025 against +7.031 1/s) against the wheelsets' "
+       "yaw frequencies (docs/validation.md, 'The bundled set')",
+    10: "rank 10, wheelset 1's longitudinal-yaw mode, at 11.490 Hz (-8.7 %), the same trade",
 }
 MISSED_CHARACTER: dict[int, str] = {
-    3: "rank 3 (5.3465 Hz) is the frame's bounce with both TMs, Table 2's 4th character; the "
-       "frame's pitch (Table 2's 3rd) is at 5.3470 Hz: the two published 0.4 % apart are 0.01 % "
+    3: "rank 3 (5.455 Hz) is the frame's bounce with both TMs, Table 2's 4th character; the "
+       "frame's pitch (Table 2's 3rd) is at 5.466 Hz: the two published 0.4 % apart are 0.2 % "
        "apart and in the other order",
-    4: "rank 4 (5.3470 Hz) is the frame's pitch with both TMs, Table 2's 3rd character (3 and 4 "
+    4: "rank 4 (5.466 Hz) is the frame's pitch with both TMs, Table 2's 3rd character (3 and 4 "
        "swapped)",
 }
 MISSED_RE: dict[int, str] = {
-    8: "Re of wheelset 1's longitudinal-pitch mode -4.54 1/s (published -3.282, -38 %)",
-    9: "Re of wheelset 2's longitudinal-yaw mode -5.79 1/s (published -3.958, -46 %): the "
-       "creep slope ∂μ/∂s(0.005) = 3.9 of the calibrated creep shape",
+    8: "Re of wheelset 1's longitudinal-pitch mode -7.16 1/s (published -3.282, -118 %)",
+    9: "Re of wheelset 2's longitudinal-yaw mode -6.74 1/s (published -3.958, -70 %)",
+    10: "Re of wheelset 1's longitudinal-yaw mode -5.33 1/s (published -4.010, -33 %)",
 }
-MISSED_RE_COUNT = ("4 of the 6 real parts within the acceptance (modes 1, 3, 4, 10; 8 and 9 "
-                   "missed by 38 and 46 %, see MISSED_RE): target at least 5")
-MISSED_TWO_DIVERGENCES = ("one positive real eigenvalue, +6.88 1/s, within 3 % of the "
+MISSED_TWO_DIVERGENCES = ("one positive real eigenvalue, +7.025 1/s, within 0.1 % of the "
                           "published +7.031 (wheelset 1's spin with rotor 1 on the calibrated "
-                          "creep's falling slope, ∂μ/∂s(0.014) = -1.17); the published second, "
-                          "+0.062, has no counterpart: ID2's spin is held by its motor slope "
-                          "b_M = 2.46e3 N m s/rad and oscillates instead (+5.14 1/s at 2.09 Hz)")
-MISSED_PATTERN = ("unstable among the first ten at s0 = 0.014: pairs 2, 3, 9, 10 (published 3, "
-                  "7, 8, 9, 10): wheelset 2's pitch with its disc clutch (+5.14 1/s at 2.09 Hz), "
-                  "ID1's torsion with its disc clutch (+2.32 at 3.31 Hz) and the wheelsets' yaw modes (+1.57 at "
-                  "9.70 Hz, +0.14 at 11.22 Hz); the wheelsets' longitudinal modes stay damped "
-                  "(-2.12 at 8.52 Hz, -0.84 at 9.66 Hz)")
-MISSED_ON_BOUNDS = ("three calibrated parameters on a bound: polach_A (its lower 0.2), "
-                    "yaw_damping (its upper 1 MN s/m), yaw_damper_height (0.60 m); the vertical "
-                    "dampers (primary 0.20, secondary 0.21 kN s/m) below their hardware bounds "
-                    "(10 kN s/m: docs/validation.md, 'Which published numbers a bogie can "
-                    "reach')")
+                          "creep's falling slope); the published second, +0.062, has no "
+                          "counterpart: ID2's spin is held by its motor slope b_M = 1.21e3 "
+                          "N m s/rad and oscillates instead (+4.34 1/s at 1.78 Hz)")
+MISSED_PATTERN = ("unstable among the first ten at s0 = 0.014: pairs 2, 3, 8 (published 3, 7, 8, "
+                  "9, 10): wheelset 2's pitch with its disc clutch (+4.34 1/s at 1.78 Hz), "
+                  "ID1's torsion with its disc clutch (+1.81 at 3.15 Hz) and the wheelsets' "
+                  "longitudinal mode (+1.43 at 9.28 Hz); the wheelsets' yaw modes stay damped "
+                  "(-3.22 at 9.75 Hz, -0.94 at 10.80 Hz)")
+MISSED_ON_BOUNDS = ("four calibrated parameters on a bound: stator_inertia_y (its upper "
+                    "400 kg m^2), yaw_damper_height (0.60 m), traction_link_stiffness (its lower "
+                    "3 MN/m), traction_link_height (0.30 m); every value inside its bounds")
 
 
 # published numbers that no bogie within the hardware bounds can reach (the proofs: the reduced
 # models of model/studies/reachability.py, numbers in docs/validation.md, "Which published
 # numbers a bogie can reach"; regenerate with scripts/reachability.py)
 FORBIDDEN_SUSPENSION_RE = (
-    "the published real parts of the car body bounce (-0.032 1/s), the frame pitch (-0.199) and "
-    "the frame bounce (-0.056) need vertical dampers 12x, 70x and 140x below their hardware "
-    "lower bounds (10 kN s/m): with the dampers at the bounds the full model gives -0.370, -2.19 "
-    "and -3.43 1/s (docs/validation.md, 'Which published numbers a bogie can reach')")
+    "the published real parts of the car body bounce (-0.032 1/s) and the frame bounce (-0.056) "
+    "need vertical dampers 16x and 80x below their hardware lower bounds (10 kN s/m), and the "
+    "frame pitch (-0.199) is damped more than that even without vertical dampers (-2.09 1/s): "
+    "with the dampers at the bounds the full model gives -0.52, -3.71 and -2.95 1/s "
+    "(docs/validation.md, 'Which published numbers a bogie can reach')")
 FORBIDDEN_MODE2 = (
     "mode 2's Re -0.041 at s0 = 0.005 and -0.060 at 0.014 with the +7.031 1/s spin divergence: "
     "in the torsional chain (rotor and gears against the disc clutch, creep damper on the "
@@ -109,11 +106,6 @@ FORBIDDEN_MODE2 = (
     "(published: 0.019 1/s more damped), and with the motor slope within its bounds no chain "
     "keeps mode 2 within 5 % of 2.689 Hz at 0.014 (docs/validation.md, 'Which published numbers "
     "a bogie can reach')")
-MISSED_SUSPENSION_ZETA = (
-    "the bundled set's vertical dampers (0.20 and 0.21 kN s/m, below their hardware bounds) give "
-    "the car body bounce, the frame pitch and the frame bounce damping ratios of 0.0009, 0.006 "
-    "and 0.003 (target >= 0.05; the bundled set is kept, docs/validation.md)")
-SUSPENSION_ZETA = 0.05  # the damping ratio a real car body and frame have (hardware dampers)
 
 
 @pytest.fixture(scope="module")
@@ -154,7 +146,14 @@ def test_table1_pair_by_rank_has_table2_character(calibrated, k):
     assert matched[k - 1] == result.complex_index[k - 1]
 
 
-@pytest.mark.parametrize("k", [pytest.param(k, marks=_marks(MISSED_RE, k)) for k in RE_MODES])
+def _re_marks(k: int):
+    if k in SUSPENSION_MODES:
+        return pytest.mark.xfail(strict=True, reason="forbidden by the bounds: "
+                                 + FORBIDDEN_SUSPENSION_RE)
+    return _marks(MISSED_RE, k)
+
+
+@pytest.mark.parametrize("k", [pytest.param(k, marks=_re_marks(k)) for k in RE_MODES])
 def test_table1_real_part(calibrated, k):
     _, _, result, matched = calibrated
     published = TABLE1_RE[k - 1]
@@ -223,10 +222,12 @@ def test_calibrated_values_inside_their_bounds_at_most_two_on_one(calibrated):
     assert len(on) <= 2, on
 
 
-@pytest.mark.xfail(bool(MISSED_RE_COUNT), strict=True, reason="documented miss: " + MISSED_RE_COUNT)
+@pytest.mark.xfail(strict=True, reason="forbidden by the bounds: three of the six are the "
+                   "suspension modes' (" + FORBIDDEN_SUSPENSION_RE + "); of the wheelset modes' "
+                   "8, 9, 10 none is met (MISSED_RE)")
 def test_at_least_five_of_six_real_parts(calibrated):
-    """The issue's target on the real parts of modes 1, 3, 4, 8, 9, 10 (each with the
-    tolerance of test_table1_real_part)."""
+    """The earlier target on the real parts of modes 1, 3, 4, 8, 9, 10 (each with the
+    tolerance of test_table1_real_part): at least five; out of reach of hardware dampers."""
     _, _, result, matched = calibrated
     met = 0
     for k in RE_MODES:
@@ -261,6 +262,15 @@ def test_two_divergent_reals_at_large_creepage(unstable):
     that no independently derived b_M can be asked to reproduce (docs/validation.md)."""
     assert unstable.divergence == 2
     assert unstable.real_eigenvalues[0] == pytest.approx(DIVERGENCE_RATES[0], rel=0.3)
+
+
+def test_largest_divergence_within_10_percent(unstable):
+    """The study's larger divergence, +7.031 1/s at s0 = 0.014: a wheelset's spin with its drive
+    on the falling creep slope.  10 %: the rate is the falling slope of a creep law published
+    only through its operating data (M(s0) at two creepages, M_ad, s0*) over the drivetrain's
+    inertia, both calibrated; the calibration weighs it against Table 1's frequencies
+    (docs/validation.md, 'The bundled set')."""
+    assert unstable.real_eigenvalues[0] == pytest.approx(DIVERGENCE_RATES[0], rel=0.10)
 
 
 @pytest.mark.xfail(bool(MISSED_PATTERN), strict=True, reason="documented miss: " + MISSED_PATTERN)
@@ -315,11 +325,10 @@ def test_mode2_real_parts_reachable_with_the_published_divergence(calibrated):
     assert proof.reachable
 
 
-@pytest.mark.xfail(strict=True, reason="documented miss: " + MISSED_SUSPENSION_ZETA)
 def test_suspension_modes_damped_as_real_hardware(calibrated):
     """The car body's and the frame's bounce and pitch (Table 2's rows 1, 3, 4, matched by
     character) with a damping ratio of at least 0.05."""
     _, _, result, matched = calibrated
-    for k in (1, 3, 4):
+    for k in SUSPENSION_MODES:
         lam = result.eigenvalues[matched[k - 1]]
         assert -lam.real / abs(lam) >= SUSPENSION_ZETA, k

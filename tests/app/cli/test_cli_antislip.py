@@ -171,15 +171,15 @@ def test_peak_never_falls_as_the_delay_grows(bogie, s0, v_kmh):
     """peak(τ) on 0 … 0.5 s (the default grid, 2 s at 10 kHz) is non-decreasing: a later action
     only lets the oscillation grow longer (tolerance 1e-9 relative: rounding of equal runs).
     Where unprotected ID2 passes M_ad within the record (200 km/h; 0.02 at 120 km/h) a late action
-    raises the peak; at the study's 0.014, 120 km/h ID2 stays at its pre-fault load for 2 s
-    whatever the delay (docs/nonlinear.md), so peak(τ) is flat there."""
+    raises the peak beyond the limit; at the study's 0.014, 120 km/h every delay keeps ID2 below
+    M_ad (docs/nonlinear.md): the peak may rise with the delay, never to the limit."""
     parameters, model = bogie
     op = default_operating_point(parameters, s0, v_kmh)
     result = required_reaction_time(model, op)
     assert np.all(np.diff(result.peak_torque) >= -1e-9 * result.limit), \
         np.round(result.peak_torque / result.limit, 5)
     if result.reason == "every delay suffices":
-        assert result.peak_torque[-1] == pytest.approx(result.peak_torque[0], rel=1e-9)
+        assert result.peak_torque[-1] < result.limit
     else:
         assert result.peak_torque[-1] > result.peak_torque[0]
     assert (result.reason == "every delay suffices") == ((s0, v_kmh) == (0.014, 120.0))

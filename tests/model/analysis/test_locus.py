@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from itertools import pairwise
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ from model.analysis.locus import (
 )
 
 CONTROLLED = 1.5 * 2 * np.pi * 20.0  # |λ| inside which the tolerance is enforced [1/s]
+PREVIOUS_SET = Path(__file__).resolve().parents[3] / "assets" / "parameters" / "previous_calibrated.toml"
 
 
 @pytest.fixture(scope="module")
@@ -148,8 +150,13 @@ def test_a_floor_keeps_the_sweep_reduced_through_a_zero_eigenvalue():
     and every point of it stayed reduced without a floor).  None lies on s0_max itself: there
     the spin is a double zero (its position a rigid-body mode, its velocity undamped), whose
     first-order error estimate has nothing to divide by, and that one point is solved densely
-    with or without a floor."""
-    parameters = load_parameters()
+    with or without a floor.
+
+    The set is assets/parameters/previous_calibrated.toml, whose points near the crossing are
+    solved densely without a floor; on the bundled set they stay reduced with or without one (its
+    spin's error estimate near the crossing stays within the tolerance), so the floor's effect
+    cannot be seen there."""
+    parameters = load_parameters(PREVIOUS_SET)
     model = build_model(parameters)
     op = replace(default_operating_point(parameters), v=151.0 / 3.6)
     s0_max = brentq(lambda s: pattern_coefficients(model, replace(op, s0=s))[0], 0.001, 0.02,
