@@ -11,7 +11,7 @@ what the part can physically be), on their logarithms (heights on their values).
   phases, optimal one-to-one assignment over the lowest candidates);
 * the real parts of the wheelset modes 8, 9, 10 at s0 = 0.005 (30 % or 0.05 1/s); the
   suspension modes 1, 3, 4 (car body bounce, frame pitch and bounce) a damping ratio of at least
-  0.05 instead of their published real parts, which need dampers 12-140x below real hardware;
+  0.05 instead of their published real parts, which no damper of real hardware reaches;
   mode 2's damping is *not* a target (no plausible torsional chain reaches it together with the
   divergence at s0 = 0.014); both proofs in docs/validation.md;
 * the 298.4 Hz driving-shaft mode (largest strain share of ID1's driving shaft);

@@ -224,8 +224,8 @@ def evaluate_by_rank(parameters: Parameters, model=None, complete: Callable | No
 
 
 RE_MODES = (1, 3, 4, 8, 9, 10)  # Table 1 rows whose real part at s0 = 0.005 is reported
-# the suspension modes (car body bounce, frame pitch, frame bounce): their published real parts need
-# vertical dampers 12-140x below real hardware (docs/validation.md, "Which published numbers a
+# the suspension modes (car body bounce, frame pitch, frame bounce): no vertical damper of real
+# hardware reaches their published real parts (docs/validation.md, "Which published numbers a
 # bogie can reach"), so the calibration asks them for a damping ratio instead of Table 1's Re
 SUSPENSION_MODES = (1, 3, 4)
 SUSPENSION_ZETA = 0.05  # [-] the least damping ratio of a suspension mode of a real vehicle
