@@ -71,11 +71,11 @@ def example_output() -> str:
     the heading and its row."""
     import tempfile
 
+    from model_facts import SOFTER
+
     from app.cli.parameters import parameter_table
     from model.mechanics.parameters import Parameters, load_parameters, save_parameters
     from model.studies.calibration_bounds import parameter_rows
-
-    from model_facts import SOFTER
 
     base = load_parameters()
     variant = base.replace(driving_shaft_stiffness=round(SOFTER * base["driving_shaft_stiffness"], -4))
