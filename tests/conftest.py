@@ -271,6 +271,28 @@ def open_app(browser, url: str, timeout_ms: float = 120_000, viewport=(1600, 100
     return page
 
 
+def until(condition, what: str, timeout: float = 300.0, poll: float = 0.25):
+    """Poll ``condition()`` until it returns something true (its value), with a deadline [s]."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = condition()
+        if value:
+            return value
+        time.sleep(poll)
+    raise AssertionError(f"not within {timeout:g} s: {what}")
+
+
+def live_dashboards(t_end: float) -> list:
+    """The served dashboards (this process's server) that are alive with simulated time
+    ``t_end`` [s]: a browser test's page picks its own session by a t_end no other uses."""
+    import math
+
+    from app.dashboard.scheduler import _SCHEDULERS
+
+    return [s.dashboard for s in list(_SCHEDULERS)
+            if s.dashboard.alive() and math.isclose(s.dashboard.state().t_end, t_end)]
+
+
 # --- the server's study queue without a server ---------------------------------------------------
 
 class InProcessEngine:

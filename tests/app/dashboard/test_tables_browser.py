@@ -21,10 +21,9 @@ import json
 import math
 import subprocess
 import sys
-import time
 
 import pytest
-from conftest import ROOT, open_app
+from conftest import ROOT, live_dashboards, open_app, until
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
@@ -35,23 +34,9 @@ ROWS = 5  # rows compared per table (a Tabulator renders only its visible rows)
 
 def _dashboard():
     """The served dashboard of this module's page (the live session with T_END)."""
-    from app.dashboard.scheduler import _SCHEDULERS
-
-    found = [s.dashboard for s in list(_SCHEDULERS)
-             if s.dashboard.alive() and math.isclose(s.dashboard.state().t_end, T_END)]
+    found = live_dashboards(T_END)
     assert len(found) == 1, f"{len(found)} live sessions with t_end = {T_END} s"
     return found[0]
-
-
-def _until(condition, what: str, timeout: float = 300.0):
-    """Poll ``condition()`` until it returns something true (its value), with a deadline."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.25)
-    raise AssertionError(f"not within {timeout:g} s: {what}")
 
 
 def tabulator_rows(page, css: str, columns) -> list[dict[str, str]]:
@@ -64,7 +49,7 @@ def tabulator_rows(page, css: str, columns) -> list[dict[str, str]]:
         rows = [dict(row.evaluate(cells))
                 for row in page.locator(f".{css} .tabulator-row").all()[:ROWS]]
         return rows if rows and all(set(columns) <= set(r) for r in rows) else None
-    return _until(read, f"the rows of .{css}")
+    return until(read, f"the rows of .{css}")
 
 
 def html_rows(page, selector: str, expected_rows: int) -> list[list[str]]:
@@ -74,7 +59,7 @@ def html_rows(page, selector: str, expected_rows: int) -> list[list[str]]:
                                     for tr in page.locator(f"{selector} tr").all())
                 if cells][:expected_rows]
         return rows if len(rows) == expected_rows else None
-    return _until(read, f"the rows of {selector}")
+    return until(read, f"the rows of {selector}")
 
 
 def number(cell: str) -> float:
@@ -101,11 +86,11 @@ def _open_tab(page, title: str) -> None:
 
 def test_verdicts_table_shows_the_checks_as_bogie_assess_gives_them(page):
     _open_tab(page, "Verdicts")
-    dashboard = _until(_dashboard, "the page's session")
+    dashboard = until(_dashboard, "the page's session")
     from app.dashboard.verdicts_view import COLUMNS
 
     rows = tabulator_rows(page, "verdict-table", COLUMNS)
-    shown = _until(lambda: dashboard.verdicts.rows, "the session's verdict")
+    shown = until(lambda: dashboard.verdicts.rows, "the session's verdict")
     # the data the view computed: text as it is, numbers to the frame's decimals
     for drawn, row in zip(rows, shown, strict=False):
         for name, dtype in COLUMNS.items():
@@ -131,8 +116,8 @@ def test_verdicts_table_shows_the_checks_as_bogie_assess_gives_them(page):
 
 def test_modes_tables_show_the_point_computed(page):
     _open_tab(page, "Modes")
-    dashboard = _until(_dashboard, "the page's session")
-    point = _until(lambda: dashboard.point, "the session's point")
+    dashboard = until(_dashboard, "the page's session")
+    point = until(lambda: dashboard.point, "the session's point")
     modes = point.modes
     rows = tabulator_rows(page, "mode-table", ("nu", "im_hz", "re", "zeta", "description"))
     for cells, mode in zip(rows, modes, strict=False):
@@ -154,8 +139,8 @@ def test_modes_tables_show_the_point_computed(page):
 
 def test_peak_table_shows_the_history_computed(page):
     _open_tab(page, "Response")
-    dashboard = _until(_dashboard, "the page's session")
-    history = _until(lambda: dashboard.history, "the session's history")
+    dashboard = until(_dashboard, "the page's session")
+    history = until(lambda: dashboard.history, "the session's history")
     names = list(history.outputs)
     rows = html_rows(page, ".peak-table table.peaks", len(names))
     for cells, name in zip(rows, names, strict=True):
@@ -172,8 +157,8 @@ def test_peak_table_shows_the_history_computed(page):
 
 def test_design_loads_tables_show_the_worst_case_and_the_spectra_computed(page):
     _open_tab(page, "Design loads")
-    dashboard = _until(_dashboard, "the page's session")
-    worst = _until(lambda: getattr(dashboard.design_loads, "worst", None), "the worst case")
+    dashboard = until(_dashboard, "the page's session")
+    worst = until(lambda: getattr(dashboard.design_loads, "worst", None), "the worst case")
     names = list(worst.units)
     rows = html_rows(page, ".loads-worst table.worst-case", len(names))
     for cells, name in zip(rows, names, strict=True):
@@ -182,7 +167,7 @@ def test_design_loads_tables_show_the_worst_case_and_the_spectra_computed(page):
         assert close(cells[2], worst.phase_of_max[name], 6)
         assert math.isclose(number(cells[4]), worst.min[name], abs_tol=0.51)
         assert close(cells[6], worst.time_of_min[name], 4)
-    spectra = _until(lambda: getattr(dashboard.design_loads, "spectra", None), "the spectra")
+    spectra = until(lambda: getattr(dashboard.design_loads, "spectra", None), "the spectra")
     names = list(spectra.spectra)
     rows = html_rows(page, ".loads-spectra table.spectra", len(names))
     for cells, name in zip(rows, names, strict=True):
@@ -196,8 +181,8 @@ def test_design_loads_tables_show_the_worst_case_and_the_spectra_computed(page):
 
 def test_resonance_crossings_table_shows_the_crossings_computed(page):
     _open_tab(page, "Resonances")
-    dashboard = _until(_dashboard, "the page's session")
-    view = _until(lambda: getattr(dashboard.resonances, "campbell", None), "the Campbell view",
+    dashboard = until(_dashboard, "the page's session")
+    view = until(lambda: getattr(dashboard.resonances, "campbell", None), "the Campbell view",
                   timeout=600)
     listed = view.crossings[:ROWS]
     rows = html_rows(page, ".resonance-crossings table", len(listed))

@@ -11,11 +11,8 @@ whole bundled route takes one to three minutes on a busy 2-core machine: the wai
 
 from __future__ import annotations
 
-import math
-import time
-
 import pytest
-from conftest import open_app
+from conftest import live_dashboards, open_app, until
 
 from app.results.life import FATIGUE_CHECK
 
@@ -31,21 +28,8 @@ ROWS = """(holder) => [...holder.querySelectorAll('.tabulator-row')].map(
 
 
 def _dashboard():
-    from app.dashboard.scheduler import _SCHEDULERS
-
-    found = [s.dashboard for s in list(_SCHEDULERS)
-             if s.dashboard.alive() and math.isclose(s.dashboard.state().t_end, T_END)]
+    found = live_dashboards(T_END)
     return found[0] if len(found) == 1 else None
-
-
-def _until(condition, what: str, timeout: float = 300.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.5)
-    raise AssertionError(f"not within {timeout:g} s: {what}")
 
 
 def rendered_rows(page) -> dict[tuple, dict]:
@@ -75,10 +59,10 @@ def test_life_cells_show_the_life_computed(app_server, chromium, tmp_path):
     try:
         page.get_by_text("Verdicts", exact=True).click()
         page.locator(".bk-tab.bk-active", has_text="Verdicts").wait_for(timeout=60_000)
-        dashboard = _until(_dashboard, "the page's session")
+        dashboard = until(_dashboard, "the page's session")
         view = dashboard.verdicts
         page.locator(".verdict-table .tabulator-row").first.wait_for(timeout=300_000)
-        life = _until(lambda: view.life, "the life over the route", LIFE_WAIT_S)
+        life = until(lambda: view.life, "the life over the route", LIFE_WAIT_S)
         lives = {s.section.name: s.life_km for s in life.sections}
 
         def drawn_as_computed():
@@ -91,7 +75,7 @@ def test_life_cells_show_the_life_computed(app_server, chromium, tmp_path):
                    fatigue.items()):
                 return None
             return fatigue
-        fatigue = _until(drawn_as_computed, "the life cells drawn as the view holds them", 120)
+        fatigue = until(drawn_as_computed, "the life cells drawn as the view holds them", 120)
         assert {key[0] for key in fatigue} == set(lives)
         for (component, _, _), cells in fatigue.items():
             # the cell is the life in km to three significant digits
@@ -112,9 +96,9 @@ def test_life_cells_show_the_life_computed(app_server, chromium, tmp_path):
             m => (m.css_classes || []).includes('ctl-verdict-running')).label""")
         assert label == "running case (track, wheels, ripple; ≈ 20 s)"
         page.locator(".ctl-verdict-running input").check()
-        _until(lambda: any(r["load case"] == "running" for r in view.rows),
+        until(lambda: any(r["load case"] == "running" for r in view.rows),
                "the running case's checks", LIFE_WAIT_S)
-        running = _until(lambda: {k: v for k, v in rendered_rows(page).items()
+        running = until(lambda: {k: v for k, v in rendered_rows(page).items()
                                   if k[2] == "running"}, "the running rows drawn", 120)
         expected = {(r["component"], r["check"], r["load case"]) for r in view.rows
                     if r["load case"] == "running"}
