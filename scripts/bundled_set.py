@@ -52,11 +52,11 @@ def calibrate_at(weight: float) -> dict:
     """The calibration from the start file at one divergence weight (one BLAS thread)."""
     from threadpoolctl import threadpool_limits
 
-    from model.studies.calibration import PHASES, Weights, calibrate
+    from model.studies.calibration import PHASES, calibrate, with_divergence_weight
     from model.studies.calibration_targets import SUSPENSION_MODES, evaluate_by_rank
     from model.studies.global_calibration import target_measures
 
-    phases = (*PHASES[:-1], (PHASES[-1][0], Weights(divergence=weight)))
+    phases = with_divergence_weight(PHASES, weight)
     with threadpool_limits(1):
         fitted, rows = calibrate(load_parameters(START), lambda _text: None, phases)
         matched = evaluate_by_rank(fitted).matched

@@ -14,7 +14,6 @@ import argparse
 import json
 import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -26,7 +25,7 @@ from threadpoolctl import threadpool_limits  # noqa: E402
 
 from model import load_parameters  # noqa: E402
 from model.mechanics.parameters import ESTIMATE_FILE  # noqa: E402
-from model.studies.calibration import PHASES, stage_j_cost  # noqa: E402
+from model.studies.calibration import PHASES, stage_j_cost, with_divergence_weight  # noqa: E402
 from model.studies.calibration_bounds import SEARCH_PARAMETERS  # noqa: E402
 from model.studies.calibration_targets import TABLE1_IM_HZ, evaluate  # noqa: E402
 from model.studies.global_calibration import StartResult, spread, target_measures  # noqa: E402
@@ -64,7 +63,7 @@ def spread_block(run: dict) -> str:
 def comparison(run: dict) -> dict:
     bundled = load_parameters()
     estimate = load_parameters(ESTIMATE_FILE)
-    weights = replace(PHASES[-1][1], divergence=run.get("divergence_weight", 1.0))
+    weights = with_divergence_weight(PHASES, run.get("divergence_weight", 1.0))[-1][1]
     with threadpool_limits(1):
         rows = evaluate(bundled)
         cost = stage_j_cost(bundled, estimate, weights, clip=False)

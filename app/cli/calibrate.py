@@ -106,15 +106,12 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
     out = writable_path(args.out, "--out")
     if out.resolve() == CALIBRATED_FILE.resolve():
         print(f"bogie calibrate: replacing the bundled default set {CALIBRATED_FILE}", file=sys.stderr)
-    from model.studies.calibration import PHASES, run
+    from model.studies.calibration import PHASES, run, with_divergence_weight
 
     phases = PHASES if args.max_evaluations is None else tuple(
         (min(count, args.max_evaluations), weights) for count, weights in PHASES)
     if args.divergence_weight is not None:
-        from dataclasses import replace
-
-        count, weights = phases[-1]
-        phases = (*phases[:-1], (count, replace(weights, divergence=args.divergence_weight)))
+        phases = with_divergence_weight(phases, args.divergence_weight)
 
     def progress(text: str) -> None:
         print(text, file=sys.stderr, flush=True)

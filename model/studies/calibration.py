@@ -44,7 +44,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -258,6 +258,13 @@ class Weights:
 # 10 ranks kept their characters within 5 %, with full weight 7 — the divergence rates are not
 # smaller for it: +33 and +31 1/s against +28 and +26)
 PHASES = ((60, Weights(order=0.0, real=0.0, divergence=0.0)), (60, Weights(divergence=1.0)))
+
+
+def with_divergence_weight(phases: tuple, weight: float) -> tuple:
+    """``phases`` with the last phase's divergence weight set to ``weight`` (``bogie calibrate
+    --divergence-weight``: the trade of Table 1's frequencies against the divergence)."""
+    count, weights = phases[-1]
+    return (*phases[:-1], (count, replace(weights, divergence=weight)))
 
 
 def _evaluate_j(x: np.ndarray, start: Parameters, free, x_prior: np.ndarray,
