@@ -5,7 +5,8 @@ the starting case's bound).
     OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/example_assessment.py
 
 Writes ``docs/results/assessment.json`` (every number the page quotes; the same as
-``bogie assess --serial --json``) in a few seconds.
+``bogie assess --no-running --serial --json``: the four cases the Verdicts tab computes by
+default; the running case's numbers come from ``scripts/example_running.py``) in a few seconds.
 """
 
 from __future__ import annotations

@@ -5,8 +5,8 @@ as JSON.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/example_running.py
 
-The same numbers come from ``bogie track --s0 0.002 --v 120 --json`` and ``bogie assess --running
---json`` (the running case alone: ``model.studies.assessment.assess`` with ``cases=("running",)``,
+The same numbers come from ``bogie track --s0 0.002 --v 120 --json`` and ``bogie assess --json``
+(its running case; the running case alone: ``model.studies.assessment.assess`` with ``cases=("running",)``,
 ≈ 40 s).
 """
 

@@ -1,5 +1,5 @@
 """``bogie assess``: from loads to verdicts — every press fit, shaft section and coupling of both
-drives checked in the four load cases, with safety factors and the governing check; with
+drives checked in the five load cases, with safety factors and the governing check; with
 ``--samples`` the verdict under uncertainty.
 
     bogie assess [--s0 LIST] [--v LIST] [--n0 N] [--bm B] [--motor-bandwidth FC]
@@ -8,8 +8,8 @@ drives checked in the four load cases, with safety factors and the governing che
                  [--unstable-s0 S --unstable-v V] [--anti-slip-delay T --anti-slip-threshold W
                  --anti-slip-rate R --anti-slip-floor F] [--starting-v V]
                  [--ripple ORDER=AMPLITUDE,… --ripple-v LIST]
-                 [--running [--running-s0 LIST --running-v LIST --wheel-polygon N=µm,…
-                 --random-multiple K]] [--params FILE]
+                 [--no-running | --running-s0 LIST --running-v LIST --wheel-polygon N=µm,…
+                 --random-multiple K] [--params FILE]
                  [--samples N [--seed S] [--indices] [--ranges FILE] [--write-samples DIR]]
                  [--scheduler tcp://HOST:PORT | --workers N | --serial] [--json]
 
@@ -21,11 +21,12 @@ f_c [Hz]; default the set's) hold for every case.  That grid runs on the study e
 the envelope does (a local Dask cluster by default, ``--scheduler`` a running one, ``--serial`` in
 this process); the other cases are single runs in this process.  The ripple case takes the set's
 ripple amplitudes or ``--ripple`` (as ``bogie ripple``), over ``--ripple-v`` (default 10:200:20
-km/h, refined at every resonance).  ``--running`` adds the running case: mean traction, the
-ripple, polygonal wheels (``--wheel-polygon``, default 20=30: order 20, 30 µm, an assumed
-amplitude) and ``--random-multiple`` (default 3) times the RMS under the random track, over
-``--running-v`` (default 20:200:10 km/h) at ``--running-s0`` (default 0.002,0.005, the ripple
-case's; the running system must be stable there).  ``--samples N`` (a power of two) runs the assessment for N
+km/h, refined at every resonance).  The running case (left out with ``--no-running``, and
+under ``--samples``): mean traction, the ripple, polygonal wheels (``--wheel-polygon``, default
+20=30: order 20, 30 µm, an assumed amplitude) and ``--random-multiple`` (default 3) times the RMS
+under the random track, over ``--running-v`` (default 20:200:10 km/h) at ``--running-s0``
+(default 0.002,0.005, the ripple case's; a point whose running system has a growing mode is left
+out and named).  ``--samples N`` (a power of two) runs the assessment for N
 scrambled Sobol' samples of the unknowns' prior ranges (model.studies.verdict_priors; ``--ranges``
 a TOML file of others) on the study engine, every sample a work item, and prints each check's
 5/50/95 % band and probability of falling below its required factor; ``--indices`` adds the
@@ -113,8 +114,9 @@ def register(subparsers) -> None:
                         help="speeds [km/h] before the refinement at the resonances "
                              "(default %(default)s)")
     running = p.add_argument_group("running (mean traction, ripple, wheel polygon, random track)")
-    running.add_argument("--running", action="store_true",
-                         help="add the running load case (docs/assessment.md)")
+    running.add_argument("--running", action=argparse.BooleanOptionalAction, default=None,
+                         help="the running load case (docs/assessment.md): one of the default "
+                              "cases; --no-running leaves it out (≈ 20 s less)")
     running.add_argument("--running-s0", default="0.002,0.005", metavar="LIST",
                          help="creepages of the running case (default %(default)s)")
     running.add_argument("--running-v", default="20:200:10", metavar="LIST",
@@ -153,7 +155,7 @@ def options_from_args(args: argparse.Namespace):
     """(parameters, :class:`model.studies.assessment.AssessmentOptions`) from the options."""
     from model.mechanics.excitation import ExcitationError, parse_amplitudes
     from model.mechanics.operating_point import KMH
-    from model.studies.assessment import AssessmentOptions
+    from model.studies.assessment import LOAD_CASES, AssessmentOptions
     from model.studies.envelope import rail_parameters
 
     parameters = rail_parameters(load_parameters_from(args), args.rail)
@@ -173,10 +175,9 @@ def options_from_args(args: argparse.Namespace):
         raise UsageError(f"--ripple: {error}") from None
     ripple_v = [x * KMH for x in quantity_values(args.ripple_v, "v", increasing=True,
                                                  option="--ripple-v")]
-    running = {}
-    if args.running:
+    running = {"cases": LOAD_CASES}
+    if with_running(args):
         from model.analysis.wheel_excitation import parse_polygon
-        from model.studies.assessment import LOAD_CASES
 
         running = {"cases": (*LOAD_CASES, "running"),
                    "running_s0": tuple(quantity_values(args.running_s0, "s0", increasing=True,
@@ -191,6 +192,18 @@ def options_from_args(args: argparse.Namespace):
         unstable_v=args.unstable_v * KMH, anti_slip=anti_slip_from(args),
         starting_v=args.starting_v * KMH, ripple=ripple, ripple_v=tuple(ripple_v), **running)
     return parameters, options
+
+
+def with_running(args: argparse.Namespace) -> bool:
+    """Whether the running case is computed: by default, except under ``--samples`` (the
+    verdict under uncertainty has the four other cases); ``--running`` with ``--samples`` is
+    refused (:class:`UsageError`)."""
+    if args.samples is None:
+        return args.running is not False
+    if args.running:
+        raise UsageError("--running and --samples: the running case is not part of the verdict "
+                         "under uncertainty (leave --running out)")
+    return False
 
 
 def assessment_table(result) -> str:
@@ -245,16 +258,13 @@ def cmd_assess(args: argparse.Namespace) -> None:
     parameters, options = options_from_args(args)
     short_circuit_points(parameters, options)  # an unstable grid point: refused before any work
     if args.samples is not None:
-        if args.running:
-            raise UsageError("--running and --samples: the running case is not part of the "
-                             "verdict under uncertainty")
         return assess_under_uncertainty(args, parameters, options)
     for name in ("indices", "ranges", "write_samples", "out"):
         if getattr(args, name):
             raise UsageError(f"--{name.replace('_', '-')} needs --samples")
     with study_engine(args, "assess") as (mapper, where):
         print(f"assess: short_circuit ({len(options.s0) * len(options.v)} point(s) on {where}), "
-              f"unstable_adhesion, starting, ripple{', running' if args.running else ''} …",
+              f"unstable_adhesion, starting, ripple{', running' if with_running(args) else ''} …",
               file=sys.stderr)
         result = assess(parameters, options, mapper, ProgressBar("assess: short_circuit",
                                                                  unit="points"))

@@ -10,7 +10,7 @@ and started once that state's follow-ups (dense root locus, s0*(v)) have ended, 
 outcome, and the state has stayed for a moment (:data:`VERDICT_QUIET_MS`); it takes a few
 seconds (the short-circuit case's grid over every fault instant, the ripple case's speed sweep),
 so the indicator says "computing" meanwhile.  The "running case" checkbox adds the running load
-case (``bogie assess --running``'s defaults, about 20 s) to the same assessment.
+case (``bogie assess``'s running defaults, about 20 s) to the same assessment.
 
 Once a verdict is shown and the tab is open, each shaft section's fatigue life over the bundled route
 (:mod:`app.results.life`, 25 s to 2 min) is computed in a background worker process, its thread

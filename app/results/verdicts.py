@@ -58,8 +58,8 @@ def assessment_result(case: CaseBase, strength: tuple = (), runner=_in_this_thre
     point the unstable case is the default one, and the ripple case, steady running over every
     speed, is always at the assessment's default creepages (``AssessmentOptions().s0``, as
     ``bogie assess`` takes them); a step of the creepage or the speed leaves both as they
-    were.  ``running``: with the running case as ``bogie assess --running`` computes it by
-    default (:func:`running_load_case`).  ``runner(function, *args)`` computes it when the cache
+    were.  ``running``: with the running case as ``bogie assess`` computes it
+    (:func:`running_load_case`).  ``runner(function, *args)`` computes it when the cache
     does not hold it (the served dashboard: :func:`app.services.background.run`, a worker
     process)."""
     key = case.without("dt", "t_end")
@@ -99,7 +99,7 @@ def _assessment(key: CaseBase, strength: tuple, running: bool = False) -> Assess
 
 def running_load_case(case: CaseBase, strength: tuple = ()) -> LoadCase:
     """The running case (:func:`model.studies.assessment.running_case`) at the case's set, wheel
-    force and motor slope with ``bogie assess --running``'s defaults (its creepages, speeds,
+    force and motor slope with ``bogie assess``'s running defaults (its creepages, speeds,
     wheel polygon, track and random multiple): a step of the creepage, the speed or the short
     circuit leaves it as it was."""
     key = case.without("dt", "t_end", "v", "M0", "f", "D", "s0")

@@ -504,8 +504,10 @@ def running_case(parameters: Parameters, outputs: list[str], options: Assessment
                  ) -> LoadCase:
     """The running case (:mod:`model.studies.running_case`): mean traction, both converters'
     ripple (the ripple case's orders and amplitudes), the wheel polygon and the random track over
-    ``options.running_v`` at ``options.running_s0``, each running system checked stable (else
-    :class:`AssessmentError`); its checks made here, with the RMS and the polygon's orders."""
+    ``options.running_v`` at ``options.running_s0``, each running system checked stable (the
+    unstable points left out and named in the description and the scenario's ``unstable``; none
+    stable: :class:`AssessmentError`); its checks made here, with the RMS and the polygon's
+    orders."""
     from model.analysis.track_spectrum import TrackSpectrumError, track_spectrum
     from model.mechanics.excitation import load_excitation
     from model.studies.maps import cached_model
@@ -537,7 +539,8 @@ def running_case(parameters: Parameters, outputs: list[str], options: Assessment
         f"added), plus polygonal wheels ({words}; every wheel, the rear wheelset a wheelbase "
         f"later), plus {sweep.random_multiple:g} × the RMS under the random track "
         f"({spectrum.name}: {spectrum.source}); the parts added as magnitudes (the worst phase); "
-        "on the running system (the creep force following the wheel force)")
+        "on the running system (the creep force following the wheel force)"
+        + unstable_words(sweep.unstable))
     first = points[0]
     scenario = {"s0": list(sweep.s0), "v_kmh": [float(x) for x in v_kmh],
                 "wheel_polygon": [{"order": int(n), "input_amplitude": float(a)}
@@ -549,9 +552,24 @@ def running_case(parameters: Parameters, outputs: list[str], options: Assessment
                 "track": {"name": spectrum.name, "A_v": spectrum.A_v, "omega_c": spectrum.omega_c,
                           "omega_r": spectrum.omega_r, "source": spectrum.source},
                 "random_multiple": sweep.random_multiple, "N0": first.N0, "b_M": first.b_M,
-                "creep": "linear"}
+                "creep": "linear", "unstable": [dict(u) for u in sweep.unstable]}
     return LoadCase("running", description, None, loads, scenario, alternating=True,
                     checks=checks)
+
+
+def unstable_words(unstable: tuple[dict, ...]) -> str:
+    """The running case's points left out for a growing mode, per creepage its speeds [km/h]
+    and the largest growth rate [1/s], as a sentence ('' if none)."""
+    if not unstable:
+        return ""
+    parts = []
+    for s0 in dict.fromkeys(u["s0"] for u in unstable):
+        points = [u for u in unstable if u["s0"] == s0]
+        speeds = ", ".join(f"{u['v_kmh']:g}" for u in points)
+        growth = max(u["growth"] for u in points)
+        parts.append(f"s0 = {s0:g} at {speeds} km/h (growth up to {growth:.3g} 1/s)")
+    return ("; NOT STABLE with the wheel-force coupling, so left out (no stationary response): "
+            + "; ".join(parts))
 
 
 def assess(parameters: Parameters, options: AssessmentOptions | None = None,

@@ -22,8 +22,11 @@ and the alternating amplitude the checks take is ``ripple + amplitude + random_m
 (all at their worst relative phase: added as magnitudes).  Press fits against ``|mean| +
 alternating`` (slip at the peak), the shafts' DIN 743 fatigue with that amplitude about the mean,
 the couplings' T_KW against it (:func:`model.analysis.assessment.verify_alternating`).  The
-deterministic parts are the steady state, the random one stationary: a running system with a
-growing mode at any point of the grid is refused (:class:`RunningCaseError`).
+deterministic parts are the steady state, the random one stationary: a point of the grid
+(creepage, speed) whose running system has a growing mode has neither, so it is left out of the
+checks and listed (``RunningSweep.unstable``, the load case's description and ``unstable`` in its
+scenario: a finding of its own, the running system's stability limit); a grid without one stable
+point is refused (:class:`RunningCaseError`).
 
 **The random part's spectral fatigue damage** (beside the verdict, which is DIN 743's amplitude
 check): for a shaft's fatigue check, the Miner damage per hour of the random torque alone at the
@@ -90,9 +93,11 @@ class RunningSweep:
     moments: np.ndarray  # (s0, outputs, V, 4) its spectral moments m0, m1, m2, m4
     random_multiple: float
     spectrum: TrackSpectrum
+    unstable: tuple[dict, ...] = ()  # the points left out: {"s0", "v_kmh", "growth" [1/s]}
 
     def alternating(self) -> np.ndarray:
-        """(s0, outputs, V): ripple + polygon + random_multiple · rms [N m]."""
+        """(s0, outputs, V): ripple + polygon + random_multiple · rms [N m] (nan at the
+        unstable points)."""
         return self.ripple + self.polygon.sum(axis=1) + self.random_multiple * self.rms
 
 
@@ -121,17 +126,18 @@ def running_sweep(model: BogieModel, points: list[OperatingPoint], speeds, outpu
     mean, ripple_part, rms = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     moments = np.zeros((*shape, 4))
     polygon_part = np.zeros((len(points), len(polygon_orders), len(outputs), len(v)))
-    inputs: tuple[str, ...] = ()
+    unstable = []
     for a, op in enumerate(points):
         for i, speed in enumerate(v):
             point = replace(op, v=float(speed))
             lam = running_system(model, point).eigen[0]
             growth = float(np.max(lam[non_neutral(lam)].real))
-            if growth > 0:
-                raise RunningCaseError(
-                    f"running case: s0 = {op.s0:g} is not stable at {speed / KMH:g} km/h with the "
-                    f"wheel-force coupling (growth rate {growth:.3g} 1/s): no stationary response; "
-                    "take smaller creepages or a lower top speed")
+            if growth > 0:  # no stationary response: left out, listed
+                unstable.append({"s0": op.s0, "v_kmh": float(speed / KMH), "growth": growth})
+                mean[a, :, i] = ripple_part[a, :, i] = rms[a, :, i] = np.nan
+                moments[a, :, i, :] = np.nan
+                polygon_part[a, :, :, i] = np.nan
+                continue
             matrices, rows = output_indices(model, point, outputs)
             mean[a, :, i] = (matrices.C_q @ static_deflection(model, point))[rows]
             damping = damping_matrix(model, point)
@@ -150,29 +156,37 @@ def running_sweep(model: BogieModel, points: list[OperatingPoint], speeds, outpu
     x = np.array([model.positions[rim][0] for rim in model.rims])
     phases = np.degrees(-np.outer(polygon_orders, x.max() - x) / r0).reshape(
         len(polygon_orders), len(x))
+    if len(unstable) == len(points) * len(v):
+        worst = max(unstable, key=lambda u: u["growth"])
+        raise RunningCaseError(
+            f"running case: no point of the grid is stable with the wheel-force coupling (growth "
+            f"up to {worst['growth']:.3g} 1/s at s0 = {worst['s0']:g}, {worst['v_kmh']:g} km/h): "
+            "no stationary response; take smaller creepages or a lower top speed")
     inputs = tuple(f"{rim}.irregularity" for rim in model.rims)
     return RunningSweep(v, tuple(op.s0 for op in points), tuple(outputs), mean, ripple_part,
                         ripple_orders, ripple_amplitudes, polygon_orders, polygon_amplitudes,
                         polygon_part, polygon_hz, phases, inputs, rms, moments, random_multiple,
-                        spectrum)
+                        spectrum, tuple(unstable))
 
 
 def running_loads(sweep: RunningSweep) -> dict[str, AlternatingLoad]:
     """Per output over the speeds: the mean of largest magnitude and the largest alternating
-    amplitude over the creepages (each with its creepage), as an
+    amplitude over the creepages (each with its creepage; the unstable points left out, a speed
+    unstable at every creepage with them), as an
     :class:`~model.analysis.assessment.AlternatingLoad` (its orders: none; the running check's
     orders come from :func:`running_check`)."""
     total = sweep.alternating()
-    speeds = np.arange(len(sweep.v))
+    stable = np.isfinite(sweep.mean[:, 0, :])  # (s0, V): the points with a stationary response
+    speeds = np.flatnonzero(stable.any(axis=0))  # a speed stable at one creepage at least
     loads = {}
     for j, name in enumerate(sweep.names):
-        at_mean = np.argmax(np.abs(sweep.mean[:, j, :]), axis=0)
-        at_amplitude = np.argmax(total[:, j, :], axis=0)
+        at_mean = np.argmax(np.where(stable, np.abs(sweep.mean[:, j, :]), -np.inf), axis=0)[speeds]
+        at_amplitude = np.argmax(np.where(stable, total[:, j, :], -np.inf), axis=0)[speeds]
         scenarios = tuple({"s0": sweep.s0[b], "s0_mean": sweep.s0[a]}
                           for a, b in zip(at_mean, at_amplitude, strict=True))
-        loads[name] = AlternatingLoad(sweep.v, sweep.mean[at_mean, j, speeds],
+        loads[name] = AlternatingLoad(sweep.v[speeds], sweep.mean[at_mean, j, speeds],
                                       total[at_amplitude, j, speeds], (), np.zeros(0),
-                                      np.zeros((0, len(sweep.v))), np.zeros((0, len(sweep.v))),
+                                      np.zeros((0, len(speeds))), np.zeros((0, len(speeds))),
                                       scenarios)
     return loads
 

@@ -106,6 +106,22 @@ EXTERNAL = {  # options of other programs the pages show (pip, docker, dask, pyt
 COMMENT = re.compile(r"<!--.*?-->", re.S)
 
 
+def parser_options() -> set[str]:
+    """Every option string of ``bogie``'s parser and its sub-commands'."""
+    import argparse
+
+    from app.cli.main import build_parser
+
+    options, parsers = set(), [build_parser()]
+    while parsers:
+        parser = parsers.pop()
+        for action in parser._actions:
+            options |= {o for o in action.option_strings if o.startswith("--")}
+            if isinstance(action, argparse._SubParsersAction):
+                parsers.extend(action.choices.values())
+    return options
+
+
 def test_every_option_a_page_names_exists():
     """An option a page names (``--something``) is one of ``bogie``'s (its commands' own or a
     case quantity's, declared in app/results/case.py), a script's, ``run.sh``'s, or one of
@@ -118,6 +134,7 @@ def test_every_option_a_page_names_exists():
         known |= set(re.findall(r"[\"'](--[a-z][a-z0-9-]+)", path.read_text(encoding="utf-8")))
         if path.suffix == ".sh":
             known |= set(OPTION.findall(path.read_text(encoding="utf-8")))
+    known |= parser_options()  # the parser's own (``--no-X`` of a yes/no option included)
     missing = sorted({f"{page.relative_to(ROOT).as_posix()}: {option}" for page in PAGES
                       for option in OPTION.findall(COMMENT.sub("", page.read_text(encoding="utf-8")))
                       if option not in known})

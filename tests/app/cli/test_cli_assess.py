@@ -15,17 +15,19 @@ from model.mechanics.parameters import dumps_parameters, load_parameters
 
 GRID = ["--s0", "0.003,0.005", "--v", "120,200", "--t-end", "3", "--fs", "2500"]
 RIPPLE = ["--ripple-v", "40:120:5"]  # the ripple case's coarse grid (refined at the resonances)
+FOUR = ["--no-running"]  # the contract tests of the four other cases (the running case: below)
 
 
 @pytest.fixture(scope="module")
 def assessed():
-    """``bogie assess --json`` on a small grid (module scope: one run for the contract tests)."""
+    """``bogie assess --no-running --json`` on a small grid (module scope: one run for the
+    contract tests)."""
     import contextlib
     import io
 
     out = io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
-        code = main(["assess", *GRID, *RIPPLE, "--serial", "--json"])
+        code = main(["assess", *GRID, *RIPPLE, *FOUR, "--serial", "--json"])
     assert code == 0
     return json.loads(out.getvalue())
 
@@ -97,7 +99,7 @@ def test_the_short_circuit_grid_on_a_local_cluster_equals_serial(assessed):
     """The envelope's engine options: ``--workers 2`` (a local cluster of worker processes, the
     default engine) gives the serial run's checks; a wet rail and the protection's options reach
     the load cases."""
-    cluster = run_process(["assess", *GRID, *RIPPLE, "--workers", "2", "--json"])
+    cluster = run_process(["assess", *GRID, *RIPPLE, *FOUR, "--workers", "2", "--json"])
     assert cluster.returncode == 0, cluster.stderr
     assert "local cluster of 2 worker process(es)" in cluster.stderr
     data = json.loads(cluster.stdout)
@@ -107,7 +109,7 @@ def test_the_short_circuit_grid_on_a_local_cluster_equals_serial(assessed):
 
 @pytest.mark.slow
 def test_rail_and_anti_slip_options_reach_the_load_cases(assessed, capsys):
-    code, out, err = run(["assess", *GRID, *RIPPLE, "--serial", "--json", "--rail", "wet",
+    code, out, err = run(["assess", *GRID, *RIPPLE, *FOUR, "--serial", "--json", "--rail", "wet",
                           "--anti-slip-delay", "0.25", "--anti-slip-rate", "5"], capsys)
     assert code == 0, err
     data = json.loads(out)
@@ -182,7 +184,9 @@ def test_a_sample_of_the_verdict_under_uncertainty_reruns_from_its_file(tmp_path
     assert sample["values"]  # what this sample changed
     files = sorted(tmp_path.glob("*.toml"))
     assert len(files) == 2
-    code, out, err = run(["assess", *options, "--params", str(files[1]), "--json"], capsys)
+    # the verdict under uncertainty has the four cases without the running one
+    code, out, err = run(["assess", *options, "--params", str(files[1]), "--no-running", "--json"],
+                         capsys)
     assert code == 0, err
     again = json.loads(out)["governing"]
     assert again["component"] == sample["governing"]["component"]
@@ -192,17 +196,20 @@ def test_a_sample_of_the_verdict_under_uncertainty_reruns_from_its_file(tmp_path
 
 @pytest.mark.slow
 def test_running_case_recomputed_from_the_export(capsys, tmp_path):
-    """``bogie assess --running``: the running checks carry v_kmh, rms and the wheel polygon's
-    orders (order, f_hz, input_amplitude [m], wheels with their phases); the check with the
+    """``bogie assess``'s running case (a default case): the running checks carry v_kmh, rms and
+    the wheel polygon's orders (order, f_hz, input_amplitude [m], wheels with their phases); the
+    check with the
     largest deterministic polygon amplitude is recomputed from ``bogie export`` at its creepage
     and speed with numpy alone — Σ over its orders of |Σ_wheels H_wheel(2π f) e^(i phase)| ·
     input_amplitude, H from the exported running system — to 1e-3 (the JSON's speed and phases
     are exact; 1e-3 leaves room for the rounding of the frequency through f = n v / 2π r0)."""
-    code, out, err = run(["assess", *GRID, "--ripple-v", "40:120:3", "--running",
-                          "--running-v", "100,200", "--serial", "--json"], capsys)
+    code, out, err = run(["assess", *GRID, "--ripple-v", "40:120:3", "--running-v", "100,200",
+                          "--serial", "--json"], capsys)
     assert code == 0, err
     data = json.loads(out)
-    assert [c["name"] for c in data["load_cases"]][-1] == "running"
+    assert [c["name"] for c in data["load_cases"]] == ["short_circuit", "unstable_adhesion",
+                                                       "starting", "ripple", "running"]
+    assert data["load_cases"][-1]["scenario"]["unstable"] == []
     running = [c for c in data["checks"] if c["load_case"] == "running"]
     assert len(running) == 16
     for c in running:

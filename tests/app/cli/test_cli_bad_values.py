@@ -157,12 +157,18 @@ def cases():
 
 @pytest.fixture
 def stubbed(monkeypatch):
-    """Every computing function replaced by :func:`_stop`; the model assembled once per set."""
+    """Every computing function replaced by :func:`_stop`; the model assembled once per set.
+
+    Every module of ``model`` and ``app.cli`` is imported first: a module first imported while
+    the stubs are in place would keep a stub it imports by name (``from … import f``) for the
+    rest of the test session, and the other tests would meet it."""
     import importlib
 
     from model.mechanics import assembly
     from model.mechanics.parameters import parameter_hash
 
+    for module in all_modules():
+        importlib.import_module(module)
     for module, name in COMPUTING:
         monkeypatch.setattr(importlib.import_module(module), name, _stop)
     build, models = assembly.build_model, {}
@@ -174,6 +180,17 @@ def stubbed(monkeypatch):
         return models[key]
 
     monkeypatch.setattr(assembly, "build_model", cached)
+
+
+def all_modules() -> list[str]:
+    """The names of every module of the ``model`` and ``app.cli`` packages."""
+    import pkgutil
+
+    import app.cli
+    import model
+
+    return [info.name for package in (model, app.cli)
+            for info in pkgutil.walk_packages(package.__path__, package.__name__ + ".")]
 
 
 def run(argv, capsys):
