@@ -10,11 +10,13 @@ writes only where it is told, and replacing the bundled default set
     bogie calibrate --start K --out FILE
 
 ``--starts N`` (default 16) is the global calibration (:mod:`model.studies.global_calibration`):
-the same least squares from N points of a scrambled Sobol' sequence within the bounds, on the
-study engine (a local cluster by default); it writes the best start's set to FILE and prints
-every start (cost, frequency and divergence errors, the front between them) and the spread of
-the best starts per parameter.  ``--start K`` runs start K alone in this process and writes its
-set: the same bytes the global search writes when K is its best.  ``--divergence-weight W``
+the same least squares from start 0 (the ``--from`` file's own values: what the command without
+``--starts`` fits) and from N points of a scrambled Sobol' sequence within the bounds (starts 1 …
+N), on the study engine (a local cluster by default); it writes the best start's set to FILE and
+prints every start (cost, frequency and divergence errors, the front between them) and the
+spread of the best starts per parameter.  ``--start K`` runs start K alone in this process and
+writes its set: the same bytes the global search writes when K is its best (the command without
+``--start`` is ``--start 0``).  ``--divergence-weight W``
 weighs the two divergence rates at s0 = 0.014 in the last phase (default 1): the knob of the
 trade between Table 1's frequencies and the divergence (docs/validation.md).  Bad input: one line on stderr,
 exit status 2.
@@ -89,8 +91,9 @@ def starts_table(result) -> str:
     for s in result.spread:
         lines.append(f"{s.name:34} {s.low:>11.4g} {s.high:>11.4g} {100 * s.share:>6.0f}%  "
                      f"{'yes' if s.identified else 'no'}")
-    lines.append(f"\n{len(result.results)} starts in {result.seconds:.0f} s on {result.where}; "
-                 f"best: start {result.best}")
+    lines.append(f"\n{len(result.results)} starts (0: the start file's own values, 1 … "
+                 f"{len(result.results) - 1}: Sobol' points) in {result.seconds:.0f} s on "
+                 f"{result.where}; best: start {result.best}")
     return "\n".join(lines)
 
 
@@ -106,7 +109,7 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
     out = writable_path(args.out, "--out")
     if out.resolve() == CALIBRATED_FILE.resolve():
         print(f"bogie calibrate: replacing the bundled default set {CALIBRATED_FILE}", file=sys.stderr)
-    from model.studies.calibration import PHASES, run, with_divergence_weight
+    from model.studies.calibration import PHASES, with_divergence_weight
 
     phases = PHASES if args.max_evaluations is None else tuple(
         (min(count, args.max_evaluations), weights) for count, weights in PHASES)
@@ -119,20 +122,18 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
     if args.starts is not None:
         _global(args, start, out, phases, progress)
         return
-    if args.start is not None:
-        from model.studies.global_calibration import run_start, write_start
+    from model.studies.global_calibration import run_start, write_start
 
-        progress(f"calibrating from start {args.start} of the global calibration …")
-        result = run_start(args.start, start, phases)
-        if result.failed:
-            raise UsageError(f"start {args.start} cannot be calibrated: {result.failed}")
-        rows, table = write_start(result, out, start, args.divergence_weight)
-        progress(f"wrote {out}")
-        emit(args, {"out": str(out), "start": args.start, "cost": result.cost,
-                    "targets": _rows_json(rows)}, table)
-        return
-    rows, table = run(start, out, phases=phases, progress=progress)
-    emit(args, {"out": str(out), "targets": _rows_json(rows)}, table)
+    k = 0 if args.start is None else args.start  # without --start: start 0, the file's own values
+    progress(f"calibrating from start {k} of the global calibration"
+             f"{' (the values of ' + start.name + ')' if k == 0 else ''} …")
+    result = run_start(k, start, phases, progress)
+    if result.failed:
+        raise UsageError(f"start {k} cannot be calibrated: {result.failed}")
+    rows, table = write_start(result, out, start, args.divergence_weight)
+    progress(f"wrote {out}")
+    emit(args, {"out": str(out), "start": k, "cost": result.cost,
+                "targets": _rows_json(rows)}, table)
 
 
 def _global(args, start, out, phases, progress) -> None:
@@ -148,7 +149,7 @@ def _global(args, start, out, phases, progress) -> None:
                  f"{result.largest_real_unstable:+.3f} 1/s ({result.seconds:.0f} s)")
 
     with study_engine(args, "calibrate") as (mapper, where):
-        progress(f"global calibration: {args.starts} starts on {where} …")
+        progress(f"global calibration: start 0 and {args.starts} Sobol' starts on {where} …")
         result = global_search(args.starts, mapper, start, phases, done, where)
     best = next(r for r in result.results if r.index == result.best)
     rows, table = write_start(best, out, start, args.divergence_weight)

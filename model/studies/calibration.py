@@ -35,8 +35,9 @@ machine's floating-point kernels can move the last digits, BENCHMARKS.md).
 
 The published targets and how a set is judged against them live in
 :mod:`model.studies.calibration_targets`, the free parameters and their bounds in
-:mod:`model.studies.calibration_bounds`; this module holds the fit (stages A and J) and
-``bogie calibrate`` (:func:`run`).
+:mod:`model.studies.calibration_bounds`; this module holds the fit (stages A and J);
+``bogie calibrate`` runs it as start 0 of :mod:`model.studies.global_calibration` (the start
+file's own values) and writes the set there (:func:`~model.studies.global_calibration.write_start`).
 """
 
 from __future__ import annotations
@@ -50,14 +51,9 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from model.analysis.eigen import eigen_analysis
-from model.analysis.stability import stability_limit
 from model.mechanics.assembly import build_model
 from model.mechanics.parameters import (
-    CALIBRATED_FILE,
-    ESTIMATE_FILE,
     Parameters,
-    load_parameters,
-    save_parameters,
 )
 from model.studies.calibration_bounds import (
     CREEP_PARAMETERS,
@@ -79,11 +75,9 @@ from model.studies.calibration_targets import (
     SUSPENSION_ZETA,
     TABLE1_IM_HZ,
     TABLE1_RE,
-    V_REF,
     TargetRow,
     driving_shaft_mode,
     evaluate,
-    format_table,
     operating_rows,
     reference_point,
     signature_assignment,
@@ -526,7 +520,7 @@ def calibrate(start: Parameters, progress: Callable = print,
     dampers and the motor slope to Table 1 by rank with its characters, the real parts, the
     driving-shaft mode and the divergences, on the analytic Jacobian.  Returns the calibrated set
     and all its targets.  Deterministic: no random numbers, no time limits (run it with one BLAS
-    thread, as :func:`run` does: another thread count rounds differently).  ``initial``: the
+    thread, as ``bogie calibrate`` does: another thread count rounds differently).  ``initial``: the
     set stage J starts from (default: ``start``, which is the prior either way)."""
     stage_a = fit_operating_data(with_constraints(start))
     progress(f"  stage A: μ0 {stage_a['polach_mu0']:.5g}, A {stage_a['polach_A']:.5g}, "
@@ -562,26 +556,3 @@ def stage_j_cost(parameters: Parameters, start: Parameters, weights: Weights = P
     residual = _evaluate_j(x, prior, free, np.clip(_to_x(prior, free), low, high),
                            weights).residual
     return float(np.sum(np.sqrt(1 + (residual / LOSS_SCALE) ** 2) - 1))
-
-
-def run(start_file=ESTIMATE_FILE, out_file=CALIBRATED_FILE, phases: tuple = PHASES,
-        progress: Callable = print) -> tuple[list[TargetRow], str]:
-    """The ``bogie calibrate`` command: fit (with one BLAS thread, for a reproducible path) and
-    write the calibrated set; returns its targets and their table."""
-    from threadpoolctl import threadpool_limits
-
-    start = load_parameters(start_file)
-    progress(f"calibrating {len(FREE_PARAMETERS)} parameters from {start_file} …")
-    with threadpool_limits(1):
-        calibrated, rows = calibrate(start, progress, phases)
-        limit = stability_limit(build_model(calibrated), V_REF, calibrated["wheel_force"],
-                                calibrated["motor_slope"]).s0_limit
-    table = format_table(rows, limit)
-    name = start_file.name if hasattr(start_file, "name") else start_file
-    weight = phases[-1][1].divergence
-    how = "" if weight == PHASES[-1][1].divergence else f" --divergence-weight {weight:g}"
-    header = ("Calibrated parameter set (default everywhere). Produced by `bogie calibrate` from\n"
-              f"{name}{how}; re-run it to reproduce. Targets and results:\n" + table)
-    save_parameters(calibrated, out_file, header)
-    progress(f"wrote {out_file}")
-    return rows, table

@@ -4,13 +4,14 @@ A local least squares from one start lands where its start and its character ass
 it; this module runs the same least squares (stages A and J, unchanged) from ``N`` starts spread
 over the calibration bounds and compares where they land:
 
-* **Starts**: the points of a scrambled Sobol' sequence (``scipy.stats.qmc.Sobol``, seed
+* **Starts**: start 0 is the start file's own values (``start_file``: what ``bogie calibrate``
+  without ``--starts`` fits, so the single calibration is start 0 of every search); starts 1 … N
+  are the points 0 … N − 1 of a scrambled Sobol' sequence (``scipy.stats.qmc.Sobol``, seed
   :data:`SOBOL_SEED`) in the unit cube of the search parameters
   (:data:`~model.studies.calibration_bounds.SEARCH_PARAMETERS`), mapped onto their bounds (log
-  parameters log-uniformly, heights linearly); start ``k`` is the ``k``-th point of the sequence
-  whatever ``N`` (``fast_forward``), so one start re-runs alone (``bogie calibrate --start K``).
-  Stage A solves the creep law and the gear ratio at each start; the prior of stage J stays the
-  estimate (``start_file``).
+  parameters log-uniformly, heights linearly); start ``k`` is the same whatever ``N``
+  (``fast_forward``), so one start re-runs alone (``bogie calibrate --start K``).  Stage A solves
+  the creep law and the gear ratio at each start; the prior of stage J stays the start file.
 * **Each start** is a pure function of its index (:func:`run_start`; one BLAS thread): the study
   engine (:mod:`model.studies.engine`) runs them on its workers.
 * **Ranking**: by stage J's own cost at its last phase's weights
@@ -65,9 +66,14 @@ def sobol_unit_point(k: int, dimension: int) -> np.ndarray:
 
 
 def start_values(k: int, free=SEARCH_PARAMETERS) -> dict[str, float]:
-    """Start ``k``'s values of the search parameters [SI]: the Sobol' point mapped onto each
-    parameter's bounds (log-uniformly for log parameters, linearly for heights)."""
-    u = sobol_unit_point(k, len(free))
+    """Start ``k``'s values of the search parameters [SI]: none for start 0 (the start file's
+    own), else Sobol' point ``k − 1`` mapped onto each parameter's bounds (log-uniformly for log
+    parameters, linearly for heights)."""
+    if k < 0:
+        raise ValueError(f"start index must be >= 0, got {k}")
+    if k == 0:
+        return {}
+    u = sobol_unit_point(k - 1, len(free))
     values = {}
     for f, ui in zip(free, u, strict=True):
         if f.log:
@@ -117,9 +123,10 @@ def target_measures(rows: list[TargetRow]) -> dict:
             "divergence_error": float(abs(largest - DIVERGENCE_RATES[0]) / DIVERGENCE_RATES[0])}
 
 
-def run_start(k: int, start_file: str | Path | None = None, phases: tuple = PHASES) -> StartResult:
+def run_start(k: int, start_file: str | Path | None = None, phases: tuple = PHASES,
+              progress: Callable[[str], None] = lambda _text: None) -> StartResult:
     """Stages A and J from start ``k`` (one BLAS thread; a pure function of its arguments, for
-    the study engine's workers)."""
+    the study engine's workers); ``progress`` gets the stages' lines."""
     from threadpoolctl import threadpool_limits
 
     began = time.perf_counter()
@@ -127,8 +134,8 @@ def run_start(k: int, start_file: str | Path | None = None, phases: tuple = PHAS
     values = start_values(k)
     try:
         with threadpool_limits(1):
-            calibrated, rows = calibrate(estimate, lambda _text: None, phases,
-                                         initial=estimate.replace(**values))
+            calibrated, rows = calibrate(estimate, progress, phases,
+                                         initial=estimate.replace(**values) if values else None)
             cost = stage_j_cost(calibrated, estimate, phases[-1][1])
     except (ValueError, np.linalg.LinAlgError) as error:  # a start the model cannot analyse
         # (e.g. a creep shape whose law has no maximum below s = 1 for any μ0, A, B, p)
@@ -193,7 +200,7 @@ def spread(results: Iterable[StartResult], free=SEARCH_PARAMETERS) -> list[Sprea
 
 @dataclass(frozen=True)
 class GlobalResult:
-    results: list[StartResult]  # by start index
+    results: list[StartResult]  # by start index: 0 (the start file), then the Sobol' starts
     best: int  # index of the start with the lowest cost
     front: list[int]
     spread: list[SpreadRow]
@@ -202,7 +209,7 @@ class GlobalResult:
     extra: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
-        return {"starts": len(self.results), "best": self.best, "front": self.front,
+        return {"starts": len(self.results) - 1, "best": self.best, "front": self.front,
                 **self.extra,
                 "seconds": self.seconds, "where": self.where, "sobol_seed": SOBOL_SEED,
                 "results": [r.as_dict() for r in self.results],
@@ -215,16 +222,16 @@ def global_search(starts: int, map_unordered: Callable[[Callable, list], Iterato
                   start_file: str | Path | None = None, phases: tuple = PHASES,
                   progress: Callable[[StartResult], None] = lambda _result: None,
                   where: str = "") -> GlobalResult:
-    """Starts 0 … ``starts`` − 1 on ``map_unordered`` (the study engine's, or
-    :func:`model.studies.engine.serial_map_unordered`); ``progress`` is called with each start's
-    result as it finishes."""
+    """Start 0 (the start file) and the Sobol' starts 1 … ``starts`` on ``map_unordered`` (the
+    study engine's, or :func:`model.studies.engine.serial_map_unordered`); ``progress`` is
+    called with each start's result as it finishes."""
     if starts < 1:
         raise ValueError(f"starts must be >= 1, got {starts}")
     began = time.perf_counter()
     function = partial(run_start, start_file=None if start_file is None else str(start_file),
                        phases=phases)
     results = {}
-    for _, result in map_unordered(function, list(range(starts))):
+    for _, result in map_unordered(function, list(range(starts + 1))):
         results[result.index] = result
         progress(result)
     ordered = [results[k] for k in sorted(results)]
@@ -256,10 +263,18 @@ def write_start(result: StartResult, out_file: str | Path, start_file: str | Pat
     table = format_table(rows, limit)
     name = Path(ESTIMATE_FILE if start_file is None else start_file).name
     how = "" if divergence_weight is None else f" --divergence-weight {divergence_weight:g}"
-    header = (f"Calibrated parameter set of start {result.index} of the global calibration "
-              f"(scrambled Sobol' sequence, seed {SOBOL_SEED}, within the calibration bounds).\n"
-              f"Produced by `bogie calibrate --start {result.index} --from {name}{how}`; "
-              f"`bogie calibrate --starts N` writes the same file\nwhen start {result.index} is "
-              f"its best. Stage J's cost {result.cost:.6g}. Targets and results:\n" + table)
+    if result.index == 0:
+        what = (f"Calibrated parameter set of start 0 of the global calibration: from {name}'s "
+                "own values.\n"
+                f"Produced by `bogie calibrate --from {name}{how}` (the same as `--start 0`);\n"
+                "`bogie calibrate --starts N` writes the same file when start 0 is its best.")
+    else:
+        what = (f"Calibrated parameter set of start {result.index} of the global calibration "
+                f"(scrambled Sobol' sequence, seed {SOBOL_SEED}, its point {result.index - 1}, "
+                "within the calibration bounds).\n"
+                f"Produced by `bogie calibrate --start {result.index} --from {name}{how}`; "
+                f"`bogie calibrate --starts N` writes the same file\nwhen start {result.index} is "
+                "its best.")
+    header = f"{what} Stage J's cost {result.cost:.6g}. Targets and results:\n" + table
     save_parameters(parameters, out_file, header)
     return rows, table

@@ -47,7 +47,6 @@ COMPUTING = (
     ("model.studies.life", "route_life"),
     ("model.studies.assessment", "short_circuit_points"),
     ("model.studies.verdict_uncertainty", "run_verdict_uncertainty"),
-    ("model.studies.calibration", "run"),
     ("model.studies.global_calibration", "global_search"),
     ("model.studies.global_calibration", "run_start"),
     ("model.studies.compare", "compare_designs"),

@@ -7,19 +7,10 @@ from __future__ import annotations
 import json
 
 import pytest
+from test_cli import run
 
-from app.cli.main import main
 from model.studies import global_calibration as gc
 from model.studies.calibration_bounds import SEARCH_PARAMETERS
-
-
-def run(argv: list[str], capsys) -> tuple[int, str, str]:
-    try:
-        code = main(argv)
-    except SystemExit as exit_:
-        code = exit_.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture
@@ -28,7 +19,7 @@ def stubbed(monkeypatch):
     values = {f.name: f.low for f in SEARCH_PARAMETERS}
     written = []
 
-    def fake_start(k, start_file=None, phases=None):
+    def fake_start(k, start_file=None, phases=None, progress=None):
         return gc.StartResult(k, gc.start_values(k), values, float((k - 1) ** 2 + 1), 0.1 * k,
                               10 - k, 10, 7.0 + k, k / 7.031, 0.5)
 
@@ -50,19 +41,19 @@ def test_starts_serial_writes_the_best_start_and_reports_every_start(capsys, tmp
     data = json.loads(stdout)
     assert data["starts"] == 3
     assert data["best"] == 1  # cost (k − 1)² + 1
-    assert [r["index"] for r in data["results"]] == [0, 1, 2]
+    assert [r["index"] for r in data["results"]] == [0, 1, 2, 3]  # start 0: the file's values
     assert data["front"] == [0]  # the smallest frequency and divergence errors
     assert {row["name"] for row in data["spread"]} == {f.name for f in SEARCH_PARAMETERS}
     assert out.read_text(encoding="utf-8") == "start 1\n"
     assert stubbed == [1]
-    assert "global calibration: 3 starts on this process (serial)" in err
+    assert "global calibration: start 0 and 3 Sobol' starts on this process (serial)" in err
 
 
 def test_sixteen_starts_and_the_table(capsys, tmp_path, stubbed):
     code, stdout, err = run(["calibrate", "--starts", "16", "--serial", "--out",
                              str(tmp_path / "best.toml")], capsys)
     assert code == 0, err
-    assert "16 starts" in stdout
+    assert "17 starts" in stdout  # start 0 and the 16 Sobol' starts
     assert "spread of the best starts" in stdout
     assert "best: start 1" in stdout
 
@@ -110,3 +101,19 @@ def test_start_alone_reproduces_the_global_searchs_best_byte_for_byte(capsys, tm
     assert code == 0, err
     assert alone.read_bytes() == best.read_bytes()
     assert f"start {k} of the global calibration" in alone.read_text(encoding="utf-8")
+
+
+@pytest.mark.slow
+def test_the_single_calibration_is_start_0(capsys, tmp_path):
+    """``bogie calibrate`` without ``--start`` fits the start file's own values: start 0 of the
+    global calibration, the same bytes as ``--start 0`` (the bundled set's header names the
+    command; its re-run: scripts/bench_calibration.py)."""
+    single, alone = tmp_path / "single.toml", tmp_path / "start0.toml"
+    code, _, err = run(["calibrate", "--max-evaluations", "1", "--out", str(single)], capsys)
+    assert code == 0, err
+    assert "start 0 of the global calibration" in err
+    code, _, err = run(["calibrate", "--start", "0", "--max-evaluations", "1", "--out",
+                        str(alone)], capsys)
+    assert code == 0, err
+    assert single.read_bytes() == alone.read_bytes()
+    assert "(the same as `--start 0`)" in single.read_text(encoding="utf-8")

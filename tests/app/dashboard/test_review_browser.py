@@ -24,14 +24,27 @@ WIDGET_VALUE = """(cls) => { const doc = Bokeh.documents[0];
   return m ? m.value : null; }"""
 
 
+MODE_TABLE_MODEL = """() => { const doc = Bokeh.documents[0];
+  const m = [...doc.all_models].find(m => (m.css_classes || []).includes('mode-table'));
+  if (!m) return null;
+  const d = m.source.data, first = d instanceof Map ? [...d.values()][0] : Object.values(d)[0];
+  return {rows: first ? first.length : 0, visible: m.visible, height: m.height}; }"""
+
+
 def _what_the_modes_tab_shows(page, server_log) -> str:
+    """What the page holds when the mode table shows no row: the active tab, the table's element
+    (its box: zero where it is laid out hidden), the rows in the DOM (attached, visible or not),
+    the rows of the table's model in the browser (zero: the server never sent the modes), the
+    page's errors and the server's log."""
     active = page.locator(".bk-tab.bk-active").all_inner_texts()
     tables = page.locator(".mode-table")
-    text = tables.first.inner_text()[:300] if tables.count() else "(no .mode-table element)"
+    box = tables.first.bounding_box() if tables.count() else None
+    attached = page.locator(".mode-table .tabulator-row").count()
+    model = page.evaluate(MODE_TABLE_MODEL)
     log_tail = server_log.read_text()[-2000:] if server_log.exists() else "(no server log)"
-    return (f"no mode-table row within 120 s; active tabs {active}, .mode-table elements "
-            f"{tables.count()}, its text {text!r}, page errors {page.errors}, "
-            f"server log tail:\n{log_tail}")
+    return (f"no visible mode-table row within 120 s; active tabs {active}, .mode-table elements "
+            f"{tables.count()}, its box {box}, rows in the DOM {attached}, its model in the "
+            f"browser {model}, page errors {page.errors}, server log tail:\n{log_tail}")
 
 
 def _tab(page, title: str) -> None:

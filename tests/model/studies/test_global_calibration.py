@@ -14,26 +14,30 @@ from model.studies.engine import serial_map_unordered
 
 
 def test_start_k_is_the_same_point_whatever_the_number_of_starts():
-    """Start k is the k-th point of one scrambled Sobol' sequence (fast_forward): a start
-    re-runs alone; the first points are the sequence's, inside every bound."""
+    """Start 0 is the start file's own values (no value replaced); start k ≥ 1 is point k − 1
+    of one scrambled Sobol' sequence (fast_forward): a start re-runs alone; the first points are
+    the sequence's, inside every bound."""
     from scipy.stats import qmc
 
     first = qmc.Sobol(len(SEARCH_PARAMETERS), scramble=True, seed=gc.SOBOL_SEED).random(8)
     for k in range(8):
         assert gc.sobol_unit_point(k, len(SEARCH_PARAMETERS)) == pytest.approx(first[k], abs=0)
-    for k in (0, 5, 17):
+    assert gc.start_values(0) == {}
+    for k in (1, 5, 17):
         values = gc.start_values(k)
         assert values == gc.start_values(k)
         for f in SEARCH_PARAMETERS:
             assert f.low <= values[f.name] <= f.high, f.name
-    assert gc.start_values(0) != gc.start_values(1)
+    assert gc.start_values(1) != gc.start_values(2)
     with pytest.raises(ValueError, match="start index"):
         gc.sobol_unit_point(-1, 3)
+    with pytest.raises(ValueError, match="start index"):
+        gc.start_values(-1)
 
 
 def test_log_parameters_are_spread_log_uniformly():
     u = gc.sobol_unit_point(3, len(SEARCH_PARAMETERS))
-    values = gc.start_values(3)
+    values = gc.start_values(4)
     for f, ui in zip(SEARCH_PARAMETERS, u, strict=True):
         if f.log:
             assert math.log(values[f.name] / f.low) / math.log(f.high / f.low) == pytest.approx(ui)
@@ -86,24 +90,24 @@ def test_global_search_runs_every_start_and_picks_the_lowest_cost(monkeypatch):
 
     monkeypatch.setattr(gc, "run_start", fake)
     seen = []
-    result = gc.global_search(4, serial_map_unordered, progress=lambda r: seen.append(r.index))
+    result = gc.global_search(3, serial_map_unordered, progress=lambda r: seen.append(r.index))
     assert seen == [0, 1, 2, 3]
     assert [r.index for r in result.results] == [0, 1, 2, 3]
     assert result.best == 1
     assert result.front == [0, 1, 2, 3]
     assert len(result.spread) == len(SEARCH_PARAMETERS)
     data = result.as_dict()
-    assert data["starts"] == 4
+    assert data["starts"] == 3  # the Sobol' starts 1 … 3 beside start 0, the start file's
     assert data["best"] == 1
     with pytest.raises(ValueError, match="starts"):
         gc.global_search(0, serial_map_unordered)
 
 
 def test_a_start_the_model_cannot_analyse_is_reported_not_fatal(monkeypatch):
-    """Start 7's creep shape leaves the creep law without a maximum below s = 1 for any (μ0,
+    """Start 8's creep shape leaves the creep law without a maximum below s = 1 for any (μ0,
     A, B, p) within their bounds: the start is reported as failed, and the search goes on
     without it (not in the front, the spread or the best)."""
-    failed = gc.run_start(7, phases=((1, gc.PHASES[0][1]), (1, gc.PHASES[1][1])))
+    failed = gc.run_start(8, phases=((1, gc.PHASES[0][1]), (1, gc.PHASES[1][1])))
     assert "no maximum" in failed.failed
     assert math.isinf(failed.cost)
     assert failed.as_dict()["cost"] is None
@@ -115,7 +119,7 @@ def test_a_start_the_model_cannot_analyse_is_reported_not_fatal(monkeypatch):
         return _result(k, float(k), 0.1 * k, 0.1 * k, values)
 
     monkeypatch.setattr(gc, "run_start", fake)
-    result = gc.global_search(3, serial_map_unordered)
+    result = gc.global_search(2, serial_map_unordered)
     assert result.best == 0
     assert result.front == [0]
     assert [r.index for r in gc.best_starts(result.results)] == [0, 2]
