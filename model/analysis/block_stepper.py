@@ -40,6 +40,20 @@ TOLERANCE = 1e-12  # relative change of the channel values at which Newton stops
 MAX_ITERATIONS = 40  # per block before it is halved
 
 
+def hold_weights(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """φ1(x) = (eˣ − 1)/x and φ2(x) = (eˣ − 1 − x)/x² (complex x), with series near 0: the
+    modal weights of a first-order hold over a step h are ``h(φ1 − φ2)`` (the start value) and
+    ``h φ2`` (the end value) at x = λh."""
+    x = np.asarray(x, dtype=complex)
+    small = np.abs(x) < 1e-2
+    xs = np.where(small, 1.0, x)
+    phi1 = np.where(small, 1 + x / 2 + x**2 / 6 + x**3 / 24 + x**4 / 120 + x**5 / 720,
+                    np.expm1(xs) / xs)
+    phi2 = np.where(small, 0.5 + x / 6 + x**2 / 24 + x**3 / 120 + x**4 / 720 + x**5 / 5040,
+                    (np.expm1(xs) - xs) / xs**2)
+    return phi1, phi2
+
+
 def _toeplitz(W: np.ndarray, E: np.ndarray, Q: np.ndarray, D1: np.ndarray, L: int) -> np.ndarray:
     """T (L·rows x L·nc): row block i, column block j holds D1 (i = j) or Re(W E^(i−j−1) Q)
     (W: rows x m, Q: m x nc, D1: rows x nc)."""

@@ -66,12 +66,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from model.analysis.block_stepper import StepInputs, march, step_matrices
+from model.analysis.block_stepper import StepInputs, hold_weights, march, step_matrices
 from model.analysis.eigen import bogie_system
 from model.analysis.load_peaks import LIMITED, LimitCrossing, history_peaks_and_crossings
+from model.analysis.nonlinear_inputs import AntiSlip, NonlinearError
 from model.analysis.response import (
     MAX_POINTS,
-    ResponseError,
     ShortCircuit,
     time_grid_points,
 )
@@ -92,10 +92,6 @@ CREEP_MODELS = ("nonlinear", "tangent")
 BLOCK_STEPS = 2048  # steps per compiled block (modal states of a block: ≈ 6 MB)
 NEWTON_TOL = 1e-12  # relative change of the contact velocities at which Newton stops
 NEWTON_MAX = 60
-
-
-class NonlinearError(ResponseError):
-    """Bad input for a nonlinear response (one-line message)."""
 
 
 # --- maps between the state and the contacts -------------------------------------------------------
@@ -124,60 +120,6 @@ def damping_without_longitudinal_creep(model: BogieModel, op: OperatingPoint) ->
 def contact_names(model: BogieModel) -> list[str]:
     """Names of the contacts (rims) in the order of G's columns and H's rows."""
     return list(model.rims)
-
-
-# --- anti-slip protection -----------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class AntiSlip:
-    """Anti-slip protection of the healthy drive ID2 (see docs/nonlinear.md for the sources).
-
-    Defaults (assumptions, said as such in the docs):
-
-    * ``threshold = 0.3 m/s``: ≈ 1 km/h of extra slip speed of the wheelset, the order of the
-      slip-speed thresholds of wheel-slip detection in traction control (a few tenths of a m/s to a
-      few km/h); the pre-fault slip speed s0·v (0.17 m/s at s0 = 0.005, 0.47 m/s at 0.014,
-      120 km/h) is not counted.
-    * ``delay = 0.1 s``: the reaction time under study (the study: "within about 0.35 s").
-    * ``rate = 10 1/s``: the converter takes the full torque (characteristic) away in 0.1 s.
-    * ``floor = 0``: the torque is taken away completely (with ID1 failed, traction on that bogie is
-      cut) and held there for the rest of the run.
-    """
-
-    enabled: bool = True
-    delay: float = 0.1  # reaction delay τ after detection [s], ≥ 0
-    threshold: float = 0.3  # |Δ slip velocity| of ID2's wheelset that trips it [m/s], > 0
-    rate: float = 10.0  # torque reduction rate [fraction of M(s0, v) per s], > 0
-    floor: float = 0.0  # torque kept after the reduction [fraction of M(s0, v)], 0 ≤ floor < 1
-
-    def __post_init__(self) -> None:
-        checks = (("anti-slip delay (s)", self.delay, 0.0, 60.0, True, "in [0, 60] s"),
-                  ("anti-slip threshold (m/s)", self.threshold, 0.0, 100.0, False,
-                   "> 0 and at most 100 m/s"),
-                  ("anti-slip rate (1/s)", self.rate, 0.0, 1e6, False, "> 0 and at most 1e6 1/s"),
-                  ("anti-slip floor", self.floor, 0.0, 1.0, True, "in [0, 1)"))
-        for label, value, low, high, closed_low, allowed in checks:
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise NonlinearError(f"{label} must be a number, got {value!r}")
-            ok = (low <= value if closed_low else low < value) and value <= high
-            if label.endswith("floor") and value >= 1.0:
-                ok = False
-            if not math.isfinite(value) or not ok:
-                raise NonlinearError(f"{label} = {value} is not allowed: must be {allowed}")
-
-
-# --- first-order-hold weights ------------------------------------------------------------------------
-
-def _phi12(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """φ1(x) = (eˣ − 1)/x and φ2(x) = (eˣ − 1 − x)/x² (complex x), with series near 0."""
-    x = np.asarray(x, dtype=complex)
-    small = np.abs(x) < 1e-2
-    xs = np.where(small, 1.0, x)
-    phi1 = np.where(small, 1 + x / 2 + x**2 / 6 + x**3 / 24 + x**4 / 120 + x**5 / 720,
-                    np.expm1(xs) / xs)
-    phi2 = np.where(small, 0.5 + x / 6 + x**2 / 24 + x**3 / 120 + x**4 / 720 + x**5 / 5040,
-                    (np.expm1(xs) - xs) / xs**2)
-    return phi1, phi2
 
 
 # --- result ---------------------------------------------------------------------------------------------
@@ -263,7 +205,7 @@ def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
     beta = system.solve_eigenvectors(rhs)[keep]  # m x (2 + contacts)
     lam_k = lam[keep]
     E = np.exp(lam_k * h)
-    phi1, phi2 = _phi12(lam_k * h)
+    phi1, phi2 = hold_weights(lam_k * h)
     w1 = h * phi2
     w0 = h * phi1 - w1
     # modal state -> full state (rigid angles left out: loads and velocities do not see them)
@@ -404,11 +346,11 @@ def _excitation_increments(setup: _Setup, excitation: ShortCircuit, step: float,
     u0, a, mu = excitation.terms(step)
     u0, a = u0 * scale, a * scale
     lam = setup.lam
-    phi1_step, _ = _phi12(lam * h)
+    phi1_step, _ = hold_weights(lam * h)
     inc_step = setup.beta_mc * u0 * h * phi1_step
     if excitation.M0 > 0 and scale != 0:
-        phi_p, _ = _phi12((mu - lam) * h)
-        phi_m, _ = _phi12((np.conj(mu) - lam) * h)
+        phi_p, _ = hold_weights((mu - lam) * h)
+        phi_m, _ = hold_weights((np.conj(mu) - lam) * h)
         cp = setup.beta_mc * 0.5 * a * setup.E * h * phi_p
         cm = setup.beta_mc * 0.5 * np.conj(a) * setup.E * h * phi_m
     else:
