@@ -3,12 +3,14 @@ itself, with an anti-slip protection on the healthy drive's motor torque.
 
 API::
 
-    from model.analysis.nonlinear import AntiSlip, nonlinear_response
+    from model.analysis.nonlinear import AntiSlip, IrregularityHistory, nonlinear_response
     r = nonlinear_response(model, op, ShortCircuit(), t_end=2.0, fs=10_000.0,
-                           creep="nonlinear", anti_slip=AntiSlip(delay=0.1))
+                           creep="nonlinear", anti_slip=AntiSlip(delay=0.1),
+                           irregularity=IrregularityHistory.harmonic(80.0, 1e-4))  # or None
     r.outputs["ID2.disc_clutch.torque"]   # totals, the same names as the linear response [N m]
     r.creepage["ID2.rim12"], r.slip_velocity[...], r.utilisation[...]   # per wheel
     r.motor_torques["ID2.motor.torque"]    # after protection [N m]
+    r.wheel_force["ID2.rim12"]             # N_j with irregularities [N]
 
 Equations.  With the creepage formed from the state (eq. 14), ``Δs_i v = H_i Δq̇`` (H: contacts
 x n, :func:`creep_velocity_map`), the longitudinal creep force at contact i is
@@ -22,7 +24,8 @@ creep`), ``G`` = ``−Hᵀ`` (n x contacts, :func:`creep_force_map`) puts a unit
 ``ΔM_2(t)`` the anti-slip reduction of that torque.  With μ replaced by its tangent at s0 this is
 eq. 20 again: ``B + b_M B_M + B_ad = B_nl − G diag(N0 μ'(s0)/v) H``.  Kept linear as in the study:
 the lateral and spin creep forces (Kalker, eq. 9–10), the vertical wheel forces (N = N0 in the
-creep law; the track's m_R, b_R, k_R stay in M, B, K), the healthy motor's slope b_M.
+creep law unless irregularities are given, below; the track's m_R, b_R, k_R stay in M, B, K), the
+healthy motor's slope b_M.
 
 Method (exact linear part, implicit remainder). The equation is split at the tangent:
 
@@ -56,6 +59,29 @@ Anti-slip protection (:class:`AntiSlip`): detection when the slip velocity of ID
 solved with the creep forces in the same Newton iteration (a fifth channel).  ID1's motor is the
 one that short-circuited: its torque is the fault torque M_C(t) of its machine, which no converter
 controls, so the protection cannot act on it.
+
+Rail–wheel irregularities (``irregularity``: an :class:`IrregularityHistory` of the four wheels'
+Δ_j(t) [m]).  The wheel force varies, ``N_j = N0 + ΔN_j``, ``ΔN_j = −(m_R z̈_j + b_R ż_j + k_R z_j)
++ k_R Δ_j + b_R Δ̇_j + m_R Δ̈_j`` (z_j: the rim's ``z``, :mod:`model.mechanics.irregularity`), and
+the creep force is ``T_j = N_j μ(s_j, v)`` — it saturates at μ_max N_j as a wheel unloads:
+
+    (M + M_c) Δq̈ + (B_total + B_c) Δq̇ + (K + K_c) Δq = f_mc M_C + f_m2 ΔM_2
+        + G_q Δ + G_v Δ̇ + G_a Δ̈ + G [r(H Δq̇) + ΔN ∘ (μ(s) − μ(s0))]
+
+The linear part is then the running system (:func:`model.analysis.eigen.running_system`, its own
+cached eigendecomposition: M + M_c is not symmetric), stepped exactly like the bogie; it holds
+μ(s0) ΔN_j, whose state part is stiff (k_R μ(s0) on the longitudinal pattern) and would carry the
+hold error in the remainder.  The deviations' force enters by exact modal increments (harmonic)
+or first-order hold (sampled).  Only the product ΔN_j (μ(s_j) − μ(s0)) joins the remainder; ΔN is
+not lagged but solved with it at each step's end, as further rows of the block solve (state,
+remainders and the inputs' direct feed into z̈; :mod:`model.analysis.nonlinear_irregularity`),
+held in Newton's Jacobian only, so the scheme keeps its order.  ``creep="tangent"`` gives
+``T = N (μ0 + μ0' Δs)``, whose small-amplitude limit is the running system's frequency response.
+The short circuit alone moves the rims vertically (its torque reaction loads ID1's wheels and
+unloads ID2's by tens of per cent of N0), which a run with irregularities — Δ = 0 included —
+takes into account and one without (N = N0, the bogie's system, the computation above) does not.
+Not modelled: a wheel lifting off (N_j ≤ 0 ends the run), the Hertzian contact's own stiffness,
+μ's own dependence on N (the law stays that of N0), the lateral and spin creep forces' on N.
 """
 
 from __future__ import annotations
