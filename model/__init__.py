@@ -18,7 +18,8 @@ them):
 * eigenvalues and stability: :func:`eigen_analysis`, :func:`mode_character`,
   :func:`stability_limit`, :func:`root_locus`;
 * the short circuit: :func:`short_circuit_response` (linear, closed form),
-  :func:`nonlinear_response` with :class:`AntiSlip` (nonlinear creep, anti-slip protection),
+  :func:`nonlinear_response` with :class:`AntiSlip` (nonlinear creep, anti-slip protection) and
+  :class:`IrregularityHistory` (rail–wheel deviations, varying wheel forces),
   :func:`required_reaction_time`;
 * sensitivities: :func:`eigen_sensitivities`, :func:`limit_sensitivity`,
   :func:`peak_load_sensitivities`;
@@ -35,7 +36,12 @@ from model.analysis.frequency_response import FrequencyResponse, frequency_respo
 from model.analysis.load_spectrum import LoadSpectrum, history_spectra, load_spectrum
 from model.analysis.locus import RootLocus, root_locus
 from model.analysis.modes import ModeCharacter, characterize, mode_character
-from model.analysis.nonlinear import AntiSlip, NonlinearResult, nonlinear_response
+from model.analysis.nonlinear import (
+    AntiSlip,
+    IrregularityHistory,
+    NonlinearResult,
+    nonlinear_response,
+)
 from model.analysis.peak_sensitivity import PeakLoadSensitivity, peak_load_sensitivities
 from model.analysis.response import ResponseResult, ShortCircuit, short_circuit_response
 from model.analysis.sensitivity import (
@@ -70,7 +76,8 @@ from model.studies.envelope import Envelope, EnvelopeStudy, run_envelope
 
 __all__ = [
     "KMH", "AntiSlip", "BogieModel", "CampbellDiagram", "DesignComparison", "EigenResult",
-    "EigenSensitivities", "Envelope", "EnvelopeStudy", "FrequencyResponse", "LimitSensitivity",
+    "EigenSensitivities", "Envelope", "EnvelopeStudy", "FrequencyResponse", "IrregularityHistory",
+    "LimitSensitivity",
     "LoadSpectrum", "ModeCharacter", "NoStabilityLimit", "NonlinearResult", "OperatingPoint",
     "OperatingPointError", "OutputMatrices", "ParameterError", "Parameters", "PeakLoadSensitivity",
     "ReactionTime", "ResponseResult", "RootLocus", "ShortCircuit", "StabilityLimit",

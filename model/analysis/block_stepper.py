@@ -40,6 +40,20 @@ TOLERANCE = 1e-12  # relative change of the channel values at which Newton stops
 MAX_ITERATIONS = 40  # per block before it is halved
 
 
+def hold_weights(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """φ1(x) = (eˣ − 1)/x and φ2(x) = (eˣ − 1 − x)/x² (complex x), with series near 0: the
+    modal weights of a first-order hold over a step h are ``h(φ1 − φ2)`` (the start value) and
+    ``h φ2`` (the end value) at x = λh."""
+    x = np.asarray(x, dtype=complex)
+    small = np.abs(x) < 1e-2
+    xs = np.where(small, 1.0, x)
+    phi1 = np.where(small, 1 + x / 2 + x**2 / 6 + x**3 / 24 + x**4 / 120 + x**5 / 720,
+                    np.expm1(xs) / xs)
+    phi2 = np.where(small, 0.5 + x / 6 + x**2 / 24 + x**3 / 120 + x**4 / 720 + x**5 / 5040,
+                    (np.expm1(xs) - xs) / xs**2)
+    return phi1, phi2
+
+
 def _toeplitz(W: np.ndarray, E: np.ndarray, Q: np.ndarray, D1: np.ndarray, L: int) -> np.ndarray:
     """T (L·rows x L·nc): row block i, column block j holds D1 (i = j) or Re(W E^(i−j−1) Q)
     (W: rows x m, Q: m x nc, D1: rows x nc)."""
@@ -59,11 +73,13 @@ class _Blocks:
     its triangular part for Newton, the outputs' Toeplitz T_V, the powers of E and the index
     patterns of a block."""
 
-    def __init__(self, W, E, Q, D1, P1, V, creep):
+    def __init__(self, W, E, Q, D1, P1, V, creep, wheel=None):
         self.Q, self.P1 = Q, P1
         self.channels = nc = W.shape[0]
         self.creep = creep  # channels: creep (True) or ID2's slope torque
         self.rows_out = V.shape[0]
+        # the wheel-force rows (irregularities only): ΔN = Re(W_n ζ) + D_n r + known inputs
+        self.wheel_rows = 0 if wheel is None else wheel[0].shape[0]
         self.full = _toeplitz(W, E, Q, D1, SUB_STEPS)
         # the Newton matrix's part: T without the within-step coupling between channels
         self.triangular = np.tril(self.full)
@@ -72,7 +88,13 @@ class _Blocks:
             block[np.triu_indices(nc, 1)] = 0.0  # np.tril kept the lower part of D1 only
             block[np.tril_indices(nc, -1)] = 0.0
         self.outputs = _toeplitz(V, E, Q, (V @ P1).real, SUB_STEPS)
-        self.projection = np.ascontiguousarray(np.vstack([W, V]).T)  # m x (nc + outputs)
+        self.wheel = None
+        if wheel is None:
+            self.projection = np.ascontiguousarray(np.vstack([W, V]).T)  # m x (nc + outputs)
+        else:  # m x (nc + wheels + outputs); the wheel forces' Toeplitz has their direct feed
+            W_n, D_n = wheel
+            self.wheel = _toeplitz(W_n, E, Q, (W_n @ P1).real + D_n, SUB_STEPS)
+            self.projection = np.ascontiguousarray(np.vstack([W, W_n, V]).T)
         self.powers = E[None, :] ** np.arange(SUB_STEPS)[:, None]  # E^k, k = 0 … L−1
         self.doubling = [E]  # E^(2^k) for the doubling scan
         while 2 ** len(self.doubling) < SUB_STEPS:
@@ -93,12 +115,13 @@ class _Blocks:
         return J
 
 
-def step_matrices(W, E, P0, P1, D1, V, n_creep) -> _Blocks:
+def step_matrices(W, E, P0, P1, D1, V, n_creep, wheel=None) -> _Blocks:
     """The matrices of a run's step loop (Q = diag(E) P1 + P0; V: outputs x m, y = Re(V ζ);
     the first ``n_creep`` of the channels are creep channels), built once per run and passed, in
     the run's :class:`StepInputs`, to every :func:`march` call of it (one per output block of
-    2 048 steps)."""
-    return _Blocks(W, E, E[:, None] * P1 + P0, D1, P1, V, np.arange(W.shape[0]) < n_creep)
+    2 048 steps).  ``wheel``: with irregularities, (W_n, D_n) of the contacts' wheel-force
+    changes ``ΔN = Re(W_n ζ) + D_n r + …`` (n_creep x m, n_creep x channels) [N]."""
+    return _Blocks(W, E, E[:, None] * P1 + P0, D1, P1, V, np.arange(W.shape[0]) < n_creep, wheel)
 
 
 @dataclass(frozen=True)
@@ -133,13 +156,21 @@ class StepInputs:
     rate: float  # torque reduction rate [1/s]
     floor: float  # torque kept after the reduction [fraction of M(s0, v)]
     blocks: _Blocks  # the run's :func:`step_matrices`
+    # the rail–wheel irregularities (None: none, N = N0): an object with ``forcing(k, L)``, the
+    # exact or held modal increments of their generalized force over steps k … k+L−1 (L x m),
+    # ``known(k, L)``, the wheel-force changes at the ends of those steps that do not come from
+    # the modal state or the remainders (L x contacts) [N], and ``d_m2`` (contacts), the direct
+    # feed of ID2's motor torque into them [N per N m]
+    # (:class:`model.analysis.nonlinear_irregularity.IrregularityLoop`)
+    irregularity: object | None = None
 
 
 def march(k0, k1, inputs: StepInputs, zeta, phi, z, u2_now, det_state, Y_out, z_out, phi_out,
-          u2_out, iterations):
+          u2_out, iterations, wheel_out=None):
     """Steps k0 → k1 (exclusive of k0's state, which is given).  Writes the outputs Re(V ζ)
     (``inputs.blocks``' V), contact velocities, remainder forces and ΔM_2 of steps k0+1 … k1 into
-    rows 0 … of ``Y_out``, ``z_out``, ``phi_out``, ``u2_out``; updates zeta, phi, z, det_state and
+    rows 0 … of ``Y_out``, ``z_out``, ``phi_out``, ``u2_out`` (and, with irregularities, the
+    contacts' wheel-force changes ΔN [N] into ``wheel_out``); updates zeta, phi, z, det_state and
     ``iterations`` in place (``u2_now``: ΔM_2 at step k0 [N m]).  Returns 0, or the step at which
     Newton failed (negative)."""
     i = inputs
@@ -155,7 +186,7 @@ def march(k0, k1, inputs: StepInputs, zeta, phi, z, u2_now, det_state, Y_out, z_
                                      - i.dmu_s0)
     state = _LoopState(zeta.copy(), phi.copy(), z.copy(), float(u2_now), float(det_state[0]),
                        slope)
-    out = _Buffers(Y_out, z_out, phi_out, u2_out)
+    out = _Buffers(Y_out, z_out, phi_out, u2_out, wheel_out)
     row, L = 0, SUB_STEPS
     while row < k1 - k0:
         L = min(L, k1 - k0 - row)
@@ -215,6 +246,7 @@ class _Buffers:
     z: np.ndarray
     phi: np.ndarray
     u2: np.ndarray
+    wheel: np.ndarray | None = None  # the contacts' wheel-force changes ΔN [N] (irregularities)
 
 
 def _block(state: _LoopState, kb: int, L: int, row0: int, inputs: StepInputs,
@@ -224,15 +256,23 @@ def _block(state: _LoopState, kb: int, L: int, row0: int, inputs: StepInputs,
     writes into ``out``."""
     nc = state.z.shape[0]
     t1, reduction, u2, forced, projected = _forced_block(state, kb, L, inputs, fixed.basis)
-    solved = _solve_remainders(state, L, inputs, fixed, projected[:, :nc].reshape(-1), reduction)
+    wheel = None
+    if inputs.irregularity is not None:  # the wheel-force changes without the block's remainders
+        nw = inputs.blocks.wheel_rows
+        wheel = (projected[:, nc:nc + nw] + inputs.irregularity.known(kb, L)
+                 + u2[:, None] * inputs.irregularity.d_m2[None, :]).reshape(-1)
+    solved = _solve_remainders(state, L, inputs, fixed, projected[:, :nc].reshape(-1), reduction,
+                               wheel)
     if solved is None:
         return 0
-    zf, r, dr, count = solved
+    zf, r, dr, count, n = solved
     zb, rb = zf.reshape(L, nc), r.reshape(L, nc)
     accepted = L
     if state.detection < 0.0:
         accepted = _cut_at_detection(state, zb, t1, inputs, fixed.detect)
     _accept(state, accepted, row0, inputs.blocks, forced, projected, zb, rb, dr, u2, out)
+    if n is not None:
+        out.wheel[row0:row0 + accepted] = n.reshape(L, -1)[:accepted]
     iterations[0] += count * accepted  # every accepted step took part in `count` iterations
     return accepted
 
@@ -255,6 +295,8 @@ def _forced_block(state: _LoopState, kb: int, L: int, i: StepInputs, basis: np.n
     inputs[:, 3] = u2
     forcing = inputs @ basis
     forcing += i.inc_step
+    if i.irregularity is not None:
+        forcing += i.irregularity.forcing(kb, L)
     forcing[0] += i.E * state.zeta + i.P0 @ state.phi
     forced = _recurrence(i.blocks.doubling, forcing)
     projected = (forced @ i.blocks.projection).real
@@ -262,9 +304,17 @@ def _forced_block(state: _LoopState, kb: int, L: int, i: StepInputs, basis: np.n
 
 
 def _solve_remainders(state: _LoopState, L: int, i: StepInputs, fixed: _MarchConstants,
-                      a: np.ndarray, reduction: np.ndarray):
+                      a: np.ndarray, reduction: np.ndarray, wheel: np.ndarray | None = None):
     """Newton on ``z = a + T r(z)`` for the block's L·nc channel values (``a``: the forced
-    values); (z, r, r'(z), iterations), or None when it does not converge."""
+    values); (z, r, r'(z), iterations, ΔN), or None when it does not converge.
+
+    With irregularities (``wheel``: the contacts' wheel-force changes without the block's
+    remainders, L·contacts [N]) the creep remainder is ``N0 (μ − μ0) − N0 μ0' z/v + ΔN (μ − μ0)``
+    (:mod:`model.analysis.nonlinear`) with ``ΔN = wheel + T_n r`` (the wheel forces' Toeplitz):
+    ΔN is formed from each iterate's remainders and held in the Jacobian (its only entries would
+    be ``(μ − μ0) ∂ΔN/∂r``: the creep forces move the wheels' vertical motion through the
+    structure's couplings only); the residual and the stopping rule keep it, so the solution is
+    that of the coupled equations, ΔN included (ΔN's change counts relative to N0)."""
     blocks = i.blocks
     nc = state.z.shape[0]
     T = blocks.full[:L * nc, :L * nc]
@@ -282,16 +332,26 @@ def _solve_remainders(state: _LoopState, L: int, i: StepInputs, fixed: _MarchCon
     zf, info = trtrs(blocks.newton_matrix(L, dr), -(a + T @ offset), lower=1)
     if info != 0:
         return None
+    n = T_n = None
+    if wheel is not None:  # ΔN from the start's remainders (linearized about the last step)
+        T_n = blocks.wheel[:L * blocks.wheel_rows, :L * nc]
+        n = wheel + T_n @ (offset + dr * zf)
     r = np.empty(L * nc)
     count = 0
     while True:
         zc = zf[is_creep]
         if i.tangent:
             r[is_creep] = i.N0 * ((i.mu_s0 + i.dmu_s0 * (zc / i.v)) - i.mu_s0) - tangent_slope * zc
+            if n is not None:  # T = N (μ0 + μ0' z/v): the product ΔN μ0' z/v
+                r[is_creep] += n * (i.dmu_s0 * (zc / i.v))
+                dr[is_creep] = n * (i.dmu_s0 / i.v)
         else:
             mu_v, dmu_v = polach_mu_and_slope(i.s0 + zc / i.v, i.v, *fixed.law)
             r[is_creep] = i.N0 * (mu_v - i.mu_s0) - tangent_slope * zc
             dr[is_creep] = i.N0 / i.v * (dmu_v - i.dmu_s0)
+            if n is not None:  # T = N μ: the product ΔN (μ − μ0)
+                r[is_creep] += n * (mu_v - i.mu_s0)
+                dr[is_creep] += n * (dmu_v / i.v)
         r[~is_creep] = slope_scale * zf[~is_creep]
         residual = a + T @ r - zf
         step, info = trtrs(blocks.newton_matrix(L, dr), residual, lower=1)
@@ -301,10 +361,14 @@ def _solve_remainders(state: _LoopState, L: int, i: StepInputs, fixed: _MarchCon
         r = r - dr * step  # the remainders at the new values to first order (O(step²) ≈ 1e-24)
         count += 1
         change = float(np.max(np.abs(step) / (np.abs(zf) + fixed.scale)))
+        if n is not None:
+            n_new = wheel + T_n @ r
+            change = max(change, float(np.max(np.abs(n_new - n))) / i.N0)
+            n = n_new
         if not math.isfinite(change):
             return None
         if change <= TOLERANCE:
-            return zf, r, dr, count
+            return zf, r, dr, count, n
         if count >= MAX_ITERATIONS:
             return None
 
@@ -337,7 +401,7 @@ def _accept(state: _LoopState, accepted: int, row0: int, blocks: _Blocks, forced
     nc = zb.shape[1]
     n_out = blocks.rows_out
     r = rb.reshape(-1)
-    out.Y[row0:row0 + accepted] = projected[:accepted, nc:] + (
+    out.Y[row0:row0 + accepted] = projected[:accepted, nc + blocks.wheel_rows:] + (
         blocks.outputs[:accepted * n_out, :accepted * nc] @ r[:accepted * nc]).reshape(accepted, n_out)
     last = forced[accepted - 1] + blocks.P1 @ rb[accepted - 1]
     if accepted > 1:

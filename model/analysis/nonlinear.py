@@ -3,12 +3,14 @@ itself, with an anti-slip protection on the healthy drive's motor torque.
 
 API::
 
-    from model.analysis.nonlinear import AntiSlip, nonlinear_response
+    from model.analysis.nonlinear import AntiSlip, IrregularityHistory, nonlinear_response
     r = nonlinear_response(model, op, ShortCircuit(), t_end=2.0, fs=10_000.0,
-                           creep="nonlinear", anti_slip=AntiSlip(delay=0.1))
+                           creep="nonlinear", anti_slip=AntiSlip(delay=0.1),
+                           irregularity=IrregularityHistory.harmonic(80.0, 1e-4))  # or None
     r.outputs["ID2.disc_clutch.torque"]   # totals, the same names as the linear response [N m]
     r.creepage["ID2.rim12"], r.slip_velocity[...], r.utilisation[...]   # per wheel
     r.motor_torques["ID2.motor.torque"]    # after protection [N m]
+    r.wheel_force["ID2.rim12"]             # N_j with irregularities [N]
 
 Equations.  With the creepage formed from the state (eq. 14), ``Δs_i v = H_i Δq̇`` (H: contacts
 x n, :func:`creep_velocity_map`), the longitudinal creep force at contact i is
@@ -22,7 +24,8 @@ creep`), ``G`` = ``−Hᵀ`` (n x contacts, :func:`creep_force_map`) puts a unit
 ``ΔM_2(t)`` the anti-slip reduction of that torque.  With μ replaced by its tangent at s0 this is
 eq. 20 again: ``B + b_M B_M + B_ad = B_nl − G diag(N0 μ'(s0)/v) H``.  Kept linear as in the study:
 the lateral and spin creep forces (Kalker, eq. 9–10), the vertical wheel forces (N = N0 in the
-creep law; the track's m_R, b_R, k_R stay in M, B, K), the healthy motor's slope b_M.
+creep law unless irregularities are given, below; the track's m_R, b_R, k_R stay in M, B, K), the
+healthy motor's slope b_M.
 
 Method (exact linear part, implicit remainder). The equation is split at the tangent:
 
@@ -56,6 +59,29 @@ Anti-slip protection (:class:`AntiSlip`): detection when the slip velocity of ID
 solved with the creep forces in the same Newton iteration (a fifth channel).  ID1's motor is the
 one that short-circuited: its torque is the fault torque M_C(t) of its machine, which no converter
 controls, so the protection cannot act on it.
+
+Rail–wheel irregularities (``irregularity``: an :class:`IrregularityHistory` of the four wheels'
+Δ_j(t) [m]).  The wheel force varies, ``N_j = N0 + ΔN_j``, ``ΔN_j = −(m_R z̈_j + b_R ż_j + k_R z_j)
++ k_R Δ_j + b_R Δ̇_j + m_R Δ̈_j`` (z_j: the rim's ``z``, :mod:`model.mechanics.irregularity`), and
+the creep force is ``T_j = N_j μ(s_j, v)`` — it saturates at μ_max N_j as a wheel unloads:
+
+    (M + M_c) Δq̈ + (B_total + B_c) Δq̇ + (K + K_c) Δq = f_mc M_C + f_m2 ΔM_2
+        + G_q Δ + G_v Δ̇ + G_a Δ̈ + G [r(H Δq̇) + ΔN ∘ (μ(s) − μ(s0))]
+
+The linear part is then the running system (:func:`model.analysis.eigen.running_system`, its own
+cached eigendecomposition: M + M_c is not symmetric), stepped exactly like the bogie; it holds
+μ(s0) ΔN_j, whose state part is stiff (k_R μ(s0) on the longitudinal pattern) and would carry the
+hold error in the remainder.  The deviations' force enters by exact modal increments (harmonic)
+or first-order hold (sampled).  Only the product ΔN_j (μ(s_j) − μ(s0)) joins the remainder; ΔN is
+not lagged but solved with it at each step's end, as further rows of the block solve (state,
+remainders and the inputs' direct feed into z̈; :mod:`model.analysis.nonlinear_irregularity`),
+held in Newton's Jacobian only, so the scheme keeps its order.  ``creep="tangent"`` gives
+``T = N (μ0 + μ0' Δs)``, whose small-amplitude limit is the running system's frequency response.
+The short circuit alone moves the rims vertically (its torque reaction loads ID1's wheels and
+unloads ID2's by tens of per cent of N0), which a run with irregularities — Δ = 0 included —
+takes into account and one without (N = N0, the bogie's system, the computation above) does not.
+Not modelled: a wheel lifting off (N_j ≤ 0 ends the run), the Hertzian contact's own stiffness,
+μ's own dependence on N (the law stays that of N0), the lateral and spin creep forces' on N.
 """
 
 from __future__ import annotations
@@ -66,17 +92,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from model.analysis.block_stepper import StepInputs, march, step_matrices
-from model.analysis.eigen import bogie_system
+from model.analysis.block_stepper import StepInputs, hold_weights, march, step_matrices
+from model.analysis.eigen import bogie_system, running_system
+from model.analysis.linear_system import LinearSystem
 from model.analysis.load_peaks import LIMITED, LimitCrossing, history_peaks_and_crossings
+from model.analysis.nonlinear_inputs import AntiSlip, IrregularityHistory, NonlinearError
+from model.analysis.nonlinear_irregularity import IrregularityLoop, force_columns, irregularity_loop
 from model.analysis.response import (
     MAX_POINTS,
-    ResponseError,
     ShortCircuit,
     time_grid_points,
 )
 from model.contact.creep import PolachLaw
 from model.mechanics.assembly import DRIVES, RIM_NODES, BogieModel
+from model.mechanics.irregularity import irregularity_inputs
 from model.mechanics.operating_point import (
     OperatingPoint,
     adhesion_moment,
@@ -92,10 +121,6 @@ CREEP_MODELS = ("nonlinear", "tangent")
 BLOCK_STEPS = 2048  # steps per compiled block (modal states of a block: ≈ 6 MB)
 NEWTON_TOL = 1e-12  # relative change of the contact velocities at which Newton stops
 NEWTON_MAX = 60
-
-
-class NonlinearError(ResponseError):
-    """Bad input for a nonlinear response (one-line message)."""
 
 
 # --- maps between the state and the contacts -------------------------------------------------------
@@ -124,60 +149,6 @@ def damping_without_longitudinal_creep(model: BogieModel, op: OperatingPoint) ->
 def contact_names(model: BogieModel) -> list[str]:
     """Names of the contacts (rims) in the order of G's columns and H's rows."""
     return list(model.rims)
-
-
-# --- anti-slip protection -----------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class AntiSlip:
-    """Anti-slip protection of the healthy drive ID2 (see docs/nonlinear.md for the sources).
-
-    Defaults (assumptions, said as such in the docs):
-
-    * ``threshold = 0.3 m/s``: ≈ 1 km/h of extra slip speed of the wheelset, the order of the
-      slip-speed thresholds of wheel-slip detection in traction control (a few tenths of a m/s to a
-      few km/h); the pre-fault slip speed s0·v (0.17 m/s at s0 = 0.005, 0.47 m/s at 0.014,
-      120 km/h) is not counted.
-    * ``delay = 0.1 s``: the reaction time under study (the study: "within about 0.35 s").
-    * ``rate = 10 1/s``: the converter takes the full torque (characteristic) away in 0.1 s.
-    * ``floor = 0``: the torque is taken away completely (with ID1 failed, traction on that bogie is
-      cut) and held there for the rest of the run.
-    """
-
-    enabled: bool = True
-    delay: float = 0.1  # reaction delay τ after detection [s], ≥ 0
-    threshold: float = 0.3  # |Δ slip velocity| of ID2's wheelset that trips it [m/s], > 0
-    rate: float = 10.0  # torque reduction rate [fraction of M(s0, v) per s], > 0
-    floor: float = 0.0  # torque kept after the reduction [fraction of M(s0, v)], 0 ≤ floor < 1
-
-    def __post_init__(self) -> None:
-        checks = (("anti-slip delay (s)", self.delay, 0.0, 60.0, True, "in [0, 60] s"),
-                  ("anti-slip threshold (m/s)", self.threshold, 0.0, 100.0, False,
-                   "> 0 and at most 100 m/s"),
-                  ("anti-slip rate (1/s)", self.rate, 0.0, 1e6, False, "> 0 and at most 1e6 1/s"),
-                  ("anti-slip floor", self.floor, 0.0, 1.0, True, "in [0, 1)"))
-        for label, value, low, high, closed_low, allowed in checks:
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise NonlinearError(f"{label} must be a number, got {value!r}")
-            ok = (low <= value if closed_low else low < value) and value <= high
-            if label.endswith("floor") and value >= 1.0:
-                ok = False
-            if not math.isfinite(value) or not ok:
-                raise NonlinearError(f"{label} = {value} is not allowed: must be {allowed}")
-
-
-# --- first-order-hold weights ------------------------------------------------------------------------
-
-def _phi12(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """φ1(x) = (eˣ − 1)/x and φ2(x) = (eˣ − 1 − x)/x² (complex x), with series near 0."""
-    x = np.asarray(x, dtype=complex)
-    small = np.abs(x) < 1e-2
-    xs = np.where(small, 1.0, x)
-    phi1 = np.where(small, 1 + x / 2 + x**2 / 6 + x**3 / 24 + x**4 / 120 + x**5 / 720,
-                    np.expm1(xs) / xs)
-    phi2 = np.where(small, 0.5 + x / 6 + x**2 / 24 + x**3 / 120 + x**4 / 720 + x**5 / 5040,
-                    (np.expm1(xs) - xs) / xs**2)
-    return phi1, phi2
 
 
 # --- result ---------------------------------------------------------------------------------------------
@@ -215,6 +186,9 @@ class NonlinearResult:
     remainder_force: np.ndarray | None = None  # N x contacts: r(H Δq̇) [N]
     states: np.ndarray | None = None  # samples x N: [Δq; Δq̇_inertial] without the rigid-body
     # positions (the rolling velocity included), if asked
+    irregularity: IrregularityHistory | None = None  # the rail–wheel deviations, if given
+    wheel_force: dict[str, np.ndarray] | None = None  # rim -> vertical wheel force N_j [N]
+    # (with irregularities; without, N_j = N0 throughout)
 
     def perturbation(self, name: str) -> np.ndarray:
         """Δy(t) = total − pre-fault value [unit of the output]."""
@@ -241,11 +215,11 @@ class _Setup:
     modal_to_state: np.ndarray  # N x m: x = Re(X ζ) (rigid angles left out)
 
 
-def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
-    """The modal pieces of the stepping at step ``h`` [s] (:class:`_Setup`), built once per
-    (model, operating point, h) and kept in the cached system (:func:`bogie_system`)."""
+def _setup(model: BogieModel, op: OperatingPoint, h: float, system: LinearSystem) -> _Setup:
+    """The modal pieces of the stepping at step ``h`` [s] (:class:`_Setup`) of ``system`` (the
+    bogie, :func:`bogie_system`, or the running system, :func:`running_system`), built once per
+    (model, operating point, h) and kept in the cached system."""
     key = ("nonlinear_setup", h)
-    system = bogie_system(model, op)
     cached = system._cache.get(key)
     if cached is not None:
         return cached
@@ -263,7 +237,7 @@ def _setup(model: BogieModel, op: OperatingPoint, h: float) -> _Setup:
     beta = system.solve_eigenvectors(rhs)[keep]  # m x (2 + contacts)
     lam_k = lam[keep]
     E = np.exp(lam_k * h)
-    phi1, phi2 = _phi12(lam_k * h)
+    phi1, phi2 = hold_weights(lam_k * h)
     w1 = h * phi2
     w0 = h * phi1 - w1
     # modal state -> full state (rigid angles left out: loads and velocities do not see them)
@@ -296,7 +270,8 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
                        anti_slip: AntiSlip | None = None, outputs: list[str] | None = None,
                        strength: float | None = None, keep_states: bool = False,
                        substeps: int = 1, excitation_scale: float = 1.0,
-                       checkpoint: Callable[[], None] | None = None) -> NonlinearResult:
+                       checkpoint: Callable[[], None] | None = None,
+                       irregularity: IrregularityHistory | None = None) -> NonlinearResult:
     """Time histories after the short circuit of ID1's motor with nonlinear longitudinal creep.
 
     ``creep``: "nonlinear" (the law) or "tangent" (its tangent at s0, through the same loop);
@@ -310,7 +285,11 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     small-amplitude limit; the result's ``M_C`` is the scaled torque);
     ``checkpoint``: called between blocks of BLOCK_STEPS integration steps; whatever it raises
     ends the run and reaches the caller (a caller's cancellation: an interactive session that no
-    longer wants the result stops it within one block, not at the end of the run).
+    longer wants the result stops it within one block, not at the end of the run);
+    ``irregularity``: the four wheels' rail–wheel surface deviations Δ_j(t) [m]
+    (:class:`IrregularityHistory`): the running system is the linear part, the creep forces
+    follow the varying wheel forces (T_j = N_j μ(s_j)) and the result reports N_j
+    (``wheel_force`` [N]); None: N = N0 throughout (module docstring).
 
     Example::
 
@@ -325,7 +304,7 @@ def nonlinear_response(model: BogieModel, op: OperatingPoint,
     """
     excitation = ShortCircuit() if excitation is None else excitation
     request = _check_inputs(model, op, t_end, fs, creep, anti_slip, outputs, strength, keep_states,
-                            substeps, excitation_scale)
+                            substeps, excitation_scale, irregularity)
     run = _set_up_run(model, op, excitation, request)
     histories = _step(run, request, checkpoint)
     return _pack_result(model, op, excitation, request, run, histories)
@@ -347,11 +326,13 @@ class _Request:
     n_points: int  # output samples (t = 0 included)
     n_steps: int  # integration steps
     h: float  # integration step [s]
+    irregularity: IrregularityHistory | None = None  # the rail–wheel deviations, if any
 
 
 def _check_inputs(model: BogieModel, op: OperatingPoint, t_end: float, fs: float, creep: str,
                   anti_slip: AntiSlip | None, outputs: list[str] | None, strength: float | None,
-                  keep_states: bool, substeps: int, excitation_scale: float) -> _Request:
+                  keep_states: bool, substeps: int, excitation_scale: float,
+                  irregularity: IrregularityHistory | None = None) -> _Request:
     """The arguments of :func:`nonlinear_response` checked (:class:`NonlinearError` with a one-line
     message otherwise) and the time grid: ``t_end`` [s], ``fs`` [Hz], ``strength`` [N m]."""
     if creep not in CREEP_MODELS:
@@ -380,10 +361,40 @@ def _check_inputs(model: BogieModel, op: OperatingPoint, t_end: float, fs: float
             or not math.isfinite(excitation_scale):
         raise NonlinearError(f"excitation_scale = {excitation_scale!r} must be a finite number")
     protection = anti_slip if anti_slip is not None and anti_slip.enabled else None
+    h = 1.0 / (fs * substeps)
+    _check_irregularity(model, irregularity, (n_points - 1) / fs, h)
     return _Request(creep=creep, protection=protection, strength=strength, keep_states=keep_states,
                     excitation_scale=excitation_scale, names=names, matrices=matrices, fs=fs,
                     substeps=substeps, n_points=n_points, n_steps=n_steps,
-                    h=1.0 / (fs * substeps))
+                    h=h, irregularity=irregularity)
+
+
+STEPS_PER_PERIOD = 20  # a harmonic irregularity needs at least this many steps per period
+
+
+def _check_irregularity(model: BogieModel, irregularity: IrregularityHistory | None,
+                        t_end: float, h: float) -> None:
+    """An irregularity history fits the run: its inputs are the model's
+    (:func:`irregularity_inputs`), a sampled one covers 0 … ``t_end`` [s], a harmonic one's
+    frequencies leave :data:`STEPS_PER_PERIOD` steps ``h`` [s] per period (the creep remainder
+    is held over a step)."""
+    if irregularity is None:
+        return
+    if not isinstance(irregularity, IrregularityHistory):
+        raise NonlinearError("irregularity must be an IrregularityHistory or None")
+    if tuple(irregularity.names) != irregularity_inputs(model):
+        raise NonlinearError(f"irregularity inputs {', '.join(irregularity.names)} are not the "
+                             f"model's: {', '.join(irregularity_inputs(model))}")
+    start, end = irregularity.span
+    if start > 0.0 or end < t_end * (1 - 1e-12):
+        raise NonlinearError(f"the irregularity history covers {start:g} … {end:g} s, not the run's "
+                             f"0 … {t_end:g} s")
+    if irregularity.is_harmonic:
+        f_max = float(irregularity.frequency.max())
+        if f_max * STEPS_PER_PERIOD * h > 1.0:
+            raise NonlinearError(f"irregularity frequency {f_max:g} Hz is too high for the step "
+                                 f"{h:g} s: at most {1.0 / (STEPS_PER_PERIOD * h):g} Hz (raise fs "
+                                 "or substeps)")
 
 
 @dataclass(frozen=True)
@@ -394,6 +405,8 @@ class _Run:
     law: PolachLaw  # the creep law at N0
     rims: list[str]  # contact names, in the order of the creep channels
     loads: list[str]  # the requested outputs formed in the loop (y = Re(V ζ)), in V's row order
+    system: LinearSystem  # the linear part: the bogie, or with irregularities the running system
+    irregularity: IrregularityLoop | None = None  # the irregularities' part of the loop
 
 
 def _excitation_increments(setup: _Setup, excitation: ShortCircuit, step: float, scale: float,
@@ -404,11 +417,11 @@ def _excitation_increments(setup: _Setup, excitation: ShortCircuit, step: float,
     u0, a, mu = excitation.terms(step)
     u0, a = u0 * scale, a * scale
     lam = setup.lam
-    phi1_step, _ = _phi12(lam * h)
+    phi1_step, _ = hold_weights(lam * h)
     inc_step = setup.beta_mc * u0 * h * phi1_step
     if excitation.M0 > 0 and scale != 0:
-        phi_p, _ = _phi12((mu - lam) * h)
-        phi_m, _ = _phi12((np.conj(mu) - lam) * h)
+        phi_p, _ = hold_weights((mu - lam) * h)
+        phi_m, _ = hold_weights((np.conj(mu) - lam) * h)
         cp = setup.beta_mc * 0.5 * a * setup.E * h * phi_p
         cm = setup.beta_mc * 0.5 * np.conj(a) * setup.E * h * phi_m
     else:
@@ -416,15 +429,14 @@ def _excitation_increments(setup: _Setup, excitation: ShortCircuit, step: float,
     return inc_step, cp, cm, complex(np.exp(mu * h))
 
 
-def _output_map(model: BogieModel, op: OperatingPoint, request: _Request,
-                setup: _Setup) -> tuple[list[str], np.ndarray]:
+def _output_map(request: _Request, setup: _Setup,
+                system: LinearSystem) -> tuple[list[str], np.ndarray]:
     """The requested outputs the loop forms (all but the creep forces and adhesion moments, which
     come from the contact velocities) and V (rows x m) with y = Re(V ζ) [their units]; with
     ``keep_states`` V also holds the states x = Re(X ζ) below them."""
     matrices = request.matrices
     loads = [name for name in request.names
              if not name.endswith(("creep_force", "adhesion_moment"))]
-    system = bogie_system(model, op)
     rows = [matrices.index(nm) for nm in loads]
     C = system.state_output(matrices.C_q[rows], matrices.C_v[rows]).reshape(len(loads), system.N)
     V = C @ setup.modal_to_state  # loads x m
@@ -438,7 +450,8 @@ def _set_up_run(model: BogieModel, op: OperatingPoint, excitation: ShortCircuit,
     """The run's step-loop inputs (modal increments of the excitation, creep law, anti-slip
     settings, output map, the stepper's block matrices) from the cached per-step set-up."""
     h = request.h
-    setup = _setup(model, op, h)
+    system = bogie_system(model, op) if request.irregularity is None else running_system(model, op)
+    setup = _setup(model, op, h, system)
     p = model.parameters
     law = creep_law(p, op.N0)
     coefficients = creep_coefficients(p, op)
@@ -449,7 +462,15 @@ def _set_up_run(model: BogieModel, op: OperatingPoint, excitation: ShortCircuit,
     # channels: the four contacts, then ID2's slope torque (not a detection signal)
     detect_rows = np.array([0.5 if rim.startswith("ID2.") else 0.0 for rim in rims] + [0.0])
     protection = request.protection
-    loads, V = _output_map(model, op, request, setup)
+    loads, V = _output_map(request, setup, system)
+    loop = wheel = None
+    if request.irregularity is not None:
+        scale = request.excitation_scale
+        loop = irregularity_loop(
+            model, op, system, request.irregularity, h, setup.modal_to_state, setup.E,
+            np.column_stack([creep_force_map(model), motor2_force(model)]),
+            model.short_circuit_force, lambda t: excitation.torque(t, step) * scale)
+        wheel = (loop.W, loop.D)
     inputs = StepInputs(
         h=h, E=setup.E, inc_step=inc_step, cp=cp, cm=cm, g_step=g_step, g0=complex(1.0),
         P0=setup.P0, p0_2=setup.p0_2, p1_2=setup.p1_2, contact_scale=max(op.s0 * op.v, 1e-3),
@@ -460,8 +481,9 @@ def _set_up_run(model: BogieModel, op: OperatingPoint, excitation: ShortCircuit,
         delay=protection.delay if protection else 0.0,
         rate=protection.rate if protection else 1.0,
         floor=protection.floor if protection else 0.0,
-        blocks=step_matrices(setup.W, setup.E, setup.P0, setup.P1, setup.D1, V, len(rims)))
-    return _Run(inputs=inputs, law=law, rims=rims, loads=loads)
+        blocks=step_matrices(setup.W, setup.E, setup.P0, setup.P1, setup.D1, V, len(rims), wheel),
+        irregularity=loop)
+    return _Run(inputs=inputs, law=law, rims=rims, loads=loads, system=system, irregularity=loop)
 
 
 @dataclass(frozen=True)
@@ -475,6 +497,8 @@ class _Histories:
     u2: np.ndarray  # samples: ΔM_2, the reduction of ID2's motor torque M(s0, v) [N m]
     detection: float | None  # when the protection detected the slip [s] (None: never)
     iterations: int  # Newton iterations summed over the steps
+    wheel: np.ndarray | None = None  # samples x contacts: wheel-force changes ΔN [N]
+    # (irregularities only)
 
 
 def _step(run: _Run, request: _Request, checkpoint: Callable[[], None] | None) -> _Histories:
@@ -501,6 +525,11 @@ def _step(run: _Run, request: _Request, checkpoint: Callable[[], None] | None) -
     z_out = np.empty((block, nc))
     phi_out = np.empty((block, nc))
     u2_out = np.empty(block)
+    wheel_hist = wheel_out = None
+    if run.irregularity is not None:  # ΔN at t = 0 (Δq = 0): the deviations' own terms
+        wheel_hist = np.zeros((n_points, len(run.rims)))
+        wheel_hist[0] = run.irregularity.at(np.zeros(1))[0]
+        wheel_out = np.empty((block, len(run.rims)))
     u2_now = 0.0
     k = 0
     while k < n_steps:
@@ -508,7 +537,7 @@ def _step(run: _Run, request: _Request, checkpoint: Callable[[], None] | None) -
             checkpoint()
         k1 = min(n_steps, k + block)
         status = march(k, k1, inputs, zeta, phi, z, u2_now, det_state, Y_out, z_out, phi_out,
-                       u2_out, iterations)
+                       u2_out, iterations, wheel_out)
         if status < 0:
             raise NonlinearError(f"the creep-force iteration did not converge at t = "
                                  f"{-status * h:.6g} s")
@@ -519,24 +548,37 @@ def _step(run: _Run, request: _Request, checkpoint: Callable[[], None] | None) -
         z_hist[samples] = z_out[sel]
         r_hist[samples] = phi_out[sel]
         u2_hist[samples] = u2_out[sel]
+        if wheel_out is not None:
+            _check_contact(wheel_out[:k1 - k], inputs.N0, run.rims, k, h)
+            wheel_hist[samples] = wheel_out[sel]
         k = k1
     detection = float(det_state[0]) if det_state[0] >= 0 else None
     return _Histories(Y=Y, z=z_hist, r=r_hist, u2=u2_hist, detection=detection,
-                      iterations=int(iterations[0]))
+                      iterations=int(iterations[0]), wheel=wheel_hist)
 
 
-def _with_free_velocity(model: BogieModel, op: OperatingPoint, states: np.ndarray,
+def _check_contact(wheel: np.ndarray, N0: float, rims: list[str], k: int, h: float) -> None:
+    """Every wheel force N0 + ΔN of a block's steps (steps k+1 …, step h [s]) stays positive: the
+    track's spring is linear and T = N μ has no meaning once a wheel would pull on the rail, so
+    a run in which a wheel lifts ends with a one-line :class:`NonlinearError`."""
+    lowest = np.unravel_index(int(np.argmin(wheel)), wheel.shape)
+    if N0 + wheel[lowest] <= 0.0:
+        raise NonlinearError(f"the wheel force of {rims[lowest[1]]} falls to "
+                             f"{N0 + wheel[lowest]:.4g} N at t = {(k + lowest[0] + 1) * h:.6g} s: "
+                             "a wheel lifting off the rail is not modelled")
+
+
+def _with_free_velocity(system: LinearSystem, forces: np.ndarray, states: np.ndarray,
                         inputs: np.ndarray, t: np.ndarray) -> np.ndarray:
     """The sampled states (samples x N, the modal part the loop forms) with the vehicle's rolling
     velocity added: no damping meets it, so it is deflated with the rigid-body modes and the loop
     does not carry it, but it holds kinetic energy.  Its rate is the deflated row of
     ``A x + b u`` (it depends on the other states and the inputs only), integrated by the
     trapezoidal rule over the samples [s] (second order in 1/fs).  ``inputs``: M_C, ID2's motor
-    torque change and the contacts' remainder forces (samples x 2 + contacts) [N m, N]."""
-    system = bogie_system(model, op)
+    torque change and the contacts' remainder forces (samples x 2 + contacts) [N m, N], with
+    irregularities also their (Δ, Δ̇, Δ̈) [m, m/s, m/s²]; ``forces``: their generalized forces
+    (n x inputs); ``system``: the run's linear part."""
     deflation = system.deflation
-    forces = np.column_stack([model.short_circuit_force, motor2_force(model),
-                              creep_force_map(model)])
     rates = deflation.to_deflated(system.A @ states.T + system.input_map(forces) @ inputs.T)
     free = np.arange(system.R.shape[1], system.rigid_count)
     velocity = np.zeros((len(t), len(free)))
@@ -563,16 +605,18 @@ def _limits(p: Parameters, op: OperatingPoint, mu_max: float,
 
 
 def _totals(model: BogieModel, op: OperatingPoint, request: _Request, run: _Run, Y: np.ndarray,
-            creep_total: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, str], dict[str, float]]:
-    """The requested outputs as totals (pre-fault value + Δy; the creep forces N0 μ [N] and the
-    wheelsets' adhesion moments r0 Σ N0 μ [N m] from ``creep_total``, samples x contacts: μ [-]),
-    in the requested order, with their units and pre-fault values."""
+            creep_total: np.ndarray, wheel_force: np.ndarray | None = None
+            ) -> tuple[dict[str, np.ndarray], dict[str, str], dict[str, float]]:
+    """The requested outputs as totals (pre-fault value + Δy; the creep forces N μ [N] and the
+    wheelsets' adhesion moments r0 Σ N μ [N m] from ``creep_total``, samples x contacts: μ [-],
+    with N = ``wheel_force`` (samples x contacts) [N] or N0), in the requested order, with their
+    units and pre-fault values."""
     matrices, names, rims = request.matrices, request.names, run.rims
     totals, units, steady = {}, {}, {}
     for j, name in enumerate(run.loads):
         i = matrices.index(name)
         totals[name] = Y[:, j] + matrices.steady[i]
-    forces = op.N0 * creep_total  # N x contacts, totals
+    forces = (op.N0 if wheel_force is None else wheel_force) * creep_total  # totals [N]
     r0 = model.parameters["wheel_radius"]
     for i, rim in enumerate(rims):
         totals_name = f"{rim}.creep_force"
@@ -606,7 +650,12 @@ def _pack_result(model: BogieModel, op: OperatingPoint, excitation: ShortCircuit
         inputs_hist = np.column_stack([excitation.torque(t, inputs.M_step)
                                        * request.excitation_scale,
                                        u2_hist + r_hist[:, -1], r_hist[:, :-1]])
-        X_hist = _with_free_velocity(model, op, Y[:, len(run.loads):], inputs_hist, t)
+        forces = np.column_stack([model.short_circuit_force, motor2_force(model),
+                                  creep_force_map(model)])
+        if run.irregularity is not None:
+            forces = np.column_stack([forces, force_columns(model, op)])
+            inputs_hist = np.column_stack([inputs_hist, run.irregularity.inputs(t)])
+        X_hist = _with_free_velocity(run.system, forces, Y[:, len(run.loads):], inputs_hist, t)
     if not np.all(np.isfinite(Y)) or not np.all(np.isfinite(z_hist)):
         raise NonlinearError("the nonlinear response is not finite")
     slope_torque, slope_cut = z_hist[:, -1], r_hist[:, -1]
@@ -614,7 +663,8 @@ def _pack_result(model: BogieModel, op: OperatingPoint, excitation: ShortCircuit
     creep_total = np.asarray(law.mu(op.s0 + z_hist / op.v, op.v)) if request.creep == "nonlinear" \
         else mu_s0 + dmu_s0 * z_hist / op.v
     _, mu_max = law.maximum(op.v)
-    outputs_total, units, steady = _totals(model, op, request, run, Y, creep_total)
+    wheel = None if histories.wheel is None else op.N0 + histories.wheel  # N_j [N]
+    outputs_total, units, steady = _totals(model, op, request, run, Y, creep_total, wheel)
     M_C = excitation.torque(t, step) * request.excitation_scale
     motor = {"ID1.motor.torque": step + M_C,
              "ID2.motor.torque": step + slope_torque + u2_hist + slope_cut}
@@ -635,4 +685,6 @@ def _pack_result(model: BogieModel, op: OperatingPoint, excitation: ShortCircuit
         action_time=None if detection is None else detection + inputs.delay, motor_torque=step,
         mu_max=float(mu_max), newton_iterations=float(histories.iterations) / max(request.n_steps, 1),
         torque_reduction=u2_hist + slope_cut,
-        contact_velocity=z_hist, remainder_force=r_hist, states=X_hist)
+        contact_velocity=z_hist, remainder_force=r_hist, states=X_hist,
+        irregularity=request.irregularity,
+        wheel_force=None if wheel is None else {rim: wheel[:, i] for i, rim in enumerate(rims)})
