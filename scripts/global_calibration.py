@@ -1,9 +1,10 @@
 """The numbers, tables and figure of docs/validation.md's "Global calibration" from a stored run
 of ``bogie calibrate --starts N --json`` (the search takes tens of minutes; its output is kept
-in ``assets/data/``), and the comparison of its best set with the bundled one.
+in ``assets/data/``), and the comparison of the bundled set (start 0, the search's best) with
+the best of the Sobol' starts.
 
     bogie calibrate --starts 16 --from assets/parameters/calibration_start.toml \\
-        --divergence-weight 10 --out assets/parameters/global_best.toml \\
+        --divergence-weight 10 --out global_best.toml \\
         --json > assets/data/global_calibration_n16.json
     .venv/bin/python scripts/global_calibration.py      # docs/results/global_calibration.json,
                                                         # assets/figures/global_calibration_front.png
@@ -25,10 +26,20 @@ from docs_numbers import write_results  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
 
 from model import load_parameters  # noqa: E402
-from model.studies.calibration import PHASES, stage_j_cost, with_divergence_weight  # noqa: E402
+from model.studies.calibration import (  # noqa: E402
+    PHASES,
+    calibrated_set,
+    stage_j_cost,
+    with_divergence_weight,
+)
 from model.studies.calibration_bounds import SEARCH_PARAMETERS  # noqa: E402
 from model.studies.calibration_targets import TABLE1_IM_HZ, evaluate  # noqa: E402
-from model.studies.global_calibration import StartResult, spread, target_measures  # noqa: E402
+from model.studies.global_calibration import (  # noqa: E402
+    StartResult,
+    ranking_key,
+    spread,
+    target_measures,
+)
 
 RUN = ROOT / "assets" / "data" / "global_calibration_n16.json"
 START = ROOT / "assets" / "parameters" / "calibration_start.toml"  # the search's start 0 and prior
@@ -61,36 +72,51 @@ def spread_block(run: dict) -> str:
     return "\n".join(lines)
 
 
+def best_sobol_start(run: dict) -> dict:
+    """The best of the Sobol' starts (1 … N) by the search's own rule (ranking_key)."""
+    done = [StartResult(r["index"], r["start"], r["values"], r["cost"], r["frequency_error"],
+                        r["ranks_within_5_percent"], r["characters"], r["largest_real_at_0.014"],
+                        r["divergence_error"], r["seconds"])
+            for r in run["results"] if r["index"] > 0 and not r["failed"]]
+    index = min(done, key=ranking_key).index
+    return next(r for r in run["results"] if r["index"] == index)
+
+
 def comparison(run: dict) -> dict:
+    """The bundled set (start 0) against the best Sobol' start, target by target."""
     bundled = load_parameters()
     prior = load_parameters(START)
     weights = with_divergence_weight(PHASES, run.get("divergence_weight", 1.0))[-1][1]
+    other = best_sobol_start(run)
     with threadpool_limits(1):
         rows = evaluate(bundled)
+        other_rows = evaluate(calibrated_set(other["values"], prior))
         cost = stage_j_cost(bundled, prior, weights, clip=False)
-    best = next(r for r in run["results"] if r["index"] == run["best"])
-    measures = target_measures(rows)
-    bundled_rows = {row.name.split(" [")[0].replace(" OTHER CHARACTER:", ""): row for row in rows}
-    best_rows = {row["name"].split(" [")[0].replace(" OTHER CHARACTER:", ""): row
-                 for row in run["targets"]}
-    table = ["| target | published | bundled set | global best |", "|---|---|---|---|"]
-    for name, row in bundled_rows.items():
-        other = best_rows.get(name)
-        if other is None:
+
+    def by_name(rows):
+        return {row.name.split(" [")[0].replace(" OTHER CHARACTER:", ""): row for row in rows}
+
+    others = by_name(other_rows)
+    table = ["| target | published | bundled set (start 0) | best Sobol' start |",
+             "|---|---|---|---|"]
+    for name, row in by_name(rows).items():
+        if name not in others:
             continue
         table.append(f"| {name} | {row.target:.5g} | {row.achieved:.5g} ({100 * row.error:+.1f} %) | "
-                     f"{other['achieved']:.5g} ({100 * other['error']:+.1f} %) |")
+                     f"{others[name].achieved:.5g} ({100 * others[name].error:+.1f} %) |")
     on_bound = {}
-    for label, values in (("bundled", bundled.values), ("best", best["values"])):
+    for label, values in (("bundled", bundled.values), ("other", other["values"])):
         on_bound[label] = [f.name for f in SEARCH_PARAMETERS if f.on_bound(values[f.name])
                            or not f.low <= values[f.name] <= f.high]
-    return {"bundled": {"cost": cost, **measures, "outside_or_on_bound": on_bound["bundled"]},
-            "best": {"cost": best["cost"], "frequency_error": best["frequency_error"],
-                     "ranks_within": best["ranks_within_5_percent"],
-                     "characters": best["characters"],
-                     "largest_real_unstable": best["largest_real_at_0.014"],
-                     "divergence_error": best["divergence_error"],
-                     "outside_or_on_bound": on_bound["best"]},
+    return {"bundled": {"cost": cost, **target_measures(rows),
+                        "outside_or_on_bound": on_bound["bundled"]},
+            "best_sobol": {"index": other["index"], "cost": other["cost"],
+                           "frequency_error": other["frequency_error"],
+                           "ranks_within": other["ranks_within_5_percent"],
+                           "characters": other["characters"],
+                           "largest_real_unstable": other["largest_real_at_0.014"],
+                           "divergence_error": other["divergence_error"],
+                           "outside_or_on_bound": on_bound["other"]},
             "block": "\n".join(table)}
 
 

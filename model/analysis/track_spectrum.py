@@ -50,7 +50,7 @@ from model.analysis.frequency_response import (
     output_indices,
     resonance_grid,
 )
-from model.analysis.wheel_excitation import WheelTransfer
+from model.analysis.wheel_excitation import ModalWheels
 from model.mechanics.assembly import BogieModel
 from model.mechanics.operating_point import OperatingPoint
 
@@ -150,13 +150,13 @@ def random_response(model: BogieModel, op: OperatingPoint, spectrum: TrackSpectr
     lam = running_system(model, op).eigen[0]
     grid = resonance_grid(lam, f_lo, f_hi, points)
     matrices, rows = output_indices(model, op, outputs)
-    system = WheelTransfer(model, op, rows)
-    transfer = np.column_stack([system.combined(float(f))[0] for f in grid])
+    system = ModalWheels(model, op, rows)
+    transfer = system.combined(grid)
     g = spectrum.temporal(grid, op.v)
     psd = g[None, :] * np.abs(transfer) ** 2
 
     def integrand(f: float) -> np.ndarray:
-        value = spectrum.temporal(f, op.v) * np.abs(system.combined(float(f))[0]) ** 2
+        value = spectrum.temporal(f, op.v) * np.abs(system.combined(f)[:, 0]) ** 2
         return np.concatenate([value, f * value, f * f * value, f ** 4 * value])
 
     upper = lam[lam.imag > 0].imag / (2 * math.pi)

@@ -86,6 +86,46 @@ class WheelTransfer:
         return self.wheels(f_hz) @ np.exp(1j * phases), phases
 
 
+class ModalWheels:
+    """Σ_j H_j(2π f) e^(i φ_j) at many frequencies from the running system's modal form (the
+    cached eigendecomposition: a few microseconds a frequency, against a dense solve of the
+    dynamic stiffness each), each wheel's H_j as
+    :func:`model.analysis.frequency_response.irregularity_transfer` forms it; where the modal
+    sum's rounding estimate exceeds ``MODAL_TOLERANCE`` of an output's scale, those frequencies
+    are solved directly (:class:`WheelTransfer`), as the frequency response does.  The scale is
+    each output's largest value on the first frequencies asked (a caller's grid over its band;
+    later calls, one frequency each, are judged against it)."""
+
+    def __init__(self, model: BogieModel, op: OperatingPoint, rows: np.ndarray | None = None):
+        from model.analysis.frequency_response import irregularity_transfer
+        from model.mechanics.irregularity import irregularity_inputs
+
+        matrices, all_rows = output_indices(model, op)
+        rows = all_rows if rows is None else rows
+        self.model, self.op = model, op
+        self.transfers = [irregularity_transfer(model, op, name, matrices, rows)
+                          for name in irregularity_inputs(model)]
+        self.direct = WheelTransfer(model, op, rows)
+        self.direct_points = 0  # frequencies solved directly so far
+        self.scale: np.ndarray | None = None  # (p, 1) each output's largest |Σ H_j e^(iφ_j)|
+
+    def combined(self, f_hz) -> np.ndarray:
+        """Σ_j H_j(2π f) e^(i φ_j) (p x F complex) [output unit per m] at ``f_hz`` [Hz] (> 0)."""
+        from model.analysis.frequency_response import MODAL_TOLERANCE
+
+        f = np.atleast_1d(np.asarray(f_hz, dtype=float))
+        x = np.array([self.model.positions[rim][0] for rim in self.model.rims])
+        phases = -2 * math.pi * f[None, :] * (x.max() - x)[:, None] / self.op.v  # 4 x F
+        H = sum(t(f) * np.exp(1j * phases[j])[None, :] for j, t in enumerate(self.transfers))
+        estimate = sum(t.rounding_estimate(f) for t in self.transfers)
+        if self.scale is None:
+            self.scale = np.abs(H).max(axis=1, keepdims=True)
+        for k in np.flatnonzero(np.any(estimate > MODAL_TOLERANCE * self.scale, axis=0)):
+            H[:, k] = self.direct.combined(float(f[k]))[0]
+            self.direct_points += 1
+        return H
+
+
 def wheel_responses(model: BogieModel, op: OperatingPoint, f_hz: float,
                     rows: np.ndarray | None = None) -> np.ndarray:
     """H_j(2π f) of the chosen output rows (default all) from each wheel's deviation [output unit

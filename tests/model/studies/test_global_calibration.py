@@ -45,8 +45,9 @@ def test_log_parameters_are_spread_log_uniformly():
             assert (values[f.name] - f.low) / (f.high - f.low) == pytest.approx(ui)
 
 
-def _result(index, cost, frequency, divergence, values=None):
-    return gc.StartResult(index, {}, values or {}, cost, frequency, 0, 0, 7.0, divergence, 1.0)
+def _result(index, cost, frequency, divergence, values=None, ranks=0):
+    return gc.StartResult(index, {}, values or {}, cost, frequency, ranks, 0, 7.0, divergence,
+                          1.0)
 
 
 def test_front_keeps_the_starts_no_other_beats_in_both_errors():
@@ -79,26 +80,31 @@ def test_spread_over_the_best_quarter_as_a_share_of_the_bounds():
     assert not rows[middle.name].on_bound
 
 
-def test_global_search_runs_every_start_and_picks_the_lowest_cost(monkeypatch):
-    """Stubbed least squares: the search maps every start, orders them by index, picks the
-    lowest cost (ties: the lowest index) and reports its front and spread."""
-    costs = {0: 3.0, 1: 1.0, 2: 1.0, 3: 2.0}
+def test_global_search_runs_every_start_and_ranks_them_by_the_rule(monkeypatch):
+    """Stubbed least squares: the search maps every start, orders them by index and picks the
+    best by the rule: the divergence within 10 % first, then the most ranks within 5 %, then the
+    smaller largest frequency error, then the cost (start 3 has the lowest cost but misses the
+    divergence; 1 and 2 tie in ranks, 2 has the smaller error); it reports the front and spread."""
+    starts = {0: (3.0, 0.20, 0.05, 6), 1: (2.0, 0.10, 0.08, 8), 2: (2.5, 0.08, 0.02, 8),
+              3: (1.0, 0.04, 0.50, 10)}  # cost, frequency error, divergence error, ranks
     values = {g.name: g.low for g in SEARCH_PARAMETERS}
 
     def fake(k, start_file=None, phases=None):
-        return _result(k, costs[k], 0.1 * k, 0.4 - 0.1 * k, values)
+        cost, frequency, divergence, ranks = starts[k]
+        return _result(k, cost, frequency, divergence, values, ranks)
 
     monkeypatch.setattr(gc, "run_start", fake)
     seen = []
     result = gc.global_search(3, serial_map_unordered, progress=lambda r: seen.append(r.index))
     assert seen == [0, 1, 2, 3]
     assert [r.index for r in result.results] == [0, 1, 2, 3]
-    assert result.best == 1
-    assert result.front == [0, 1, 2, 3]
+    assert result.best == 2
+    assert result.front == [2, 3]
+    assert [r.index for r in gc.best_starts(result.results)] == [2, 1, 0, 3]
     assert len(result.spread) == len(SEARCH_PARAMETERS)
     data = result.as_dict()
     assert data["starts"] == 3  # the Sobol' starts 1 … 3 beside start 0, the start file's
-    assert data["best"] == 1
+    assert data["best"] == 2
     with pytest.raises(ValueError, match="starts"):
         gc.global_search(0, serial_map_unordered)
 
