@@ -82,6 +82,14 @@ def best_sobol_start(run: dict) -> dict:
     return next(r for r in run["results"] if r["index"] == index)
 
 
+def lowest_cost(run: dict) -> dict:
+    """The start stage J's cost alone would rank first."""
+    r = min((r for r in run["results"] if not r["failed"]), key=lambda r: r["cost"])
+    return {"index": r["index"], "cost": r["cost"], "ranks_within": r["ranks_within_5_percent"],
+            "frequency_error": r["frequency_error"],
+            "divergence_error": r["divergence_error"]}
+
+
 def comparison(run: dict) -> dict:
     """The bundled set (start 0) against the best Sobol' start, target by target."""
     bundled = load_parameters()
@@ -181,6 +189,7 @@ def main() -> None:
             "held_on_bound": held, "held_count": len(held),
             "parameters": len(run["spread"]), "front_count": len(run["front"]),
             "best_start": {k: best[k] for k in best if k not in ("start", "values")},
+            "lowest_cost": lowest_cost(run),
             "comparison": {k: v for k, v in compared.items() if k != "block"},
             "ranks_published": len(TABLE1_IM_HZ),
             "blocks": {"starts": starts_block(run), "spread": spread_block(run),
