@@ -116,7 +116,7 @@ def register(subparsers) -> None:
     running = p.add_argument_group("running (mean traction, ripple, wheel polygon, random track)")
     running.add_argument("--running", action=argparse.BooleanOptionalAction, default=None,
                          help="the running load case (docs/assessment.md): one of the default "
-                              "cases; --no-running leaves it out (≈ 20 s less)")
+                              "cases; --no-running leaves it out (seconds less)")
     running.add_argument("--running-s0", default="0.002,0.005", metavar="LIST",
                          help="creepages of the running case (default %(default)s)")
     running.add_argument("--running-v", default="20:200:10", metavar="LIST",

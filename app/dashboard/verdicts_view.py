@@ -10,7 +10,7 @@ and started once that state's follow-ups (dense root locus, s0*(v)) have ended, 
 outcome, and the state has stayed for a moment (:data:`VERDICT_QUIET_MS`); it takes a few
 seconds (the short-circuit case's grid over every fault instant, the ripple case's speed sweep),
 so the indicator says "computing" meanwhile.  The "running case" checkbox adds the running load
-case (``bogie assess``'s running defaults, about 20 s) to the same assessment.
+case (``bogie assess``'s running defaults; seconds of work) to the same assessment.
 
 Once a verdict is shown and the tab is open, each shaft section's fatigue life over the bundled route
 (:mod:`app.results.life`, 25 s to 2 min) is computed in a background worker process, its thread
@@ -60,7 +60,7 @@ COLUMNS = {"component": TEXT, "check": TEXT, "load case": TEXT, "load [kN m]": N
            "capacity [kN m]": NUMBER, "safety factor": NUMBER, "band 5–95 %": TEXT,
            "required": NUMBER, "verdict": TEXT, "life [km]": TEXT, "where": TEXT, "note": TEXT}
 PENDING = "computing…"  # a fatigue row's life while it is computed
-RUNNING_LABEL = "running case (track, wheels, ripple; ≈ 20 s)"
+RUNNING_LABEL = "running case (track, wheels, ripple; adds seconds)"
 _LIFE_VIEWS: weakref.WeakSet = weakref.WeakSet()  # the views that may want a route life
 
 

@@ -94,7 +94,9 @@ def test_life_cells_show_the_life_computed(app_server, chromium, tmp_path):
         # the running case, on request
         label = page.evaluate("""() => [...Bokeh.documents[0].all_models].find(
             m => (m.css_classes || []).includes('ctl-verdict-running')).label""")
-        assert label == "running case (track, wheels, ripple; ≈ 20 s)"
+        from app.dashboard.verdicts_view import RUNNING_LABEL
+
+        assert label == RUNNING_LABEL
         page.locator(".ctl-verdict-running input").check()
         until(lambda: any(r["load case"] == "running" for r in view.rows),
                "the running case's checks", LIFE_WAIT_S)
