@@ -15,13 +15,16 @@ from model.studies.calibration_bounds import SEARCH_PARAMETERS
 
 @pytest.fixture
 def stubbed(monkeypatch):
-    """run_start and write_start without the least squares: start k costs (k − 1)² + 1."""
+    """run_start and write_start without the least squares: every start meets the divergence,
+    start k has 10 − |k − 1| ranks within 5 % (start 1 is the best by the rule) and costs
+    (k − 1)² + 1."""
     values = {f.name: f.low for f in SEARCH_PARAMETERS}
     written = []
 
     def fake_start(k, start_file=None, phases=None, progress=None):
-        return gc.StartResult(k, gc.start_values(k), values, float((k - 1) ** 2 + 1), 0.1 * k,
-                              10 - k, 10, 7.0 + k, k / 7.031, 0.5)
+        return gc.StartResult(k, gc.start_values(k), values, float((k - 1) ** 2 + 1),
+                              0.01 + 0.1 * abs(k - 1), 10 - abs(k - 1), 10, 7.0 + 0.1 * k,
+                              0.02 * k, 0.5)
 
     def fake_write(result, out, start_file=None, divergence_weight=None):
         out.write_text(f"start {result.index}\n", encoding="utf-8")
@@ -40,9 +43,9 @@ def test_starts_serial_writes_the_best_start_and_reports_every_start(capsys, tmp
     assert code == 0, err
     data = json.loads(stdout)
     assert data["starts"] == 3
-    assert data["best"] == 1  # cost (k − 1)² + 1
+    assert data["best"] == 1  # the most ranks within 5 %
     assert [r["index"] for r in data["results"]] == [0, 1, 2, 3]  # start 0: the file's values
-    assert data["front"] == [0]  # the smallest frequency and divergence errors
+    assert data["front"] == [0, 1]  # the smallest divergence and frequency errors
     assert {row["name"] for row in data["spread"]} == {f.name for f in SEARCH_PARAMETERS}
     assert out.read_text(encoding="utf-8") == "start 1\n"
     assert stubbed == [1]
