@@ -72,13 +72,20 @@ def spread_block(run: dict) -> str:
     return "\n".join(lines)
 
 
-def best_sobol_start(run: dict) -> dict:
+def start_results(run: dict) -> list[StartResult]:
+    """The stored starts as the search's results (a failed start's missing numbers: inf, nan)."""
+    return [StartResult(r["index"], r["start"], r["values"],
+                        math.inf if r["cost"] is None else r["cost"],
+                        math.inf if r["frequency_error"] is None else r["frequency_error"],
+                        r["ranks_within_5_percent"], r["characters"],
+                        math.nan if r["largest_real_at_0.014"] is None else r["largest_real_at_0.014"],
+                        math.inf if r["divergence_error"] is None else r["divergence_error"],
+                        r["seconds"], r["failed"]) for r in run["results"]]
+
+
+def best_sobol_start(run: dict, starts: list[StartResult]) -> dict:
     """The best of the Sobol' starts (1 … N) by the search's own rule (ranking_key)."""
-    done = [StartResult(r["index"], r["start"], r["values"], r["cost"], r["frequency_error"],
-                        r["ranks_within_5_percent"], r["characters"], r["largest_real_at_0.014"],
-                        r["divergence_error"], r["seconds"])
-            for r in run["results"] if r["index"] > 0 and not r["failed"]]
-    index = min(done, key=ranking_key).index
+    index = min((s for s in starts if s.index > 0 and not s.failed), key=ranking_key).index
     return next(r for r in run["results"] if r["index"] == index)
 
 
@@ -90,12 +97,12 @@ def lowest_cost(run: dict) -> dict:
             "divergence_error": r["divergence_error"]}
 
 
-def comparison(run: dict) -> dict:
+def comparison(run: dict, starts: list[StartResult]) -> dict:
     """The bundled set (start 0) against the best Sobol' start, target by target."""
     bundled = load_parameters()
     prior = load_parameters(START)
     weights = with_divergence_weight(PHASES, run.get("divergence_weight", 1.0))[-1][1]
-    other = best_sobol_start(run)
+    other = best_sobol_start(run, starts)
     with threadpool_limits(1):
         rows = evaluate(bundled)
         other_rows = evaluate(calibrated_set(other["values"], prior))
@@ -164,16 +171,10 @@ def main() -> None:
     run = json.loads(Path(args.run).read_text(encoding="utf-8"))
     # the spread by the module's rule as it stands (a parameter held on a bound by every best
     # start is not identified), from the stored starts
-    starts = [StartResult(r["index"], r["start"], r["values"],
-                          math.inf if r["cost"] is None else r["cost"],
-                          math.inf if r["frequency_error"] is None else r["frequency_error"],
-                          r["ranks_within_5_percent"], r["characters"],
-                          math.nan if r["largest_real_at_0.014"] is None else r["largest_real_at_0.014"],
-                          math.inf if r["divergence_error"] is None else r["divergence_error"],
-                          r["seconds"], r["failed"]) for r in run["results"]]
+    starts = start_results(run)
     run["spread"] = [{"name": s.name, "low": s.low, "high": s.high, "share": s.share,
                       "identified": s.identified, "on_bound": s.on_bound} for s in spread(starts)]
-    compared = comparison(run)
+    compared = comparison(run, starts)
     best = next(r for r in run["results"] if r["index"] == run["best"])
     identified = [s["name"] for s in run["spread"] if s["identified"]]
     held = [s["name"] for s in run["spread"] if s["on_bound"]]

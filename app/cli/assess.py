@@ -175,7 +175,7 @@ def options_from_args(args: argparse.Namespace):
         raise UsageError(f"--ripple: {error}") from None
     ripple_v = [x * KMH for x in quantity_values(args.ripple_v, "v", increasing=True,
                                                  option="--ripple-v")]
-    running = {"cases": LOAD_CASES}
+    running = {}
     if with_running(args):
         from model.analysis.wheel_excitation import parse_polygon
 
@@ -264,7 +264,7 @@ def cmd_assess(args: argparse.Namespace) -> None:
             raise UsageError(f"--{name.replace('_', '-')} needs --samples")
     with study_engine(args, "assess") as (mapper, where):
         print(f"assess: short_circuit ({len(options.s0) * len(options.v)} point(s) on {where}), "
-              f"unstable_adhesion, starting, ripple{', running' if with_running(args) else ''} …",
+              f"unstable_adhesion, starting, ripple{', running' if 'running' in options.cases else ''} …",
               file=sys.stderr)
         result = assess(parameters, options, mapper, ProgressBar("assess: short_circuit",
                                                                  unit="points"))

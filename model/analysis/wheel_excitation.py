@@ -114,8 +114,7 @@ class ModalWheels:
         from model.analysis.frequency_response import MODAL_TOLERANCE
 
         f = np.atleast_1d(np.asarray(f_hz, dtype=float))
-        x = np.array([self.model.positions[rim][0] for rim in self.model.rims])
-        phases = -2 * math.pi * f[None, :] * (x.max() - x)[:, None] / self.op.v  # 4 x F
+        phases = wheel_phases(self.model, 2 * math.pi * f[:, None], self.op.v).T  # 4 x F
         H = sum(t(f) * np.exp(1j * phases[j])[None, :] for j, t in enumerate(self.transfers))
         estimate = sum(t.rounding_estimate(f) for t in self.transfers)
         if self.scale is None:
