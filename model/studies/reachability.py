@@ -37,7 +37,7 @@ Plain dataclasses; numpy/scipy only.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import brentq
@@ -466,8 +466,6 @@ class WheelsetModel:
     def with_longitudinal_at(self, frequency_hz: float, b11: float) -> WheelsetModel:
         """The same wheelset with the guide stiffness k_x that puts the longitudinal mode at
         ``frequency_hz`` with the creep damper b11 (k_x may leave its bounds: the caller checks)."""
-        from dataclasses import replace
-
         def error(log_k: float) -> float:
             trial = replace(self, guide_stiffness=math.exp(log_k))
             return trial.longitudinal(b11).imag / (2 * math.pi) - frequency_hz
@@ -487,7 +485,6 @@ def _clamped_drive(parameters: Parameters, b11: float | None = None):
     op = reference_point(parameters, S0_STABLE)
     coefficients = creep_coefficients(parameters, op)
     if b11 is not None:
-        from dataclasses import replace
         coefficients = replace(coefficients, b11=b11)
     B = model.B + creep_damping(model, coefficients)  # ID1: no motor slope
     keep = [i for i, name in enumerate(model.dofs.names) if name.startswith("ID1.")]
@@ -525,7 +522,7 @@ def wheelset_model(parameters: Parameters) -> WheelsetModel:
     and yaw modes are then the undamped √(K_x/m), √(K_ψ/I))."""
     from model.mechanics.operating_point import kalker
 
-    _, _, _, names, model = _clamped_drive(parameters)
+    model = _clamped_drive(parameters)[4]
     full = model.dofs.names
     rigid = {"x": np.zeros(len(full)), "rz": np.zeros(len(full)), "ry": np.zeros(len(full))}
     for i, name in enumerate(full):
@@ -541,17 +538,17 @@ def wheelset_model(parameters: Parameters) -> WheelsetModel:
         full.index("ID1.ax13.ry"), spin_column]
     drive = np.where(rigid["ry"] > 0, 0.0, spin)
     drive[[i for i, name in enumerate(full) if not name.startswith("ID1.")]] = 0.0
-    m, I, Jw, J1 = (float(r @ model.M @ r) for r in (rigid["x"], rigid["rz"], rigid["ry"], drive))
+    m, I_yaw, Jw, J1 = (float(r @ model.M @ r)
+                        for r in (rigid["x"], rigid["rz"], rigid["ry"], drive))
     p = parameters
     b33 = kalker(p, p["wheel_force"]).f33 / V_REF
-    base = WheelsetModel(m, I, Jw, J1, p["primary_stiffness_x"], p["journal_half_distance"],
+    base = WheelsetModel(m, I_yaw, Jw, J1, p["primary_stiffness_x"], p["journal_half_distance"],
                          p["contact_half_distance"], p["wheel_radius"],
                          p["disc_clutch_torsional_stiffness"], spin_creep=b33)
     free = _clamped_modes(parameters, b11=0.0)
     wx, wz = abs(free["longitudinal"]), abs(free["yaw"])
-    from dataclasses import replace
     return replace(base, drive_share_x=m * wx**2 - 2 * base.guide_stiffness,
-                   drive_share_yaw=I * wz**2 - base.stiffness_yaw)
+                   drive_share_yaw=I_yaw * wz**2 - base.stiffness_yaw)
 
 
 @dataclass(frozen=True)
@@ -604,18 +601,20 @@ class YawProof:
     wheelset: WheelsetModel  # the set's, as identified
     creep: list[CreepSlopes]  # the creep shapes scanned (met and not)
     cases: list[WheelsetCase]
-    inertia_ratio_needed: tuple[float, float]  # I/J_eff the study's yaw real parts and its
-    # divergence need, for ranks 9 and 10, at the creep laws' largest R (single-DOF yaw, no
-    # other yaw damping; more damping or a smaller R needs a larger ratio)
+    inertia_ratio_needed: dict  # Table 1 row (9, 10) -> (least, largest) I/J_eff that the
+    # study's yaw real parts at both creepages and its divergence need, over the R of the creep
+    # laws that meet the operating data (:func:`key_inequality_ratio`)
 
     def best(self, cap_hz: float, yaw_re_within_acceptance: bool = False,
-             exact_divergence: bool = False) -> WheelsetCase:
+             exact_divergence: bool = False, max_spin_inertia: float = math.inf) -> WheelsetCase:
         """The case with the highest yaw frequency at 0.005 among those with the longitudinal
         mode at ``cap_hz`` [Hz] and k_x within its bounds (and, if asked, its yaw real part at
-        0.005 within the acceptance, its divergence the published one)."""
+        0.005 within the acceptance, its divergence the published one, its J_w at most
+        ``max_spin_inertia`` [kg m^2])."""
         return max((c for c in self.cases if c.longitudinal_cap_hz == cap_hz and c.within_bounds
                     and (c.yaw_re_within_acceptance or not yaw_re_within_acceptance)
-                    and (c.spin_rate == DIVERGENCE_RATES[0] or not exact_divergence)),
+                    and (c.spin_rate == DIVERGENCE_RATES[0] or not exact_divergence)
+                    and c.spin_inertia <= max_spin_inertia),
                    key=lambda c: c.yaw_hz)
 
     @property
@@ -628,13 +627,14 @@ class YawProof:
 def key_inequality_ratio(ratio: float, published_stable: float, published_unstable: float,
                          spin_rate: float = DIVERGENCE_RATES[0], e: float = 0.75,
                          r0: float = 0.625) -> float:
-    """I/J_eff [-] that a single-DOF yaw (λ² I + λ (2 e² b11 + d) + K_ψ = 0, d >= 0 the other
-    yaw damping) needs to have the published yaw real parts at 0.005 and 0.014 together with the
-    divergence ``spin_rate`` [1/s] (J_eff = −2 r0² b11(0.014) / spin_rate, the drive's effective
-    spin inertia), when its creep law has R = ∂μ/∂s(0.005)/|∂μ/∂s(0.014)| = ``ratio``:
-    Re(0.014) − Re(0.005) = e² N0 |μ'14| (R + 1) / (v I) fixes e² N0 |μ'14| / (v I), and with
-    d = 0 the divergence gives I/J_eff = e² spin_rate (R + 1) / (2 r0² (Re14 − Re5)); d > 0
-    only raises it (Re(0.014) <= e² N0 |μ'14| / (v I) needs R <= −Re5/Re14)."""
+    """I/J_eff [-] that a single-DOF yaw (λ² I + λ (2 e² b11 + d) + K_ψ = 0, d >= 0 the yaw's
+    damping other than the longitudinal creep) needs to have the published yaw real parts at
+    0.005 and 0.014 together with the divergence ``spin_rate`` [1/s] (J_eff = −2 r0² b11(0.014)
+    / spin_rate, the drive's effective spin inertia), when its creep law has
+    R = ∂μ/∂s(0.005)/|∂μ/∂s(0.014)| = ``ratio``.  To first order Re = −(2 e² b11 + d)/(2 I), so
+    d drops out of the difference: Re(0.014) − Re(0.005) = (R + 1) e² N0 |μ'14| / (v I), which
+    with the divergence 2 r0² N0 |μ'14| / (v J_eff) gives I/J_eff = e² spin_rate (R + 1) /
+    (2 r0² (Re14 − Re5)); d = X − Re14 >= 0 (X = e² N0 |μ'14| / (v I)) needs R <= −Re5/Re14."""
     return e**2 * spin_rate * (ratio + 1) / (2 * r0**2 * (published_unstable - published_stable))
 
 
@@ -646,8 +646,6 @@ def yaw_proof(parameters: Parameters, points: int = 5, creep_points: int = 5) ->
     and the guide stiffness that puts the longitudinal mode at rank 7's or rank 8's upper
     acceptance (8.583 and 9.183 Hz + 5 %); the yaw mode there.  The wheelset's mass, yaw
     inertia and the drive's stiffness shares are the set's (:func:`wheelset_model`)."""
-    from dataclasses import replace
-
     base = wheelset_model(parameters)
     creep = creep_slope_relation(parameters, creep_points)
     rotor = _BOUNDS["rotor_inertia"]
@@ -673,10 +671,11 @@ def yaw_proof(parameters: Parameters, points: int = 5, creep_points: int = 5) ->
                             tuned.guide_stiffness, tuned.longitudinal(b5).real,
                             yaw5.imag / (2 * math.pi), yaw5.real, yaw14.imag / (2 * math.pi),
                             yaw14.real))
-    largest = max(c.ratio for c in creep if c.met)
-    needed = tuple(key_inequality_ratio(largest, s, u, e=base.contact_half_distance,
-                                        r0=base.wheel_radius)
-                   for s, u in zip(YAW_RE_STABLE, YAW_RE_UNSTABLE, strict=True))
+    ratios = [c.ratio for c in creep if c.met]
+    needed = {row: tuple(key_inequality_ratio(R, s, u, e=base.contact_half_distance,
+                                              r0=base.wheel_radius)
+                         for R in (min(ratios), max(ratios)))
+              for row, s, u in zip((9, 10), YAW_RE_STABLE, YAW_RE_UNSTABLE, strict=True)}
     return YawProof(base, creep, cases, needed)
 
 
