@@ -682,7 +682,9 @@ def yaw_proof(parameters: Parameters, points: int = 5, creep_points: int = 5) ->
 def realize_case(parameters: Parameters, case: WheelsetCase) -> Parameters:
     """``parameters`` carrying a scanned case into the full model: the case's kA and kS with the
     initial creep slope that gives its ∂μ/∂s(0.014) (stage A re-solved), its rotor inertia,
-    its J_w (the wheel discs' and rims' polar inertias scaled alike) and its guide stiffness."""
+    its J_w (the wheel discs' and rims' polar inertias scaled alike) and its guide stiffness.
+    ValueError if no initial slope within its bounds (searched within x8 of the case's own)
+    gives that ∂μ/∂s(0.014)."""
     from model.mechanics.operating_point import creep_law
     from model.studies.calibration import fit_operating_data
 
@@ -694,10 +696,19 @@ def realize_case(parameters: Parameters, case: WheelsetCase) -> Parameters:
         return fit_operating_data(shaped.replace(creep_slope=math.exp(log_slope)))
 
     def error(log_slope: float) -> float:  # |μ'(0.014)| falls as the initial slope rises
-        return math.log(-float(creep_law(fitted(log_slope)).dmu_ds(0.014, V_REF)) / -wanted)
+        try:
+            dmu = float(creep_law(fitted(log_slope)).dmu_ds(0.014, V_REF))
+        except ValueError:  # no creep maximum: a slope far too small for the operating data
+            return 10.0
+        return math.log(-dmu / -wanted) if dmu < 0 else 10.0
 
-    slope = _BOUNDS["creep_slope"]
-    out = fitted(brentq(error, math.log(slope.low * 1.5), math.log(slope.high), xtol=1e-6))
+    bounds = _BOUNDS["creep_slope"]
+    low = math.log(max(bounds.low, case.creep_slope / 8))
+    high = math.log(min(bounds.high, case.creep_slope * 8))
+    if error(low) * error(high) > 0:
+        raise ValueError(f"no initial creep slope within its bounds gives ∂μ/∂s(0.014) = "
+                         f"{wanted:.3g} with kA = {case.kA:.3g}, kS = {case.kS:.3g}")
+    out = fitted(brentq(error, low, high, xtol=1e-6))
     rim, disc = out["rim_polar_inertia"], out["wheel_disc_polar_inertia"]
     scale = 1 + (case.spin_inertia - wheelset_model(out).spin_inertia) / (2 * (rim + disc))
     return out.replace(rim_polar_inertia=rim * scale, wheel_disc_polar_inertia=disc * scale,
