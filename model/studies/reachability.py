@@ -31,6 +31,18 @@ set with the vertical dampers at their lower hardware bounds (the least damping 
 them) and the dampers each published real part needs (the real part is linear in a damper's rate
 for light damping: a first-order modal-damping model, checked against the full solve).
 
+**(c) The wheelsets' longitudinal and yaw modes against the divergence.**  Table 1's ranks 7/8
+(8.583/9.183 Hz) and 9/10 (12.208/12.580 Hz; Re −3.958/−4.010 at 0.005, +0.911/+0.809 at 0.014)
+beside the +7.031 divergence.  :func:`creep_slope_relation` solves stage A over the creep-shape
+box: R = ∂μ/∂s(0.005)/|∂μ/∂s(0.014)| stays near 3.3 for every law that meets the operating data.
+:class:`WheelsetModel` is one wheelset on its guides under a clamped frame (x, ψ, the wheelset
+side's and the drive's spin; the longitudinal creep 2 e² b11 on ψ and 2 b11 between x and r0 φ),
+checked against the full model; :func:`key_inequality_ratio` is the I/J_eff that the study's
+yaw real parts and its divergence need; :func:`yaw_proof` scans the plausible drives with the
+longitudinal mode at its acceptance's upper end and reports the yaw frequencies reachable;
+:func:`realize_case`, :func:`full_ranks` and :func:`frame_side_ranks` carry a case into the
+full model (where the frame splits the wheelsets' in-phase pairs).
+
 Plain dataclasses; numpy/scipy only.
 """
 
