@@ -63,10 +63,10 @@ DEFAULT_PARTICIPATION = 0.01  # a mode is tracked if its peak reaches 1 % of the
 # Ritz value whose basis holds a few modes (and their shapes at three speeds) overstates the
 # error by orders of magnitude (the Ritz value is a two-sided Rayleigh quotient: its error is
 # second order in the vector's).  Measured against the dense eigenvalues on the default sweep
-# (5…200 km/h, 200 speeds): with a tolerance of 1e-3 on the estimate (127 branch-points refined by
-# Newton) the largest error is 1e-8; with 1e-4 (345 refinements) 3e-9; with 1e-2 (2) 4e-7;
-# with 1e-6 nearly every speed is solved densely (scripts/bench_resonance.py prints the largest
-# error of the default).
+# (5…200 km/h, 200 speeds) of the bundled set: with a tolerance of 1e-3 on the estimate (601
+# branch-points refined by Newton, 2 speeds solved densely) the largest error is 1.1e-7; with 1e-6
+# nearly every speed is solved densely (scripts/bench_resonance.py prints the largest error of
+# the default).
 CAMPBELL_RTOL = 1e-3
 CAMPBELL_FLOOR = 1.0  # [1/s] errors relative to max(|λ|, 1 1/s): real branches pass through 0
 MOTOR_INPUTS = ("ID1.motor.torque", "ID2.motor.torque")

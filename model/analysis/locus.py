@@ -14,9 +14,11 @@ Method — a reduced model whose error is estimated at every point and bounded b
    ``|δλ| ≈ ‖r‖ / ‖(2λ M + B_total) Φ x‖`` (conservative here: the measured errors are 10–30 times
    smaller).  The tolerance is enforced for branches inside the disc |λ| < 1.5·2π f_max (a heavily
    damped branch that leaves it is still tracked and its estimate recorded).  Where the estimate
-   exceeds ``rtol·|λ|`` for a few branches, those are refined by Newton's method on the full
-   model (quadratic convergence; the last step size is the recorded error); where it fails for
-   many, or the MAC tracking is ambiguous, the point is solved densely (exact there).
+   exceeds ``rtol·|λ|`` for some branches, those are refined by Newton's method on the full
+   model (quadratic convergence; the last step size is the recorded error; one solve per complex
+   pair, a few LU factorizations, about a tenth of a dense solve); where that needs more solves
+   than half the number of tracked branches, or the MAC tracking is ambiguous, the point is
+   solved densely (exact there).
    ``lambda_floor`` [1/s] measures the errors relative to max(|λ|, lambda_floor) instead: a
    branch passing through λ = 0 (a drivetrain spin near the creep maximum) has no relative
    accuracy to reach, and without a floor every point near its zero is solved densely.
@@ -425,7 +427,11 @@ def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, redu
     estimate = reduced.error_estimate(c, lam[chosen], X[:, chosen], floor=floor)
     values_i, vectors_i = lam[chosen], X_full[:, chosen]
     failing = np.flatnonzero((estimate > rtol) & (np.abs(values_i) < controlled))
-    if not ok or len(failing) > max(2, len(chosen) // 4):
+    # one full-model Newton solve per inaccurate pair (its branches are conjugates): up to half
+    # of the tracked branches' count before the point is solved densely instead (module
+    # docstring, step 3)
+    solves = len({complex(v.real, abs(v.imag)) for v in values_i[failing]})
+    if not ok or solves > max(2, len(chosen) // 2):
         return None
     # refine the few inaccurate branches by Newton's method in the full model; the reduced
     # matrices are real, so a complex pair's two branches are exact conjugates: the second is
