@@ -33,8 +33,9 @@ Method — a reduced model whose error is estimated at every point and bounded b
    normalized eigenvalue distance, so branches do not swap at near-crossings.  An assignment is
    ambiguous where a branch continues into a value neither of similar shape (MAC > 0.5) nor
    close (5 % of |λ|), or where the two branches of a conjugate pair continue into values that
-   are not a conjugate pair (nor both real).  An ambiguous reduced point is solved densely; an
-   ambiguous dense point halves the step: the branches are carried through densely solved
+   are not a conjugate pair (nor both real).  An ambiguous reduced point is reached through
+   reduced points in between (2, 4, then 8 steps; :func:`_reduced_steps`), else solved
+   densely; an ambiguous dense point halves the step: the branches are carried through densely solved
    intermediate points (not recorded) until every assignment is unambiguous, at most
    :data:`BRIDGE_HALVINGS` times (:func:`_bridge`).  Without it, where branches move far
    within one step (near s0 = 0.0025 at 120 km/h two well damped ≈ 18 Hz pairs move by a
@@ -397,8 +398,13 @@ def _track(model: BogieModel, parameter: str, points: list[OperatingPoint],
     refined = 0
     for i in range(1, n_points):
         if i != n_points - 1:
-            point = _reduced_point(model, points[i], coefficients[i], reduced, solution(i - 1),
+            solved = solution(i - 1)
+            point = _reduced_point(model, points[i], coefficients[i], reduced, solved,
                                    previous_values, previous_vectors, rtol, controlled, floor)
+            if point is AMBIGUOUS:  # carried through reduced points in between, else dense
+                point = _reduced_steps(model, parameter, points[i - 1], points[i], solved,
+                                       reduced, previous_values, previous_vectors, rtol,
+                                       controlled, floor)
             if point is not None:
                 values_i, vectors_i, estimate, newton_branches = point
                 refined += newton_branches
@@ -413,25 +419,63 @@ def _track(model: BogieModel, parameter: str, points: list[OperatingPoint],
     return _Tracks(eigenvalues, errors, dense, refined)
 
 
+AMBIGUOUS = "ambiguous"  # _reduced_point's answer where the assignment is ambiguous
+REDUCED_BRIDGE_HALVINGS = 3  # an ambiguous reduced step is split into 2, 4, 8 reduced steps
+
+
+def _reduced_steps(model: BogieModel, parameter: str, start: OperatingPoint,
+                   end: OperatingPoint, solved: tuple[np.ndarray, np.ndarray], reduced: Reduced,
+                   previous_values: np.ndarray, previous_vectors: np.ndarray, rtol: float,
+                   controlled: float, floor: float):
+    """The branches at ``end`` (its reduced solution ``solved``) carried from ``start`` through
+    evenly spaced reduced points in between (2, 4, then 8 steps of ``parameter``), as
+    :func:`_reduced_point` gives them at ``end``; None if no split is unambiguous and accurate
+    (the point is then solved densely).
+    A step that is ambiguous only because branches move far within it (near s0 = 0.002 the
+    coarse sweep's 25 points step by 0.0008) costs a few small eigenproblems instead of dense
+    solves and their bridge."""
+    a, b = getattr(start, parameter), getattr(end, parameter)
+    for halvings in range(1, REDUCED_BRIDGE_HALVINGS + 1):
+        values, vectors, refined = previous_values, previous_vectors, 0
+        for x in np.linspace(a, b, 2**halvings + 1)[1:]:
+            point = end if x == b else replace(end, **{parameter: float(x)})
+            c = pattern_coefficients(model, point)
+            step = _reduced_point(model, point, c, reduced,
+                                  solved if point is end else reduced.solve(c), values, vectors,
+                                  rtol, controlled, floor)
+            if step is None:
+                return None  # inaccurate: more steps do not help
+            if step is AMBIGUOUS:
+                break
+            values, vectors, estimate, newton_branches = step
+            refined += newton_branches
+        else:
+            return values, vectors, estimate, refined
+    return None
+
+
 def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, reduced: Reduced,
                    solved: tuple[np.ndarray, np.ndarray], previous_values: np.ndarray,
                    previous_vectors: np.ndarray, rtol: float, controlled: float, floor: float):
     """The branches at an inner point from its reduced solution ``solved`` (creep coefficients c),
     assigned to the previous point's: (eigenvalues [1/s], full displacement vectors, estimated
-    errors relative to max(|λ|, ``floor`` [1/s]), branches refined by Newton), or None where the
-    point must be solved densely (ambiguous assignment, too many or unrefinable inaccurate
-    branches inside |λ| < controlled)."""
+    errors relative to max(|λ|, ``floor`` [1/s]), branches refined by Newton); :data:`AMBIGUOUS`
+    where the assignment is ambiguous; None where too many or unrefinable branches inside
+    |λ| < controlled are inaccurate (the point must be solved densely)."""
     lam, X = solved  # non-rigid only: the reduced model deflates its zeros as the dense one
-    X_full = reduced.Phi @ X
-    chosen, ok = _assign(previous_vectors, previous_values, X_full, lam)
+    # Φ has orthonormal columns, so a full vector's MAC with Φ x is its projection Φᵀ p's with x:
+    # the assignment runs in the reduced coordinates and only the chosen vectors are expanded
+    chosen, ok = _assign(reduced.Phi.T @ previous_vectors, previous_values, X, lam)
+    if not ok:
+        return AMBIGUOUS
     estimate = reduced.error_estimate(c, lam[chosen], X[:, chosen], floor=floor)
-    values_i, vectors_i = lam[chosen], X_full[:, chosen]
+    values_i, vectors_i = lam[chosen], reduced.Phi @ X[:, chosen]
     failing = np.flatnonzero((estimate > rtol) & (np.abs(values_i) < controlled))
     # one full-model Newton solve per inaccurate pair (its branches are conjugates): up to half
     # of the tracked branches' count before the point is solved densely instead (module
     # docstring, step 3)
     solves = len({complex(v.real, abs(v.imag)) for v in values_i[failing]})
-    if not ok or solves > max(2, len(chosen) // 2):
+    if solves > max(2, len(chosen) // 2):
         return None
     # refine the few inaccurate branches by Newton's method in the full model; the reduced
     # matrices are real, so a complex pair's two branches are exact conjugates: the second is

@@ -46,15 +46,17 @@ def test_tracked_eigenvalues_equal_dense_solution(setup):
 
 def test_denser_sweep_reuses_the_start_and_gives_the_same_values(setup, monkeypatch):
     """A denser sweep over the same range (the dashboard's dense locus after its coarse one)
-    reuses the kept end points, basis and short sweep's solutions: it solves only its new points
-    and gives bitwise the same eigenvalues as the same sweep computed from scratch."""
+    reuses the kept end points, basis and short sweep's solutions: it solves each of its new
+    points once and none of the old ones (the reduced points between two of its points, where
+    an assignment is ambiguous, are solved in addition) and gives bitwise the same eigenvalues
+    as the same sweep computed from scratch."""
     import model.analysis.locus as locus_module
 
     model, op, _, _ = setup
     solves = []
     solve = locus_module.Reduced.solve
     monkeypatch.setattr(locus_module.Reduced, "solve",
-                        lambda self, c: solves.append(1) or solve(self, c))
+                        lambda self, c: solves.append(c.tobytes()) or solve(self, c))
     coarse_s0 = np.linspace(0.002, 0.016, 8)
     dense_s0 = np.concatenate([np.linspace(a, b, 4)[:-1] for a, b in pairwise(coarse_s0)]
                               + [coarse_s0[-1:]])
@@ -62,7 +64,11 @@ def test_denser_sweep_reuses_the_start_and_gives_the_same_values(setup, monkeypa
     coarse = root_locus(model, op, "s0", coarse_s0)
     solves.clear()
     reused = root_locus(model, op, "s0", dense_s0)
-    assert len(solves) == (len(dense_s0) - 2) - (len(coarse_s0) - 2)  # only the new inner points
+    key = lambda s0: pattern_coefficients(model, op.__class__(s0, op.v, op.N0, op.b_M)).tobytes()  # noqa: E731
+    old, new = ({key(s0) for s0 in grid[1:-1]}
+                for grid in (coarse_s0, [s for s in dense_s0 if s not in coarse_s0]))
+    assert not old & set(solves)
+    assert all(solves.count(k) == 1 for k in new)
     clear_sweep_starts()
     fresh = root_locus(model, op, "s0", dense_s0)
     assert np.array_equal(reused.eigenvalues, fresh.eigenvalues)
@@ -70,6 +76,32 @@ def test_denser_sweep_reuses_the_start_and_gives_the_same_values(setup, monkeypa
     # another operating point does not reuse this start
     other = root_locus(model, op.__class__(op.s0, op.v, op.N0, 2 * op.b_M + 1.0), "s0", coarse_s0)
     assert not np.array_equal(other.eigenvalues, coarse.eigenvalues)
+
+
+def test_an_ambiguous_long_step_is_carried_through_reduced_points(setup, monkeypatch):
+    """The dashboard's coarse sweep (25 points over s0 = 0.001…0.02 at 120 km/h, branches up to
+    20 Hz, errors relative to max(|λ|, 1 1/s)) has steps near s0 = 0.002 where branches move too
+    far to be assigned unambiguously: they are carried through reduced points in between, not
+    solved densely (only the two ends are), and every tracked eigenvalue inside the controlled
+    disc is an eigenvalue of the dense solution within 1e-6 of max(|λ|, 1 1/s)."""
+    import model.analysis.locus as locus_module
+
+    model, op, _, _ = setup
+    bridged = []
+    steps = locus_module._reduced_steps
+    monkeypatch.setattr(locus_module, "_reduced_steps",
+                        lambda *args: bridged.append(args[3].s0) or steps(*args))
+    clear_sweep_starts()
+    s0 = np.linspace(0.001, 0.02, 25)
+    locus = root_locus(model, op, "s0", s0, lambda_floor=1.0)
+    assert bridged
+    assert min(bridged) < 0.004
+    assert np.flatnonzero(locus.dense_points).tolist() == [0, len(s0) - 1]
+    for i in range(len(s0)):
+        reference = eigen_analysis(model, replace(op, s0=float(s0[i]))).eigenvalues
+        for value in locus.eigenvalues[i]:
+            if abs(value) < CONTROLLED:
+                assert np.min(np.abs(reference - value)) <= 1e-6 * max(abs(value), 1.0)
 
 
 def test_branches_do_not_swap(setup):
