@@ -29,6 +29,24 @@ CHROMIUM = Path("/usr/bin/chromium")
 ROOT = Path(__file__).resolve().parent.parent  # the project
 
 
+def bogie_parsers() -> list[tuple[list[str], object]]:
+    """(words, parser) of ``bogie``'s parser and of each of its sub-commands' (``[]`` the top
+    one, ``["study", "map"]`` …), parents before their sub-commands: the one walk of the command
+    line that the tests of its options and of the pages' option names share."""
+    import argparse
+
+    from app.cli.main import build_parser
+
+    def walk(words, parser):
+        yield words, parser
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    yield from walk([*words, name], sub)
+
+    return list(walk([], build_parser()))
+
+
 @pytest.fixture(scope="session", autouse=True)
 def _one_blas_thread():
     """Dense 386 x 386 eigenproblems run fastest on one BLAS thread, and OpenBLAS threads that

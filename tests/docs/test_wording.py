@@ -13,7 +13,7 @@ from __future__ import annotations
 import re
 
 import pytest
-from conftest import ROOT
+from conftest import ROOT, bogie_parsers
 
 THIS = "tests/docs/test_wording.py"
 _ORDINAL = r"(?:first|second|third|fourth|fifth|sixth|seventh|eighth|ninth|tenth|this|last|previous|earlier|next)"
@@ -108,18 +108,8 @@ COMMENT = re.compile(r"<!--.*?-->", re.S)
 
 def parser_options() -> set[str]:
     """Every option string of ``bogie``'s parser and its sub-commands'."""
-    import argparse
-
-    from app.cli.main import build_parser
-
-    options, parsers = set(), [build_parser()]
-    while parsers:
-        parser = parsers.pop()
-        for action in parser._actions:
-            options |= {o for o in action.option_strings if o.startswith("--")}
-            if isinstance(action, argparse._SubParsersAction):
-                parsers.extend(action.choices.values())
-    return options
+    return {o for _, parser in bogie_parsers() for action in parser._actions
+            for o in action.option_strings if o.startswith("--")}
 
 
 def test_every_option_a_page_names_exists():

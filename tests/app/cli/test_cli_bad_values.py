@@ -21,8 +21,9 @@ import re
 from pathlib import Path
 
 import pytest
+from conftest import bogie_parsers
 
-from app.cli.main import build_parser, main
+from app.cli.main import main
 from model.mechanics.parameters import CALIBRATED_FILE, ESTIMATE_FILE
 
 # where the computation of each command starts: module, function (imported by the commands when
@@ -85,15 +86,8 @@ def _stop(*_args, **_kwargs):
 
 def leaf_commands() -> list[tuple[list[str], argparse.ArgumentParser]]:
     """(words, parser) of every command of ``bogie`` that runs (``study map`` …)."""
-
-    def walk(parser, words):
-        subparsers = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
-        if not subparsers:
-            return [(words, parser)]
-        return [leaf for name, sub in subparsers[0].choices.items()
-                for leaf in walk(sub, [*words, name])]
-
-    return walk(build_parser(), [])
+    return [(words, parser) for words, parser in bogie_parsers()
+            if not any(isinstance(a, argparse._SubParsersAction) for a in parser._actions)]
 
 
 def _text(action: argparse.Action) -> str:
