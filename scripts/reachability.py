@@ -29,7 +29,8 @@ from threadpoolctl import threadpool_limits  # noqa: E402
 
 from model import load_parameters  # noqa: E402
 from model.studies.calibration_targets import DIVERGENCE_RATES  # noqa: E402
-from model.studies.reachability import (  # noqa: E402  # noqa: E402
+from model.studies.reachability import suspension_proof, torsional_chain_proof  # noqa: E402
+from model.studies.wheelset_reachability import (  # noqa: E402
     RANK7_HZ,
     RANK8_HZ,
     RANK9_HZ,
@@ -37,12 +38,10 @@ from model.studies.reachability import (  # noqa: E402  # noqa: E402
     RANK_TOLERANCE,
     YAW_RE_STABLE,
     YAW_RE_UNSTABLE,
-    _clamped_modes,
+    clamped_modes,
     frame_side_ranks,
     full_ranks,
     realize_case,
-    suspension_proof,
-    torsional_chain_proof,
     yaw_proof,
 )
 
@@ -138,7 +137,7 @@ def wheelset_numbers(parameters) -> dict:
     check = {}
     for s0 in (0.005, 0.014):
         b11 = creep_coefficients(parameters, reference_point(parameters, s0)).b11
-        clamped = _clamped_modes(parameters, b11)
+        clamped = clamped_modes(parameters, b11)
         reduced = {"longitudinal": w.longitudinal(b11), "yaw": w.yaw(b11)}
         entry = {"b11": b11, "spin_reduced": w.spin(b11), "spin_clamped": clamped["spin"].real}
         for key, lam in reduced.items():

@@ -1,5 +1,5 @@
-"""The reduced models of model/studies/reachability.py against closed forms and limits, and the
-proofs' conclusions on small scans (the full numbers: scripts/reachability.py,
+"""The reduced models of model/studies/reachability.py and wheelset_reachability.py against
+closed forms and limits, and the proofs' conclusions on small scans (the full numbers: scripts/reachability.py,
 docs/validation.md)."""
 
 from __future__ import annotations
@@ -15,14 +15,16 @@ from model.mechanics.operating_point import creep_coefficients
 from model.studies.calibration_targets import reference_point
 from model.studies.reachability import (
     Chain,
-    _clamped_modes,
     bounce_two_mass,
+    suspension_proof,
+    torsional_chain_proof,
+)
+from model.studies.wheelset_reachability import (
+    clamped_modes,
     creep_slope_relation,
     full_ranks,
     key_inequality_ratio,
     realize_case,
-    suspension_proof,
-    torsional_chain_proof,
     wheelset_model,
     yaw_proof,
 )
@@ -136,7 +138,7 @@ def test_wheelset_model_reproduces_the_full_model_of_the_bundled_set(wheelset):
     p = load_parameters()
     for s0 in (0.005, 0.014):
         b11 = creep_coefficients(p, reference_point(p, s0)).b11
-        clamped = _clamped_modes(p, b11)
+        clamped = clamped_modes(p, b11)
         for key, lam in (("longitudinal", wheelset.longitudinal(b11)), ("yaw", wheelset.yaw(b11))):
             assert lam.imag == pytest.approx(clamped[key].imag, rel=0.01)
             assert lam.real == pytest.approx(clamped[key].real, rel=0.08)
