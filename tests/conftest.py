@@ -270,6 +270,28 @@ def chromium():
         browser.close()
 
 
+def _unknown_model(message: str) -> str:
+    """For BokehJS's "reference p123 isn't known" (the server sent a change that names a model
+    the page never received): which model of this process has that id, and whether it is in a
+    document — the served app runs in the test's process, so the garbage collector finds it."""
+    import gc
+    import re
+
+    found = re.search(r"reference (\S+) isn't known", message)
+    if not found:
+        return ""
+    from bokeh.model import Model
+
+    for obj in gc.get_objects():
+        if isinstance(obj, Model) and obj.id == found.group(1):
+            what = {key: getattr(obj, key) for key in ("name", "tags", "css_classes", "text")
+                    if getattr(obj, key, None)}
+            if hasattr(obj, "data"):
+                what["columns"] = sorted(obj.data)
+            return (f" [{type(obj).__name__} {what}, in a document: {obj.document is not None}]")
+    return " [no model of this process has that id]"
+
+
 def open_app(browser, url: str, timeout_ms: float = 120_000, viewport=(1600, 1000),
              query: str = ""):
     """A new page with the app loaded (``/app?<query>``) and rendered; ``page.errors`` collects
@@ -277,7 +299,7 @@ def open_app(browser, url: str, timeout_ms: float = 120_000, viewport=(1600, 100
     page = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
     errors: list[str] = []
     page.on("console", lambda m: errors.append(f"console: {m.text}") if m.type == "error" else None)
-    page.on("pageerror", lambda e: errors.append(f"pageerror: {e}"))
+    page.on("pageerror", lambda e: errors.append(f"pageerror: {e}{_unknown_model(str(e))}"))
     # which resource failed (the console message does not say)
     page.on("requestfailed", lambda r: errors.append(f"requestfailed: {r.url} ({r.failure})"))
     page.errors = errors

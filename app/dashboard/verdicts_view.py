@@ -108,7 +108,8 @@ class VerdictsView:
         self.life = None  # the route life on screen (model.studies.life.LifeResult)
         self.life_for: tuple | None = None  # its key
         self._life_waiting: tuple | None = None  # not served: the key compute_life computes
-        self._chart_pending = False  # the life's plot waits for the tab to be shown
+        # served, a figure made while the tab is closed waits for it: {pane's role: (pane, maker)}
+        self._pending_figures: dict[str, tuple] = {}
         self._life_pending = False  # the life of the verdict on screen waits for the tab
         _LIFE_VIEWS.add(self)
         self.running = pn.widgets.Checkbox(label=RUNNING_LABEL, value=False,
@@ -209,9 +210,10 @@ class VerdictsView:
         if shown and self._life_pending and self.shown_for is not None:
             self._life_pending = False
             self._request_life(self.shown_for)
-        if shown and self._chart_pending and self.life is not None:
-            self._chart_pending = False
-            self.life_chart.object = route_life.damage_figure(self.life)
+        if shown:
+            for pane, make in self._pending_figures.values():
+                pane.object = make()
+            self._pending_figures.clear()
         if shown and self._waiting is not None:
             key, self._waiting = self._waiting, None
             self._show(key, assessment_result(key[0], key[1], running=key[2]))
@@ -228,7 +230,7 @@ class VerdictsView:
         self.cases.object = "<ul>" + "".join(
             f"<li><b>{c.name}</b> ({'steady' if c.horizon is None else f'horizon {c.horizon:g} s'}"
             f"): {html.escape(c.description)}</li>" for c in result.cases) + "</ul>"
-        self.chart.object = safety_factor_figure(result)
+        self._set_figure("safety factors", self.chart, partial(safety_factor_figure, result))
         self.dashboard.resonances.show_crossings()
         if len(key) > 1:  # a new assessment (not new bands): the life of its set, asked for
             # while the tab is open (minutes of CPU in a background worker: not for a session
@@ -288,13 +290,19 @@ class VerdictsView:
     def _show_life(self, key, result) -> None:
         self.life, self.life_for = result, key
         self.life_text.object = route_life.description(result, key[2])
-        # a new figure only while the tab is drawn: replaced in a tab the page has left, its
-        # models were unknown to the page ("reference … isn't known")
-        self._chart_pending = not self._tab_open and served_document() is not None
-        if not self._chart_pending:
-            self.life_chart.object = route_life.damage_figure(result)
+        self._set_figure("life", self.life_chart, partial(route_life.damage_figure, result))
         if self.result is not None:
             self._fill_table()
+
+    def _set_figure(self, role: str, pane, make) -> None:
+        """Show the figure ``make()`` in ``pane``; served, only while the tab is drawn, else when
+        it is opened (the newest figure of each ``role``): a figure replaced in a tab the page has
+        left had models the page never received ("reference … isn't known")."""
+        if self._tab_open or served_document() is None:
+            self._pending_figures.pop(role, None)
+            pane.object = make()
+        else:
+            self._pending_figures[role] = (pane, make)
 
     def _life_failed(self, _key, error: BaseException) -> None:
         self.life_text.object = f"**Life over the route:** not computed: {html.escape(str(error))}"
