@@ -17,8 +17,10 @@ linear creep at an unstable point, the nonlinear history beside the unbounded li
 (``dashboard.show_companion``: the peak table's physical answer).  The
 nonlinear histories are computed by :func:`app.results.compute.nonlinear_histories` (the report
 uses them too); the reaction-time search here is kept in the results cache like them and
-returns plain read-only data; served, it runs in a background worker process
-(:mod:`app.services.background`), not on the server's interpreter.  Each computation is a
+returns plain read-only data.  Served, the search and the companion history run in background
+worker processes (:mod:`app.services.background`), not on the server's interpreter: no slider
+waits for them (the history shown with nonlinear creep on is that mode's first answer and
+stays on this view's threads).  Each computation is a
 :class:`app.dashboard.jobs.ViewJob`.
 """
 
@@ -68,6 +70,28 @@ class ReactionSuperseded(Superseded):
 def _stop_unless_wanted(key: tuple) -> None:
     if not any(view.wants_reaction(key) for view in list(_VIEWS)):
         raise ReactionSuperseded(key)
+
+
+class CompanionSuperseded(Superseded):
+    """A companion history stopped because no session wants it any more."""
+
+
+def _stop_unless_companion_wanted(key: HistoryKey) -> None:
+    if not any(view.wants_companion(key) for view in list(_VIEWS)):
+        raise CompanionSuperseded(key)
+
+
+def wanted_companion(key: HistoryKey) -> NonlinearHistories:
+    """The nonlinear history beside a linear one that grows without bound (the peak table's
+    companion), in a background worker process (:mod:`app.services.background`): no slider
+    waits for it, and its step loop is mostly Python (in the server's threads it held the
+    interpreter beside every session's first answers).  It stops (CompanionSuperseded) as soon
+    as no live view wants it — before it starts and between the integration's blocks."""
+    stop = partial(_stop_unless_companion_wanted, key)
+    stop()
+    return nonlinear_histories(key.case, key.anti_slip,
+                               runner=partial(background.run, stop=stop),
+                               checkpoint=background.checkpoint)
 
 
 def wanted_reaction(case: CaseBase, threshold: float, rate: float) -> Reaction:
@@ -282,10 +306,16 @@ class NonlinearView:
 
     def _start_history(self, kind: str, key: HistoryKey, apply) -> None:
         """The nonlinear history ``key`` on the nonlinear creep model's worker (``kind``:
-        "history" shown as such, or "companion" beside a linear one)."""
-        self._histories.start((kind, key), lambda: nonlinear_histories(key.case, key.anti_slip),
-                              lambda _k, histories: apply(key, histories),
+        "history" shown as such, or "companion" beside a linear one: served, that one in a
+        background worker process, :func:`wanted_companion`)."""
+        work = ((lambda: wanted_companion(key)) if kind == "companion"
+                else (lambda: nonlinear_histories(key.case, key.anti_slip)))
+        self._histories.start((kind, key), work, lambda _k, histories: apply(key, histories),
                               lambda _k, error: self._reject(error))
+
+    def wants_companion(self, key: HistoryKey) -> bool:
+        """Whether this view still waits for the companion history ``key`` (any thread)."""
+        return self._histories.wanted == ("companion", key) and self.dash.alive()
 
     def _request_companion(self, key: HistoryKey) -> None:
         """Linear creep on: beside a linear history that grows without bound, the nonlinear

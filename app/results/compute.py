@@ -144,7 +144,7 @@ def cached(kind: str, case: CaseBase, compute, *extra):
 
 
 def _known(kind: str, case: CaseBase, *extra):
-    """The kept result of :func:`_cached`'s key, or None (nothing is computed)."""
+    """The kept result of :func:`cached`'s key, or None (nothing is computed)."""
     try:
         digest = set_hash_for(case)
     except ValueError:
@@ -505,34 +505,46 @@ class NonlinearHistories:
         return self.response.peaks
 
 
-def nonlinear_histories(case: CaseBase, anti_slip: tuple) -> NonlinearHistories:
+def nonlinear_histories(case: CaseBase, anti_slip: tuple, runner=None,
+                        checkpoint=None) -> NonlinearHistories:
     """The nonlinear response (model.analysis.nonlinear) of HISTORY_OUTPUTS; ``anti_slip``:
-    (enabled, delay [s], threshold [m/s], rate [1/s]) of ID2's protection."""
+    (enabled, delay [s], threshold [m/s], rate [1/s]) of ID2's protection.  Kept in the results
+    cache; ``runner(function, *args)`` computes it where the cache does not hold it (default: in
+    this thread), ``checkpoint()`` is asked between the integration's blocks (what it raises
+    stops the run)."""
     anti_slip = tuple(anti_slip)
 
     def compute() -> NonlinearHistories:
-        from model.analysis.load_peaks import load_peaks
-        from model.analysis.nonlinear import nonlinear_response
-
-        enabled, delay, threshold, rate = anti_slip
-        protection = AntiSlip(True, delay, threshold, rate) if enabled else None
-        r = nonlinear_response(model_for(case), case.operating_point(), case.short_circuit(),
-                               float(case.t_end), sampling_rate(case.f), anti_slip=protection,
-                               outputs=list(HISTORY_OUTPUTS))
-        stride = max(1, len(r.t) // PATH_POINTS)
-        paths = {rim: (s[::stride].astype(np.float32),
-                       (r.utilisation[rim][::stride] * r.mu_max).astype(np.float32))
-                 for rim, s in r.creepage.items()}
-        return NonlinearHistories(
-            # every drive part plotted: the Design loads tab overlays the nonlinear history
-            response=history_view(r, anti_slip_description(anti_slip), cut_growth=False,
-                                  peaks=load_peaks(r.t, r.outputs, r.steady, r.units,
-                                                   r.limit_crossings, "nonlinear",
-                                                   split_note="nonlinear creep: not split")),
-            paths=paths, detection_time=r.detection_time, action_time=r.action_time,
-            max_creepage=float(max(s.max() for s in r.creepage.values())),
-            M_ad=float(r.limits["M_ad"]))
+        if runner is None:
+            return _nonlinear_histories(case, anti_slip, checkpoint)
+        return runner(_nonlinear_histories, case, anti_slip, checkpoint)
     return cached("nonlinear", case, compute, anti_slip)
+
+
+def _nonlinear_histories(case: CaseBase, anti_slip: tuple, checkpoint=None) -> NonlinearHistories:
+    """:func:`nonlinear_histories` computed (a module-level function: a background worker's
+    task when served)."""
+    from model.analysis.load_peaks import load_peaks
+    from model.analysis.nonlinear import nonlinear_response
+
+    enabled, delay, threshold, rate = anti_slip
+    protection = AntiSlip(True, delay, threshold, rate) if enabled else None
+    r = nonlinear_response(model_for(case), case.operating_point(), case.short_circuit(),
+                           float(case.t_end), sampling_rate(case.f), anti_slip=protection,
+                           outputs=list(HISTORY_OUTPUTS), checkpoint=checkpoint)
+    stride = max(1, len(r.t) // PATH_POINTS)
+    paths = {rim: (s[::stride].astype(np.float32),
+                   (r.utilisation[rim][::stride] * r.mu_max).astype(np.float32))
+             for rim, s in r.creepage.items()}
+    return NonlinearHistories(
+        # every drive part plotted: the Design loads tab overlays the nonlinear history
+        response=history_view(r, anti_slip_description(anti_slip), cut_growth=False,
+                              peaks=load_peaks(r.t, r.outputs, r.steady, r.units,
+                                               r.limit_crossings, "nonlinear",
+                                               split_note="nonlinear creep: not split")),
+        paths=paths, detection_time=r.detection_time, action_time=r.action_time,
+        max_creepage=float(max(s.max() for s in r.creepage.values())),
+        M_ad=float(r.limits["M_ad"]))
 
 
 @dataclass(frozen=True)

@@ -163,3 +163,41 @@ def test_a_reaction_search_stops_inside_a_run_once_its_view_moves_on():
     # asked before the search and before each block of the first run (2 s at 5 kHz: 5 blocks);
     # the fourth question, the first run's third block, stopped it
     assert view.asked == 4
+
+
+def test_a_companion_history_no_session_wants_stops_at_once():
+    """The companion history (beside a linear history that grows without bound) whose key no
+    live view wants stops before its run: served, it would hold a background worker."""
+    from app.dashboard.nonlinear_view import CompanionSuperseded, wanted_companion
+
+    key = compute.HistoryKey(_case(0.01373), anti_slip_key(False, 0.1, 0.3, 10.0))
+    with pytest.raises(CompanionSuperseded):
+        wanted_companion(key)
+    assert compute._known("nonlinear", key.case, key.anti_slip) is None
+
+
+def test_a_companion_history_stops_inside_its_run_once_its_view_moves_on():
+    """The companion asks whether it is still wanted before every block of its run: a view
+    that moved on stops it within one block, and nothing is kept in the results cache."""
+    from app.dashboard.nonlinear_view import _VIEWS, CompanionSuperseded, wanted_companion
+
+    key = compute.HistoryKey(_case(0.01374), anti_slip_key(False, 0.1, 0.3, 10.0))
+
+    class MovingView:  # wants the companion for its first three questions
+        asked = 0
+
+        def wants_companion(self, asked_key):
+            assert asked_key == key
+            self.asked += 1
+            return self.asked <= 3
+
+    view = MovingView()
+    _VIEWS.add(view)
+    try:
+        with pytest.raises(CompanionSuperseded):
+            wanted_companion(key)
+    finally:
+        _VIEWS.discard(view)
+    # asked before the run and before each of its blocks: the run's third block stopped it
+    assert view.asked == 4
+    assert compute._known("nonlinear", key.case, key.anti_slip) is None
