@@ -137,32 +137,42 @@ def test_a_reaction_search_no_session_wants_stops_at_once():
     assert time.perf_counter() - start < 5.0  # no nonlinear run (each ≈ 0.5 s) was started
 
 
-def test_a_reaction_search_stops_inside_a_run_once_its_view_moves_on():
-    """The search asks whether it is still wanted before every block of every nonlinear run (not
-    only between runs): a view whose sliders moved on stops it within one block."""
-    from app.dashboard.nonlinear_view import _VIEWS, ReactionSuperseded, wanted_reaction
+def _questions_until_stopped(wants: str, key, call, superseded) -> int:
+    """How many times ``call()`` asks a stand-in view (its method ``wants``: wants_reaction or
+    wants_companion) whether ``key`` is still wanted before it raises ``superseded``; the view
+    wants it for its first three questions."""
+    from app.dashboard.nonlinear_view import _VIEWS
 
-    arguments = (_case(0.01372), 0.3, 10.0)
-    key = reaction_key(*arguments)
-
-    class MovingView:  # wants the search for its first three questions
+    class MovingView:
         asked = 0
 
-        def wants_reaction(self, asked_key):
-            assert asked_key == key
-            self.asked += 1
-            return self.asked <= 3
+    def answer(view, asked_key):
+        assert asked_key == key
+        view.asked += 1
+        return view.asked <= 3
 
+    setattr(MovingView, wants, answer)
     view = MovingView()
     _VIEWS.add(view)
     try:
-        with pytest.raises(ReactionSuperseded):
-            wanted_reaction(*arguments)
+        with pytest.raises(superseded):
+            call()
     finally:
         _VIEWS.discard(view)
+    return view.asked
+
+
+def test_a_reaction_search_stops_inside_a_run_once_its_view_moves_on():
+    """The search asks whether it is still wanted before every block of every nonlinear run (not
+    only between runs): a view whose sliders moved on stops it within one block."""
+    from app.dashboard.nonlinear_view import ReactionSuperseded, wanted_reaction
+
+    arguments = (_case(0.01372), 0.3, 10.0)
+    asked = _questions_until_stopped("wants_reaction", reaction_key(*arguments),
+                                     lambda: wanted_reaction(*arguments), ReactionSuperseded)
     # asked before the search and before each block of the first run (2 s at 5 kHz: 5 blocks);
     # the fourth question, the first run's third block, stopped it
-    assert view.asked == 4
+    assert asked == 4
 
 
 def test_a_companion_history_no_session_wants_stops_at_once():
@@ -179,25 +189,11 @@ def test_a_companion_history_no_session_wants_stops_at_once():
 def test_a_companion_history_stops_inside_its_run_once_its_view_moves_on():
     """The companion asks whether it is still wanted before every block of its run: a view
     that moved on stops it within one block, and nothing is kept in the results cache."""
-    from app.dashboard.nonlinear_view import _VIEWS, CompanionSuperseded, wanted_companion
+    from app.dashboard.nonlinear_view import CompanionSuperseded, wanted_companion
 
     key = compute.HistoryKey(_case(0.01374), anti_slip_key(False, 0.1, 0.3, 10.0))
-
-    class MovingView:  # wants the companion for its first three questions
-        asked = 0
-
-        def wants_companion(self, asked_key):
-            assert asked_key == key
-            self.asked += 1
-            return self.asked <= 3
-
-    view = MovingView()
-    _VIEWS.add(view)
-    try:
-        with pytest.raises(CompanionSuperseded):
-            wanted_companion(key)
-    finally:
-        _VIEWS.discard(view)
+    asked = _questions_until_stopped("wants_companion", key, lambda: wanted_companion(key),
+                                     CompanionSuperseded)
     # asked before the run and before each of its blocks: the run's third block stopped it
-    assert view.asked == 4
+    assert asked == 4
     assert compute._known("nonlinear", key.case, key.anti_slip) is None
