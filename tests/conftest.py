@@ -284,11 +284,11 @@ def _unknown_model(message: str) -> str:
 
     for obj in gc.get_objects():
         if isinstance(obj, Model) and obj.id == found.group(1):
-            what = {key: getattr(obj, key) for key in ("name", "tags", "css_classes", "text")
-                    if getattr(obj, key, None)}
-            if hasattr(obj, "data"):
-                what["columns"] = sorted(obj.data)
-            return (f" [{type(obj).__name__} {what}, in a document: {obj.document is not None}]")
+            what = {key: value for key in ("name", "tags", "css_classes", "text", "data")
+                    if (value := getattr(obj, key, None))}
+            if "data" in what:
+                what["data"] = sorted(what["data"])  # its columns
+            return f" [{type(obj).__name__} {what}, in a document: {obj.document is not None}]"
     return " [no model of this process has that id]"
 
 
