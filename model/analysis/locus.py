@@ -463,8 +463,10 @@ def _reduced_point(model: BogieModel, point: OperatingPoint, c: np.ndarray, redu
     where the assignment is ambiguous; None where too many or unrefinable branches inside
     |λ| < controlled are inaccurate (the point must be solved densely)."""
     lam, X = solved  # non-rigid only: the reduced model deflates its zeros as the dense one
-    # Φ has orthonormal columns, so a full vector's MAC with Φ x is its projection Φᵀ p's with x:
-    # the assignment runs in the reduced coordinates and only the chosen vectors are expanded
+    # Φ has orthonormal columns, so a vector p in its span (a reduced point's) has the same MAC
+    # with Φ x as Φᵀ p with x; a dense point's vector is compared by its projection onto the
+    # basis (the part the reduced model can follow).  The assignment runs in the reduced
+    # coordinates and only the chosen vectors are expanded
     chosen, ok = _assign(reduced.Phi.T @ previous_vectors, previous_values, X, lam)
     if not ok:
         return AMBIGUOUS
