@@ -80,6 +80,11 @@ def log(message: str) -> None:
     print(f"bench_app: {time.strftime('%H:%M:%S')} {message}", file=sys.stderr, flush=True)
 
 
+# the command line of the server's background worker processes (app/services/background.py
+# starts them from a forkserver; nothing else of a benchmark run does)
+BACKGROUND_WORKERS = "multiprocessing.forkserver"
+
+
 def cpu_seconds(match: str) -> float:
     """CPU time [s] (user + system) used so far by the processes whose command line contains
     ``match`` (Linux /proc)."""
@@ -521,7 +526,7 @@ async def page_among_clients(browser, url: str, args, results: dict) -> None:
         load.stdin.write("go\n")
         load.stdin.flush()
         cpu = (cpu_seconds("bogie serve"), cpu_seconds("chrom"),
-               cpu_seconds("--protocol-clients"))
+               cpu_seconds("--protocol-clients"), cpu_seconds(BACKGROUND_WORKERS))
         began = time.perf_counter()
         results["mixed_page_s"] = await session(page, 99, args.mixed_presses)
         wall = time.perf_counter() - began
@@ -531,7 +536,8 @@ async def page_among_clients(browser, url: str, args, results: dict) -> None:
             "wall_s": wall,
             "server_cpu_s": cpu_seconds("bogie serve") - cpu[0],
             "browser_cpu_s": cpu_seconds("chrom") - cpu[1],
-            "clients_cpu_s": cpu_seconds("--protocol-clients") - cpu[2]}
+            "clients_cpu_s": cpu_seconds("--protocol-clients") - cpu[2],
+            "background_cpu_s": cpu_seconds(BACKGROUND_WORKERS) - cpu[3]}
         report = json.loads(await asyncio.to_thread(load.stdout.readline))
         if report["failures"]:
             raise SystemExit(f"bench_app: protocol clients failed: {report['failures']}")
@@ -636,7 +642,8 @@ def report_page_among_clients(results: dict, sessions: int, single: float) -> No
           f"= {mixed / single:.2f} x single; clients median "
           f"{statistics.median(clients) * 1e3:.0f} ms (n = {len(clients)})")
     cpu = results["mixed_cpu"]
-    print(f"  during it ({cpu['wall_s']:.1f} s): server {cpu['server_cpu_s']:.1f} CPU-s, browser "
+    print(f"  during it ({cpu['wall_s']:.1f} s): server {cpu['server_cpu_s']:.1f} CPU-s, its "
+          f"background workers {cpu['background_cpu_s']:.1f} CPU-s, browser "
           f"{cpu['browser_cpu_s']:.1f} CPU-s, protocol clients {cpu['clients_cpu_s']:.1f} CPU-s")
 
 
