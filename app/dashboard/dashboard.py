@@ -123,7 +123,7 @@ class BogieDashboard(pn.viewable.Viewer):
         self._restore_tab(query_tab, query_notices)
         self.param.watch(self._share, list(self.param))
         self.tabs.param.watch(self._share, "active")
-        self.tabs.param.watch(self._tab_shown, "active")
+        self.view_tabs.on_opening(self._tab_shown)
         self._tab_shown()
         self.param.watch(self._on_mode, ["mode"])
         self.param.watch(lambda e: self.locus_plot.zoom(e.new == "low"), ["zoom"])
@@ -314,9 +314,10 @@ class BogieDashboard(pn.viewable.Viewer):
             self.warn("Some settings of the link were not used (defaults kept): "
                       + "; ".join(notices))
 
-    def _tab_shown(self, *_events) -> None:
+    def _tab_shown(self) -> None:
         """Views that compute only while shown (the variant comparison, the resonances) learn it
-        here; the updates a hidden view missed are applied."""
+        here; the updates a hidden view missed are applied (before the opened view's models are
+        made: :class:`app.dashboard.layout.OpeningTabs`)."""
         shown = self.view_tabs.shown
         self.variant_view.on_shown(shown == "variant")
         self.resonances.on_shown(shown == "resonances")

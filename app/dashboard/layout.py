@@ -65,13 +65,31 @@ def tab_name(title: str) -> str:
     return re.sub(r"[^a-z0-9]+", "-", str(title).lower()).strip("-")
 
 
+class OpeningTabs(pn.Tabs):
+    """Tabs that call ``opening()`` when another tab is opened, after ``active`` has changed and
+    before the models of the opened tab's view are made (``pn.Tabs`` makes them in its own watcher
+    of ``active``, which runs before any other watcher of it). What ``opening`` sets is then in
+    the models the browser first receives: a change sent just after them can reach a view that
+    is still building, and a Tabulator that is building drops new rows (it drew none, while
+    its model in the browser held ten)."""
+
+    def __init__(self, *objects, **params):
+        super().__init__(*objects, **params)
+        self.opening = None  # the callback (no arguments), or None
+
+    def _update_active(self, *events):
+        if self.opening is not None and any(event.name == "active" for event in events):
+            self.opening()
+        super()._update_active(*events)
+
+
 class ViewTabs:
     """The views of a dashboard, one tab each, and the updates that wait for a hidden tab."""
 
     def __init__(self, *views: tuple[str, object]):
         """``views``: (title, view) pairs; more are added with :meth:`add`."""
-        self.tabs = pn.Tabs(*views, dynamic=True, css_classes=["views"],
-                            sizing_mode="stretch_width")
+        self.tabs = OpeningTabs(*views, dynamic=True, css_classes=["views"],
+                                sizing_mode="stretch_width")
         self.names = [tab_name(title) for title, _view in views]
         self._pending: dict[tuple[str, str], tuple] = {}  # (tab, what) -> (function, args)
 
@@ -79,6 +97,11 @@ class ViewTabs:
         """One more view, in a tab of its own at the end."""
         self.tabs.append((title, view))
         self.names.append(tab_name(title))
+
+    def on_opening(self, callback) -> None:
+        """``callback()`` whenever a tab is opened, before its view's models are made (so the
+        updates it applies reach the browser with the view)."""
+        self.tabs.opening = callback
 
     @property
     def shown(self) -> str:
