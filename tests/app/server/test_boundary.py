@@ -206,14 +206,38 @@ def _status(page) -> str:
     return page.evaluate(STATUS)
 
 
-def _wait_status(page, prefix: str, timeout_ms: float = 600_000, log: Path | None = None) -> None:
+def _wait_status(page, prefix: str, timeout_ms: float = 600_000, log: Path | None = None,
+                 server_pid: int | None = None) -> None:
     """Wait until the study ends (done, failed, stopped or dropped) and check that its status
-    line starts with ``prefix`` (the line and the server log's tail in the message if not)."""
-    page.wait_for_function(f"() => /^(done|failed|stopped|dropped): /.test(({STATUS})())",
-                           timeout=timeout_ms)
-    text = _status(page)
-    tail = log.read_text(errors="replace")[-3000:] if log is not None else ""
-    assert text.startswith(prefix), f"{text!r}; server log ends:\n{tail}"
+    line starts with ``prefix``; if not, or if it has not ended within ``timeout_ms``, the
+    message gives the line, the server's processes (state, CPU seconds, niceness) and the
+    server log's tail."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    def what_the_server_shows() -> str:
+        tail = log.read_text(errors="replace")[-3000:] if log is not None else ""
+        processes = ("" if server_pid is None else "; its processes:\n" + "\n".join(
+            _process_line(pid) for pid in [server_pid, *descendants(server_pid)]))
+        return f"{_status(page)!r}{processes}\nserver log ends:\n{tail}"
+
+    try:
+        page.wait_for_function(f"() => /^(done|failed|stopped|dropped): /.test(({STATUS})())",
+                               timeout=timeout_ms)
+    except PlaywrightTimeout:
+        pytest.fail(f"the study did not end within {timeout_ms / 1000:g} s: "
+                    f"{what_the_server_shows()}")
+    assert _status(page).startswith(prefix), what_the_server_shows()
+
+
+def _process_line(pid: int) -> str:
+    """One process's state, CPU seconds (user + system), niceness and command line (Linux)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return f"{pid}: ended"
+    cpu_s = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    return (f"{pid} state {fields[0]}, {cpu_s:.1f} CPU-s, nice {fields[16]}, "
+            f"threads {fields[17]}: {_command_line(pid)}")
 
 
 def descendants(pid: int) -> list[int]:
@@ -299,7 +323,7 @@ def test_no_browser_input_makes_the_server_connect(setup, chromium, request):
         _fill(page, "study-v-points", "2")
         page.wait_for_timeout(500)
         page.locator(".study-start button").click()
-        _wait_status(page, "done: 2/2", log=setup["log"])
+        _wait_status(page, "done: 2/2", log=setup["log"], server_pid=setup["pid"])
         page.wait_for_timeout(1000)
         assert listener.connections == 0
         assert _alive(setup["url"])
@@ -632,7 +656,7 @@ def test_a_stopped_server_leaves_no_worker_behind(tmp_path, chromium):
         _fill(page, "study-s0-points", "3")
         _fill(page, "study-v-points", "2")
         page.locator(".study-start button").click()
-        _wait_status(page, "done: 2/2", log=tmp_path / "serve.log")
+        _wait_status(page, "done: 2/2", log=tmp_path / "serve.log", server_pid=process.pid)
         workers = descendants(process.pid)  # the study engine's and the background processes
         assert len(_study_processes(process.pid)) == WORKERS
         assert len(workers) > WORKERS
