@@ -79,6 +79,9 @@ STEPS = (
     Step("bundled-set", (_python("bundled_set.py"),),
          "docs/results/bundled_set.json, assets/figures/divergence_trade.png (the calibration by "
          "divergence weight, the rule's choice, the previous bundled set against the bundled one)"),
+    Step("bound-lifting", (_python("bound_lifting.py"),),
+         "docs/results/bound_lifting.json (the bundled set's calibration with each bound it sits "
+         "on moved out of the hardware range)"),
     Step("reachability", (_python("reachability.py"),),
          "docs/results/reachability.json (the reduced models of the study's contradictions)"),
     Step("response", (_python("figures_response.py"),),

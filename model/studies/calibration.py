@@ -513,7 +513,8 @@ def jacobian_stage(start: Parameters, progress: Callable = print,
     return _from_x(x, start, free)
 
 def calibrate(start: Parameters, progress: Callable = print,
-              phases: tuple = PHASES, initial: Parameters | None = None
+              phases: tuple = PHASES, initial: Parameters | None = None,
+              free: tuple[ParameterRange, ...] | None = None
               ) -> tuple[Parameters, list[TargetRow]]:
     """Stage A fits the creep law and the gear ratio to the operating data (exactly, inside
     every evaluation); stage J (:func:`jacobian_stage`) fits the creep shape, the structure, the
@@ -521,13 +522,15 @@ def calibrate(start: Parameters, progress: Callable = print,
     driving-shaft mode and the divergences, on the analytic Jacobian.  Returns the calibrated set
     and all its targets.  Deterministic: no random numbers, no time limits (run it with one BLAS
     thread, as ``bogie calibrate`` does: another thread count rounds differently).  ``initial``: the
-    set stage J starts from (default: ``start``, which is the prior either way)."""
+    set stage J starts from (default: ``start``, which is the prior either way).  ``free``: stage
+    J's parameters and their ranges (default :data:`SEARCH_PARAMETERS`; other ranges show what a
+    bound holds, ``scripts/bound_lifting.py``)."""
     stage_a = fit_operating_data(with_constraints(start))
     progress(f"  stage A: μ0 {stage_a['polach_mu0']:.5g}, A {stage_a['polach_A']:.5g}, "
              f"B {stage_a['polach_B']:.5g} s/m, p {stage_a['gear_ratio']:.5g}")
     origin = None if initial is None else fit_operating_data(with_constraints(initial))
-    fitted = fit_operating_data(with_constraints(jacobian_stage(stage_a, progress, phases=phases,
-                                                                 initial=origin)))
+    fitted = fit_operating_data(with_constraints(jacobian_stage(stage_a, progress, free=free,
+                                                                 phases=phases, initial=origin)))
     calibrated = calibrated_set(fitted.values, start)
     return calibrated, evaluate(calibrated)
 
