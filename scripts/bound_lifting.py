@@ -31,14 +31,13 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
 
-from docs_numbers import write_results  # noqa: E402
+from bundled_set import BUNDLED, START  # noqa: E402  (the bundled set's command)
+from docs_numbers import RESULTS, write_results  # noqa: E402
 
 from model import load_parameters  # noqa: E402
 from model.studies.calibration_bounds import CREEP_PARAMETERS, FREE_PARAMETERS  # noqa: E402
 
-START = ROOT / "assets" / "parameters" / "calibration_start.toml"
-BUNDLED = ROOT / "assets" / "parameters" / "calibrated.toml"
-BUNDLED_SET_RESULTS = ROOT / "docs" / "results" / "bundled_set.json"
+BUNDLED_SET_RESULTS = RESULTS / "bundled_set.json"
 SCALE_FACTOR = 3.0  # a scale parameter's bound moves out by this factor
 
 
