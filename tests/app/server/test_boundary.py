@@ -229,10 +229,17 @@ def _wait_status(page, prefix: str, timeout_ms: float = 600_000, log: Path | Non
     assert _status(page).startswith(prefix), what_the_server_shows()
 
 
+def _stat_fields(pid: int) -> list[str]:
+    """The fields of ``/proc/PID/stat`` after the command name (Linux): [0] the state, [1] the
+    parent's id, [11] and [12] user and system clock ticks, [16] the niceness, [17] the threads;
+    OSError if the process has ended."""
+    return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+
+
 def _process_line(pid: int) -> str:
     """One process's state, CPU seconds (user + system), niceness and command line (Linux)."""
     try:
-        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        fields = _stat_fields(pid)
     except OSError:
         return f"{pid}: ended"
     cpu_s = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
@@ -246,10 +253,10 @@ def descendants(pid: int) -> list[int]:
     for entry in os.listdir("/proc"):
         if entry.isdigit():
             try:
-                fields = Path(f"/proc/{entry}/stat").read_text().rsplit(")", 1)[1].split()
+                parent = int(_stat_fields(int(entry))[1])
             except OSError:
                 continue
-            children.setdefault(int(fields[1]), []).append(int(entry))
+            children.setdefault(parent, []).append(int(entry))
     found, todo = [], list(children.get(pid, []))
     while todo:
         child = todo.pop()
@@ -680,7 +687,7 @@ def _study_processes(server_pid: int) -> list[int]:
 
 def _running(pid: int) -> bool:
     try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        state = _stat_fields(pid)[0]
     except OSError:
         return False
     return state != "Z"
