@@ -27,15 +27,18 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
 
-from bundled_set import BUNDLED, START  # noqa: E402  (the bundled set's command)
+from bundled_set import BUNDLED, calibrate_at  # noqa: E402  (the bundled set's command)
 from docs_numbers import RESULTS, write_results  # noqa: E402
 
 from model import load_parameters  # noqa: E402
-from model.studies.calibration_bounds import CREEP_PARAMETERS, FREE_PARAMETERS  # noqa: E402
+from model.mechanics.parameters import ALL_SCHEMA  # noqa: E402
+from model.studies.calibration_bounds import FREE_PARAMETERS  # noqa: E402
 
 BUNDLED_SET_RESULTS = RESULTS / "bundled_set.json"
 SCALE_FACTOR = 3.0  # a scale parameter's bound moves out by this factor
@@ -55,35 +58,34 @@ def lifted_range(parameter, value: float):
 
 
 def calibrate_with(job: tuple[tuple[str, ...], float]) -> dict:
-    """The bundled set's calibration with the ranges of ``names`` lifted (one BLAS thread)."""
-    from threadpoolctl import threadpool_limits
-
-    from model.studies.calibration import PHASES, SEARCH_PARAMETERS, calibrate, with_divergence_weight
-    from model.studies.global_calibration import target_measures
+    """The bundled set's calibration with the ranges of ``names`` lifted (one BLAS thread;
+    :func:`bundled_set.calibrate_at` with those ranges, which also judge the bounds)."""
+    from model.studies.calibration import SEARCH_PARAMETERS
 
     names, weight = job
     bundled = load_parameters(BUNDLED)
     free = tuple(lifted_range(p, bundled[p.name]) if p.name in names else p
                  for p in SEARCH_PARAMETERS)
-    with threadpool_limits(1):
-        fitted, rows = calibrate(load_parameters(START), lambda _text: None,
-                                 with_divergence_weight(PHASES, weight), free=free)
-    ranges = {p.name: p for p in CREEP_PARAMETERS + free}
+    run = calibrate_at(weight, free)
+    lifted = {p.name: p for p in free}
     hardware = {p.name: p for p in FREE_PARAMETERS}
+    landed = {name: run["values"][name] for name in names}
     return {"lifted": list(names),
-            "ranges": {name: [ranges[name].low, ranges[name].high] for name in names},
+            "ranges": {name: [lifted[name].low, lifted[name].high] for name in names},
             "hardware_ranges": {name: [hardware[name].low, hardware[name].high] for name in names},
-            "landed": {name: float(fitted[name]) for name in names},
+            "landed": landed,
             "outside_hardware": [name for name in names
-                                 if not hardware[name].low <= fitted[name] <= hardware[name].high],
-            **target_measures(rows),
-            "on_bound": [name for name, p in ranges.items() if p.on_bound(fitted[name])],
-            "values": {k: float(v) for k, v in fitted.values.items()}}
+                                 if not hardware[name].low <= landed[name] <= hardware[name].high],
+            **run}
 
 
 def _value(name: str, value: float) -> str:
-    return f"{value / 1e6:.2f} MN/m" if name.endswith("stiffness") else (
-        f"{value:.3g} m" if name.endswith("height") else f"{value:.0f} kg m²")
+    """``value`` in the parameter's unit (its schema's), a large one in millions (M…)."""
+    unit = ALL_SCHEMA[name][0]
+    if abs(value) >= 1e5:
+        return f"{value / 1e6:.2f} M{unit}"
+    shown = np.format_float_positional(value, precision=3, fractional=False, trim="-")
+    return f"{shown} {unit}"
 
 
 def table_block(runs: list[dict]) -> str:

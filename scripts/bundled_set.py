@@ -48,20 +48,29 @@ KEY_LOADS = ("ID1.disc_clutch.torque", "ID1.driving_shaft.torque", "ID2.disc_clu
              "ID2.driving_shaft.torque")
 
 
-def calibrate_at(weight: float) -> dict:
-    """The calibration from the start file at one divergence weight (one BLAS thread)."""
+def calibrate_at(weight: float, free: tuple | None = None) -> dict:
+    """The calibration from the start file at one divergence weight (one BLAS thread);
+    ``free``: stage J's parameters with other ranges than the hardware's (default: those), which
+    the parameters on a bound are judged by too."""
     from threadpoolctl import threadpool_limits
 
-    from model.studies.calibration import PHASES, calibrate, with_divergence_weight
+    from model.studies.calibration import (
+        PHASES,
+        SEARCH_PARAMETERS,
+        calibrate,
+        with_divergence_weight,
+    )
+    from model.studies.calibration_bounds import CREEP_PARAMETERS
     from model.studies.calibration_targets import SUSPENSION_MODES, evaluate_by_rank
     from model.studies.global_calibration import target_measures
 
+    free = SEARCH_PARAMETERS if free is None else free
     phases = with_divergence_weight(PHASES, weight)
     with threadpool_limits(1):
-        fitted, rows = calibrate(load_parameters(START), lambda _text: None, phases)
+        fitted, rows = calibrate(load_parameters(START), lambda _text: None, phases, free=free)
         matched = evaluate_by_rank(fitted).matched
     zeta = min(-matched[k - 1].real / abs(matched[k - 1]) for k in SUSPENSION_MODES)
-    on_bound = [f.name for f in FREE_PARAMETERS if f.on_bound(fitted[f.name])]
+    on_bound = [f.name for f in CREEP_PARAMETERS + free if f.on_bound(fitted[f.name])]
     return {"weight": weight, **target_measures(rows), "suspension_zeta_min": float(zeta),
             "on_bound": on_bound, "values": {k: float(v) for k, v in fitted.values.items()}}
 
