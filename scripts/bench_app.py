@@ -117,6 +117,10 @@ async def open_page(browser, url: str):
                                  timeout=180_000)
     await page.locator(".stability-status", has_text="STABLE").wait_for(timeout=180_000)
     await page.wait_for_function(f"() => ({SLOW})().length > 0", timeout=300_000)
+    # the session's own dense locus too: else it arrives after the next change (settle_n0) and
+    # is taken for that change's locus
+    await page.wait_for_function(f"() => !({LOCUS_TITLE})().includes('computing')",
+                                 timeout=300_000)
     return page
 
 
@@ -306,24 +310,32 @@ def protocol_clients(url: str, count: int) -> None:
                     doc.get_model_by_name("response")]
             locus = [doc.get_model_by_name("locus_points")]
             s0, n0 = control("s0"), control("N0")
-            change(n0, 60.0 + index, locus)  # own wheel force [kN]: no shared cache hits
             # settled as the single session (wait_settled): the dense root locus, s0*(v) and the
-            # verdict of the new N0 shown, else the first clients' steps are measured beside the
-            # other clients' follow-ups (≈ 3 CPU-s each, the verdict's unstable and ripple
-            # cases ≈ 2 CPU-s more), not beside their steps
+            # verdict shown, else the clients' steps are measured beside the other clients'
+            # follow-ups (≈ 3 CPU-s each, the verdict's unstable and ripple cases ≈ 2 CPU-s
+            # more), not beside their steps
             title = doc.get_model_by_name("root-locus").title
 
             def settled() -> bool:
                 texts = [t for t in (getattr(m, "text", None) for m in doc.models)
                          if isinstance(t, str)]
-                return ("computing" not in title.text
+                return (len(locus[0].data.get("x", ())) > 0 and "computing" not in title.text
                         and not any("s0*(v): computing" in t or "VERDICT: computing" in t
                                     for t in texts))
-            deadline = time.perf_counter() + 300.0
-            session._connection._loop_until(
-                lambda: settled() or time.perf_counter() > deadline)
-            if not settled():
-                raise TimeoutError(f"client {index}: the new N0's follow-ups not done in 300 s")
+
+            def wait_settled() -> None:
+                deadline = time.perf_counter() + 300.0
+                session._connection._loop_until(
+                    lambda: settled() or time.perf_counter() > deadline)
+                if not settled():
+                    raise TimeoutError(f"client {index}: follow-ups not done in 300 s")
+
+            # the new session's own first results first: the locus of the default N0 arriving
+            # after the change below would be taken for the new N0's, and the clients would
+            # step while their new N0's dense locus, s0*(v) and verdict still run
+            wait_settled()
+            change(n0, 60.0 + index, locus)  # own wheel force [kN]: no shared cache hits
+            wait_settled()
             time.sleep(1.0)
         except Exception as error:  # reported; the run fails
             failures.append(repr(error))
