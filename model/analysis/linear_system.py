@@ -260,6 +260,17 @@ class LinearSystem:
                 self._cache[key] = build()
             return self._cache[key]
 
+    def last(self, name: str, key, build):
+        """``build()``, unless the last value kept under ``name`` was built for an equal ``key``:
+        then that value.  One value per name (pieces that depend on more than the system, such
+        as an excitation's, asked for several times in a row)."""
+        kept = self._cache.get(("last", name))  # (key, value): one read, safe across threads
+        if kept is not None and kept[0] == key:
+            return kept[1]
+        value = build()
+        self._cache[("last", name)] = (key, value)
+        return value
+
     @property
     def Minv(self) -> np.ndarray:
         """M_ii⁻¹: inverse of the mass matrix on the inertial coordinates (n_i x n_i)."""

@@ -197,7 +197,15 @@ class _ModalTerms:
 
 def _modal_terms(system: LinearSystem, C: np.ndarray, u0: float, a: complex,
                  mu: complex) -> _ModalTerms:
-    """The modal closed form's pieces for the outputs ``C`` (:class:`_ModalTerms`)."""
+    """The modal closed form's pieces for the outputs ``C`` (:class:`_ModalTerms`).  The last
+    ones of each system are kept: a response, its quasi-static part and its peaks' split ask
+    for the same pieces."""
+    return system.last("modal terms", (C.shape, C.tobytes(), float(u0), complex(a), complex(mu)),
+                       lambda: _modal_terms_of(system, C, u0, a, mu))
+
+
+def _modal_terms_of(system: LinearSystem, C: np.ndarray, u0: float, a: complex,
+                    mu: complex) -> _ModalTerms:
     deflation, r = system.deflation, system.rigid_count
     lam, Y, _, _, scale = system.modal  # A22 = (T Y) Λ (T Y)⁻¹, T = diag(scale)
     alpha, beta, gamma = system.step_particular(u0)
@@ -548,11 +556,20 @@ def output_rows(model: BogieModel, op: OperatingPoint, outputs: list[str] | None
     ``steady[name]`` is the pre-fault value [unit] (outputs of
     :func:`model.mechanics.outputs.output_matrices`, default all of them, or DOF names); an
     unknown name raises :class:`ResponseError`."""
+    system = bogie_system(model, op)
+    # kept with the system: the response and its peaks ask for the same rows
+    names, C, units, steady = system._get(
+        ("output rows", None if outputs is None else tuple(outputs)),
+        lambda: _output_rows(model, op, system, outputs))
+    return list(names), C, dict(units), dict(steady)
+
+
+def _output_rows(model: BogieModel, op: OperatingPoint, system: LinearSystem,
+                 outputs: list[str] | None):
     matrices = output_matrices(model, op)
     names = list(matrices.names) if outputs is None else list(outputs)
     if not names:
         raise ResponseError("no outputs requested")
-    system = bogie_system(model, op)
     rows, units, steady = [], {}, {}
     q0 = None
     for name in names:
@@ -572,7 +589,9 @@ def output_rows(model: BogieModel, op: OperatingPoint, outputs: list[str] | None
             raise ResponseError(f"unknown output '{name}': use an output name "
                                 f"({', '.join(matrices.names[:3])}, …) or a DOF name "
                                 "(e.g. ID1.rotor.ry)")
-    return names, np.array(rows), units, steady
+    C = np.array(rows)
+    C.flags.writeable = False  # shared by every caller of output_rows at this point
+    return tuple(names), C, units, steady
 
 
 def short_circuit_response(model: BogieModel, op: OperatingPoint,

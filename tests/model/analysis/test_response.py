@@ -163,3 +163,19 @@ def test_bad_excitation_is_refused_in_one_line(kwargs, word):
     with pytest.raises(ResponseError, match=word) as info:
         ShortCircuit(**kwargs)
     assert "\n" not in str(info.value)
+
+
+def test_a_systems_kept_modal_terms_follow_the_excitation():
+    """The modal terms kept with a system (a response, its quasi-static part and its peaks ask
+    for the same ones) are those of the excitation asked for, not of the one before."""
+    from model.analysis.response import _modal_terms, _modal_terms_of
+
+    system = two_mass(c_ground=0.5)
+    C = np.eye(system.N)[:2]
+    first = _modal_terms(system, C, -1.0, 0.3 + 0.1j, complex(-2.0, 40.0))
+    assert _modal_terms(system, C, -1.0, 0.3 + 0.1j, complex(-2.0, 40.0)) is first
+    other = _modal_terms(system, C, -1.0, 0.3 + 0.1j, complex(-2.0, 55.0))
+    fresh = _modal_terms_of(system, C, -1.0, 0.3 + 0.1j, complex(-2.0, 55.0))
+    np.testing.assert_array_equal(other.x_mu, fresh.x_mu)
+    np.testing.assert_array_equal(other.coef, fresh.coef)
+    assert not np.allclose(other.x_mu, first.x_mu)
