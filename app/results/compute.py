@@ -406,7 +406,9 @@ def decimate(t: np.ndarray, ys: list[np.ndarray], buckets: int = PLOT_BUCKETS):
         padded = np.concatenate([y, np.full(runs * size - n, y[-1])]).reshape(runs, size)
         picks.append(starts + padded.argmax(axis=1))
         picks.append(starts + padded.argmin(axis=1))
-    index = np.unique(np.minimum(np.concatenate(picks), n - 1))
+    kept = np.zeros(n, dtype=bool)  # the picks in time order, each once
+    kept[np.minimum(np.concatenate(picks), n - 1)] = True
+    index = np.flatnonzero(kept)
     return t[index], [y[index] for y in ys]
 
 
