@@ -41,6 +41,7 @@ from app.dashboard.session import post
 from app.dashboard.stages import MODEL_ERRORS
 from app.results.cache import Superseded
 from app.results.case import CaseBase, Sweep
+from app.services.background import held
 from app.services.thread_pools import (
     FIRST_ANSWER_POOL,
     FOLLOW_UP_POOL,
@@ -55,6 +56,10 @@ BUSY_TEXT = '<div class="busy-text">⏳ computing…</div>'
 # speed, wheel force or motor slope has moved on, or its session has ended) stops before its
 # next eigen-analysis instead of sharing the cores with the next state's root loci
 _SCHEDULERS: weakref.WeakSet = weakref.WeakSet()
+# a session's first answers, with the background worker processes paused while they run
+# (app.services.background.held)
+HELD_POINT, HELD_RESPONSE = held(stages.point), held(stages.response)
+HELD_COARSE_LOCUS = held(stages.coarse_locus)
 
 
 class LimitSuperseded(Superseded):
@@ -163,14 +168,14 @@ class Scheduler:
                 # dense one replaces it when ready.  Nothing to do if the dense locus of this
                 # sweep is on screen already
                 need_locus = dashboard.shown_locus != (sweep, True)
-                locus_future = (loop.run_in_executor(FIRST_ANSWER_POOL, stages.coarse_locus, sweep)
+                locus_future = (loop.run_in_executor(FIRST_ANSWER_POOL, HELD_COARSE_LOCUS, sweep)
                                 if need_locus else None)
                 # the fast stage in two answers: the status first (the eigen-analysis), then the
                 # short-circuit history, which shares its decomposition
                 # (the state's views are asked for their results with the first answer, in one
                 # message to the browser: state_changed)
                 try:
-                    point = await loop.run_in_executor(FIRST_ANSWER_POOL, stages.point, case)
+                    point = await loop.run_in_executor(FIRST_ANSWER_POOL, HELD_POINT, case)
                 except MODEL_ERRORS as error:
                     post(doc, self._rejected_state, case, settled, error)
                     if locus_future is not None:
@@ -178,7 +183,7 @@ class Scheduler:
                     continue
                 post(doc, self._first_answer, case, settled, point)
                 try:
-                    response = await loop.run_in_executor(FIRST_ANSWER_POOL, stages.response,
+                    response = await loop.run_in_executor(FIRST_ANSWER_POOL, HELD_RESPONSE,
                                                           case)
                 except MODEL_ERRORS as error:
                     post(doc, dashboard.reject, error)

@@ -18,6 +18,14 @@ worker processes of their own:
 * **in the calling thread** where nothing is configured (the command line, the report, tests
   without a server): :func:`run` calls the function itself.
 
+A lower priority is not enough on a small machine: a worker that runs beside the server's
+computation still takes memory bandwidth and the core's other hardware thread.  So while any
+session's first answer is computed (:func:`held`, around the eigen-analysis, the response and the
+coarse root locus), the local workers are paused (SIGSTOP) and they go on (SIGCONT) as soon as no
+first answer runs (one page among nine protocol clients: BENCHMARKS.md).  The work of an idle
+review goes on at once; under a review group's steady changes it waits for the gaps between
+their first answers.
+
 :func:`run` blocks the calling (worker) thread until the answer is back; ``stop`` — a callable
 that raises when the answer is no longer wanted — is asked every :data:`POLL_S` seconds, and the
 running function sees it at its next :func:`checkpoint` (a flag in shared memory, one slot per
@@ -150,9 +158,17 @@ class LocalWorkers:
     def pids(self) -> list[int]:
         """The ids of the worker processes that run now (for the memory and reliability
         checks)."""
-        with self._started.get_lock():
-            recorded = [pid for pid in self._started if pid]
+        # read without the array's lock: a worker paused while it records its id holds it
+        recorded = [pid for pid in self._started.get_obj() if pid]
         return sorted(pid for pid in recorded if _alive(pid))
+
+    def signal_workers(self, signal_number: int) -> None:
+        """Send ``signal_number`` to every worker process (pause: SIGSTOP, go on: SIGCONT)."""
+        for pid in self.pids():
+            try:
+                os.kill(pid, signal_number)
+            except OSError:  # ended meanwhile
+                pass
 
     def _take_slot(self) -> int:
         with self._slot_free:
@@ -208,16 +224,12 @@ class LocalWorkers:
                     raise
 
     def close(self) -> None:
-        """Stop the worker processes at once (the server is stopping)."""
+        """Stop the worker processes at once (the server is stopping; a paused one too)."""
         with self._lock:
             pool, self._pool = self._pool, None
         if pool is None:
             return
-        for pid in self.pids():
-            try:
-                os.kill(pid, signal.SIGKILL)
-            except OSError:  # ended meanwhile
-                pass
+        self.signal_workers(signal.SIGKILL)
         pool.shutdown(wait=False, cancel_futures=True)
 
 
@@ -293,6 +305,34 @@ def configure(workers: LocalWorkers | ClusterWorkers | None) -> LocalWorkers | C
 
 def current() -> LocalWorkers | ClusterWorkers | None:
     return _workers
+
+
+_holds = 0  # first answers computing now (held)
+_holds_lock = threading.Lock()
+
+
+def _hold(change: int) -> None:
+    """One more (``change`` 1) or one fewer (−1) first answer computing: the local workers pause
+    when the first one starts and go on when the last one ends."""
+    global _holds
+    with _holds_lock:
+        _holds += change
+        edge = (_holds == 1 and change > 0) or (_holds == 0 and change < 0)
+        workers = _workers
+        if edge and isinstance(workers, LocalWorkers):
+            workers.signal_workers(signal.SIGSTOP if _holds else signal.SIGCONT)
+
+
+def held(function: Callable) -> Callable:
+    """``function`` with the local workers paused while it runs (a session's first answer: it
+    has the cores to itself and the server's other threads)."""
+    def run_held(*args, **kwargs):
+        _hold(1)
+        try:
+            return function(*args, **kwargs)
+        finally:
+            _hold(-1)
+    return run_held
 
 
 def run(function: Callable, *args, stop: Callable | None = None):

@@ -6,7 +6,9 @@ seen at the same checkpoints."""
 from __future__ import annotations
 
 import os
+import threading
 import time
+from pathlib import Path
 
 import pytest
 
@@ -95,3 +97,66 @@ def test_without_workers_the_calling_thread_runs_it_and_sees_the_stop():
 
     with pytest.raises(NoLongerWanted):
         background.run(count_checkpoints, 5.0, stop=stop)
+
+
+def _states(pids: list[int]) -> set[str]:
+    """The processes' scheduling states (R running, S sleeping, T stopped …: /proc/PID/stat)."""
+    return {Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] for pid in pids}
+
+
+def _paused(pids: list[int], paused: bool, within: float = 5.0) -> bool:
+    """Whether every one of ``pids`` is stopped (``paused``) or none is, within ``within`` s (a
+    signal is delivered a moment after ``kill`` returns)."""
+    deadline = time.monotonic() + within
+    while True:
+        states = _states(pids)
+        if (states == {"T"}) if paused else ("T" not in states):
+            return True
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.005)
+
+
+def test_the_workers_pause_while_a_first_answer_runs(workers):
+    """held(f): the local workers are stopped (SIGSTOP) while f runs, nested or side by side,
+    and go on (SIGCONT) when the last one ends; a task handed to them meanwhile is answered
+    after that; an error inside f leaves them going on."""
+    pids = workers.pids()
+    previous = background.configure(workers)
+    try:
+        seen = {}
+
+        def inner():
+            seen["inner"] = _paused(pids, True)
+
+        def outer():
+            seen["before"] = _paused(pids, True)
+            background.held(inner)()
+            seen["after inner"] = _paused(pids, True, within=0.0)  # the outer one still runs
+            return "answer"
+
+        assert background.held(outer)() == "answer"
+        assert seen == {"before": True, "inner": True, "after inner": True}
+        assert _paused(pids, False)
+        # a task given to the paused workers ends once they go on
+        result = {}
+
+        def ask():
+            result["pid"] = background.run(whoami)[0]
+
+        def first_answer():
+            asking = threading.Thread(target=ask)
+            asking.start()
+            asking.join(timeout=1.0)
+            result["during"] = "pid" in result
+            return asking
+
+        asking = background.held(first_answer)()
+        asking.join(timeout=30.0)
+        assert result["during"] is False
+        assert result["pid"] in pids
+        with pytest.raises(ValueError, match="refused"):
+            background.held(fail)("refused")
+        assert _paused(pids, False)
+    finally:
+        background.configure(previous)
