@@ -56,10 +56,6 @@ BUSY_TEXT = '<div class="busy-text">⏳ computing…</div>'
 # speed, wheel force or motor slope has moved on, or its session has ended) stops before its
 # next eigen-analysis instead of sharing the cores with the next state's root loci
 _SCHEDULERS: weakref.WeakSet = weakref.WeakSet()
-# a session's first answers, with the background worker processes paused while they run
-# (app.services.background.held)
-HELD_POINT, HELD_RESPONSE = held(stages.point), held(stages.response)
-HELD_COARSE_LOCUS = held(stages.coarse_locus)
 
 
 class LimitSuperseded(Superseded):
@@ -168,14 +164,16 @@ class Scheduler:
                 # dense one replaces it when ready.  Nothing to do if the dense locus of this
                 # sweep is on screen already
                 need_locus = dashboard.shown_locus != (sweep, True)
-                locus_future = (loop.run_in_executor(FIRST_ANSWER_POOL, HELD_COARSE_LOCUS, sweep)
+                locus_future = (loop.run_in_executor(FIRST_ANSWER_POOL, held(stages.coarse_locus),
+                                                     sweep)
                                 if need_locus else None)
                 # the fast stage in two answers: the status first (the eigen-analysis), then the
-                # short-circuit history, which shares its decomposition
+                # short-circuit history, which shares its decomposition; the first answers run
+                # with the background worker processes paused (app.services.background.held)
                 # (the state's views are asked for their results with the first answer, in one
                 # message to the browser: state_changed)
                 try:
-                    point = await loop.run_in_executor(FIRST_ANSWER_POOL, HELD_POINT, case)
+                    point = await loop.run_in_executor(FIRST_ANSWER_POOL, held(stages.point), case)
                 except MODEL_ERRORS as error:
                     post(doc, self._rejected_state, case, settled, error)
                     if locus_future is not None:
@@ -183,7 +181,7 @@ class Scheduler:
                     continue
                 post(doc, self._first_answer, case, settled, point)
                 try:
-                    response = await loop.run_in_executor(FIRST_ANSWER_POOL, HELD_RESPONSE,
+                    response = await loop.run_in_executor(FIRST_ANSWER_POOL, held(stages.response),
                                                           case)
                 except MODEL_ERRORS as error:
                     post(doc, dashboard.reject, error)
