@@ -18,8 +18,8 @@ worker processes of their own:
 * **in the calling thread** where nothing is configured (the command line, the report, tests
   without a server): :func:`run` calls the function itself.
 
-A lower priority is not enough on a small machine: a worker that runs beside the server's
-computation still takes memory bandwidth and the core's other hardware thread.  So while any
+A lower priority is not enough on a small machine: at niceness 10 the workers still took a
+third of two cores beside a review group's steps and slowed the answers.  So while any
 session's first answer is computed (:func:`held`, around the eigen-analysis, the response and the
 coarse root locus), the local workers are paused (SIGSTOP) and they go on (SIGCONT) as soon as no
 first answer runs (one page among nine protocol clients: BENCHMARKS.md).  The work of an idle
@@ -324,8 +324,8 @@ def _hold(change: int) -> None:
 
 
 def held(function: Callable) -> Callable:
-    """``function`` with the local workers paused while it runs (a session's first answer: it
-    has the cores to itself and the server's other threads)."""
+    """``function`` with the local workers paused while it runs (a session's first answer: the
+    cores are the server's while it is computed)."""
     def run_held(*args, **kwargs):
         _hold(1)
         try:

@@ -260,6 +260,11 @@ class LinearSystem:
                 self._cache[key] = build()
             return self._cache[key]
 
+    def kept(self, key, build):
+        """``build()`` once per system and ``key`` (pieces that depend on the system and a few
+        settings, such as the rows of a list of outputs)."""
+        return self._get(("kept", key), build)
+
     def last(self, name: str, key, build):
         """``build()``, unless the last value kept under ``name`` was built for an equal ``key``:
         then that value.  One value per name (pieces that depend on more than the system, such

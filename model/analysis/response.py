@@ -558,7 +558,7 @@ def output_rows(model: BogieModel, op: OperatingPoint, outputs: list[str] | None
     unknown name raises :class:`ResponseError`."""
     system = bogie_system(model, op)
     # kept with the system: the response and its peaks ask for the same rows
-    names, C, units, steady = system._get(
+    names, C, units, steady = system.kept(
         ("output rows", None if outputs is None else tuple(outputs)),
         lambda: _output_rows(model, op, system, outputs))
     return list(names), C, dict(units), dict(steady)
