@@ -1,7 +1,7 @@
 """The numbers, table and figure of docs/validation.md's "The bundled set": how the bundled set
 was chosen and what changed for a design review against the previous bundled set.
 
-    OPENBLAS_NUM_THREADS=1 .venv/bin/python scripts/bundled_set.py [--workers 2]
+    .venv/bin/python scripts/bundled_set.py [--workers 2]  # runs itself with pinned numerics
         # docs/results/bundled_set.json, assets/figures/divergence_trade.png (≈ 8 min on 2 cores)
 
 1. **The trade.** ``bogie calibrate --from assets/parameters/calibration_start.toml
@@ -46,6 +46,25 @@ FREQUENCY_TOLERANCE, DIVERGENCE_TOLERANCE = 0.05, 0.10  # tests/literature/test_
 BOGIE = [sys.executable, "-m", "app"]
 KEY_LOADS = ("ID1.disc_clutch.torque", "ID1.driving_shaft.torque", "ID2.disc_clutch.torque",
              "ID2.driving_shaft.torque")
+
+
+def pin_numerics() -> None:
+    """Run this script again with the calibration's numerics pinned
+    (:mod:`model.studies.numerics`), as ``bogie calibrate`` does: its calibrations then write
+    the bundled set's bytes on any x86-64 processor with AVX2."""
+    import os
+
+    from model.studies.numerics import description, is_pinned, reproducible_environment
+
+    if is_pinned(os.environ):
+        return
+    environment = reproducible_environment(os.environ)
+    if environment is None:
+        print("this processor cannot take the pinned numerics: the calibrations' last digits "
+              "are its own", file=sys.stderr, flush=True)
+        return
+    print(f"numerics pinned ({description()})", file=sys.stderr, flush=True)
+    os.execve(sys.executable, [sys.executable, *sys.orig_argv[1:]], environment)
 
 
 def calibrate_at(weight: float, free: tuple | None = None) -> dict:
@@ -177,6 +196,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2, help="processes for the calibrations")
     args = parser.parse_args()
+    pin_numerics()
     with ProcessPoolExecutor(args.workers) as pool:
         trade = list(pool.map(calibrate_at, WEIGHTS))
     chosen = chosen_weight(trade)

@@ -20,11 +20,18 @@ writes its set: the same bytes the global search writes when K is its best (the 
 weighs the two divergence rates at s0 = 0.014 in the last phase (default 1): the knob of the
 trade between Table 1's frequencies and the divergence (docs/validation.md).  Bad input: one line on stderr,
 exit status 2.
+
+The command runs itself again with its numerics pinned (:mod:`model.studies.numerics`: OpenBLAS's
+Haswell kernels on one thread, NumPy's loops without AVX-512), so that it writes the same bytes
+on every x86-64 processor with AVX2 (given the same NumPy and SciPy releases); the local
+cluster's workers inherit the pins.  A cluster reached by ``--scheduler`` runs in its workers'
+own environment.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from app.cli.options import (
@@ -107,6 +114,7 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
                          f"default set is {CALIBRATED_FILE.relative_to(CALIBRATED_FILE.parents[2])})")
     start = Path(args.from_file) if args.from_file else ESTIMATE_FILE
     out = writable_path(args.out, "--out")
+    _pin_numerics(args)
     if out.resolve() == CALIBRATED_FILE.resolve():
         print(f"bogie calibrate: replacing the bundled default set {CALIBRATED_FILE}", file=sys.stderr)
     from model.studies.calibration import PHASES, with_divergence_weight
@@ -123,6 +131,7 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
         _global(args, start, out, phases, progress)
         return
     from model.studies.global_calibration import run_start, write_start
+    from model.studies.numerics import in_effect
 
     k = 0 if args.start is None else args.start  # without --start: start 0, the file's own values
     progress(f"calibrating from start {k} of the global calibration"
@@ -133,12 +142,33 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
     rows, table = write_start(result, out, start, args.divergence_weight)
     progress(f"wrote {out}")
     emit(args, {"out": str(out), "start": k, "cost": result.cost,
-                "targets": _rows_json(rows)}, table)
+                "targets": _rows_json(rows), "numerics": in_effect()}, table)
+
+
+def _pin_numerics(args: argparse.Namespace) -> None:
+    """Run this command again in the pinned environment (before any work; NumPy's dispatch is
+    chosen when it is imported, so the pins need a new process).  Only a command of its own:
+    a call of :func:`app.cli.main.main` from Python runs in its caller's numerics."""
+    from model.studies.numerics import description, is_pinned, reproducible_environment
+
+    if not getattr(args, "command_line", False) or is_pinned(os.environ):
+        return
+    environment = reproducible_environment(os.environ)
+    if environment is None:
+        print("bogie calibrate: this processor cannot take the pinned numerics (x86-64 with AVX2 "
+              "and FMA): the values written may differ in their last digits from another "
+              "machine's", file=sys.stderr, flush=True)
+        return
+    print(f"bogie calibrate: numerics pinned for reproducible bytes ({description()})",
+          file=sys.stderr, flush=True)
+    sys.stdout.flush()
+    os.execve(sys.executable, [sys.executable, *sys.orig_argv[1:]], environment)
 
 
 def _global(args, start, out, phases, progress) -> None:
     from app.cli.runs import study_engine
     from model.studies.global_calibration import global_search, write_start
+    from model.studies.numerics import in_effect
 
     def done(result) -> None:
         if result.failed:
@@ -154,5 +184,6 @@ def _global(args, start, out, phases, progress) -> None:
     best = next(r for r in result.results if r.index == result.best)
     rows, table = write_start(best, out, start, args.divergence_weight)
     progress(f"wrote {out} (start {result.best})")
-    data = {"out": str(out), **result.as_dict(), "targets": _rows_json(rows)}
+    data = {"out": str(out), **result.as_dict(), "targets": _rows_json(rows),
+            "numerics": in_effect()}  # this process's; the local cluster's workers inherit it
     emit(args, data, starts_table(result) + "\n\nbest start's targets:\n" + table)

@@ -51,6 +51,7 @@ def main(argv: list[str] | None = None) -> int:
 
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.command_line = argv is None  # a process of its own (may run itself again), not a call
     try:
         with threadpool_limits(1):  # dense 200-400 sized problems: one BLAS thread is fastest
             args.func(args)

@@ -29,9 +29,10 @@ Jacobian from the eigenvalue sensitivities of :mod:`model.analysis.sensitivity` 
 matrices, ``dλ/dp = −yᴴ(λ²M′ + λB′ + K′)x / yᴴ(2λM + B)x``), checked against finite differences
 in the tests.  Its phases (:data:`PHASES`) fit the characters' frequencies first, then all
 targets; it takes about a minute.  Everything is deterministic (no random numbers, no time
-limits, one BLAS thread): on one machine ``bogie calibrate`` writes the same file every time;
-``scripts/bench_calibration.py`` compares it with ``assets/parameters/calibrated.toml`` (another
-machine's floating-point kernels can move the last digits, BENCHMARKS.md).
+limits, one BLAS thread), and ``bogie calibrate`` pins the libraries' kernels
+(:mod:`model.studies.numerics`), so that it writes the same file on every x86-64 processor with
+AVX2 given the same NumPy and SciPy releases; ``scripts/bench_calibration.py`` compares it with
+``assets/parameters/calibrated.toml``.
 
 The published targets and how a set is judged against them live in
 :mod:`model.studies.calibration_targets`, the free parameters and their bounds in

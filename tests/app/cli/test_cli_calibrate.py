@@ -5,12 +5,21 @@ least squares on a budget of one trial set per phase)."""
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 
 import pytest
 from test_cli import run
 
 from model.studies import global_calibration as gc
 from model.studies.calibration_bounds import SEARCH_PARAMETERS
+from model.studies.numerics import (
+    BLAS_KERNELS,
+    disabled_numpy_targets,
+    pinnable,
+    pinned_values,
+)
 
 
 @pytest.fixture
@@ -120,3 +129,54 @@ def test_the_single_calibration_is_start_0(capsys, tmp_path):
     assert code == 0, err
     assert single.read_bytes() == alone.read_bytes()
     assert "(the same as `--start 0`)" in single.read_text(encoding="utf-8")
+
+
+def _calibrate_process(out, environment: dict) -> subprocess.CompletedProcess:
+    """``python -m app calibrate --start 0`` on a budget of one trial set per phase, as its own
+    process started with ``environment`` (added to this one's, less the pins' variables)."""
+    base = {k: v for k, v in os.environ.items()
+            if k not in pinned_values() and not k.startswith("OPENBLAS_")}
+    return subprocess.run([sys.executable, "-m", "app", "calibrate", "--start", "0",
+                           "--max-evaluations", "1", "--out", str(out), "--json"],
+                          capture_output=True, text=True, timeout=300, check=False,
+                          env={**base, **environment})
+
+
+@pytest.mark.slow
+def test_the_command_pins_its_numerics_and_writes_the_same_bytes_from_any_environment(tmp_path):
+    """Started with OpenBLAS's Sandybridge kernels on two threads, or with the libraries'
+    own choice for this processor, the command runs itself again with the pins
+    (model.studies.numerics) and writes the same bytes; unpinned, these two write different
+    values in their last digits (measured: one trial set per phase is enough).  A processor
+    that cannot take the pins is told so on stderr."""
+    first, second = tmp_path / "sandybridge.toml", tmp_path / "native.toml"
+    runs = [_calibrate_process(first, {"OPENBLAS_CORETYPE": "Sandybridge",
+                                       "OPENBLAS_NUM_THREADS": "2"}),
+            _calibrate_process(second, {})]
+    for done in runs:
+        assert done.returncode == 0, done.stderr
+    if not pinnable():
+        assert all("cannot take the pinned numerics" in done.stderr for done in runs)
+        return
+    for done in runs:
+        assert "numerics pinned for reproducible bytes" in done.stderr
+        numerics = json.loads(done.stdout)["numerics"]
+        assert numerics["blas"], numerics
+        assert all(blas["kernels"] == BLAS_KERNELS and blas["threads"] == 1
+                   for blas in numerics["blas"]), numerics
+        assert not set(numerics["numpy_targets"]) & set(disabled_numpy_targets()), numerics
+    assert first.read_bytes() == second.read_bytes()
+
+
+def test_the_pins_name_numpys_targets_above_avx2():
+    """NumPy 2.4's grouped targets and NumPy 1.x's single features: the AVX-512 family is
+    disabled, AVX2's level kept; processors without AVX2 and FMA, or not x86-64, take no pins."""
+    assert disabled_numpy_targets(["X86_V3", "X86_V4", "AVX512_ICL", "AVX512_SPR"]) == [
+        "X86_V4", "AVX512_ICL", "AVX512_SPR"]
+    assert disabled_numpy_targets(["SSE42", "AVX2", "FMA3", "AVX512F", "AVX512_SKX"]) == [
+        "AVX512F", "AVX512_SKX"]
+    assert "NPY_DISABLE_CPU_FEATURES" not in pinned_values(["SSE42", "AVX2"])
+    assert pinned_values([])["OPENBLAS_CORETYPE"] == "Haswell"
+    assert not pinnable({"AVX2": True, "FMA3": True}, "aarch64")
+    assert not pinnable({"AVX2": False, "FMA3": True}, "x86_64")
+    assert pinnable({"AVX2": True, "FMA3": True}, "x86_64")
