@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.fft
@@ -454,7 +455,6 @@ class ResponseResult:
     peak_times: dict[str, float]  # name -> its time [s]
     perturbation_peaks: dict[str, float]  # name -> signed Δy of largest magnitude [units]
     perturbation_peak_times: dict[str, float]  # name -> its time [s]
-    dominant_frequencies: dict[str, tuple[float, ...]]  # name -> spectral peaks of Δy [Hz]
     limit_crossings: list[LimitCrossing]  # totals beyond physical limits, by time
     limits: dict[str, float]  # "M_ad" [N m], "M_ad/p" [N m], "mu_max N0" [N]
     operating_point: OperatingPoint
@@ -467,6 +467,17 @@ class ResponseResult:
     error_estimate: float
     truncated_at: float | None  # [s] if the grid was cut to avoid overflow (growth)
     highest_excited_hz: float | None  # max(f, highest mode with > 1 % of an output) [Hz]
+
+    @cached_property
+    def dominant_frequencies(self) -> dict[str, tuple[float, ...]]:
+        """name -> the strongest spectral peaks of Δy [Hz], strongest first
+        (:func:`dominant_frequencies`; computed when first asked: the dashboard shows none)."""
+        if not self.outputs:
+            return {}
+        fs = 1.0 / (self.t[1] - self.t[0]) if len(self.t) > 1 else 1.0
+        names = list(self.outputs)
+        y = np.column_stack([self.outputs[name] - self.steady[name] for name in names])
+        return dict(zip(names, dominant_frequencies(y, fs), strict=True))
 
     @property
     def nyquist_ok(self) -> bool:
@@ -628,7 +639,6 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
     t = np.arange(valid) * dt
     yT = np.ascontiguousarray(y.T)  # p x valid
     totals = {name: yT[j] + steady[name] for j, name in enumerate(names)}
-    freqs = dict(zip(names, dominant_frequencies(y, fs), strict=True))
     M_ad = adhesion_moment(model.parameters, op.v, op.N0)
     _, mu_max = creep_law(model.parameters, op.N0).maximum(op.v)
     limits = {"M_ad": M_ad, "M_ad/p": M_ad / model.parameters["gear_ratio"],
@@ -639,7 +649,7 @@ def short_circuit_response(model: BogieModel, op: OperatingPoint,
         peaks=found.peaks, peak_times=found.peak_times,
         perturbation_peaks=found.perturbation_peaks,
         perturbation_peak_times=found.perturbation_peak_times,
-        dominant_frequencies=freqs, limit_crossings=found.limit_crossings, limits=limits,
+        limit_crossings=found.limit_crossings, limits=limits,
         operating_point=op, excitation=excitation, phase_shift=excitation.shift(step),
         motor_torque=step, method=used, error_estimate=estimate,
         truncated_at=None if valid == n_points else float(t[-1]),
