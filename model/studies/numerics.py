@@ -5,8 +5,8 @@ the calibrated values by up to about 1e-5 relative between two x86-64 processors
 libraries choose their kernels by the processor they find.
 
 * OpenBLAS (NumPy's and SciPy's) picks its kernels by the processor; ``OPENBLAS_CORETYPE``
-  fixes them (Haswell: AVX2 and FMA, which every x86-64 processor of the last decade has), and
-  one BLAS thread fixes the split of its sums.
+  fixes them (Haswell's: AVX2 and FMA, which the server and desktop x86-64 processors of the last
+  decade have; :func:`pinnable` checks), and one BLAS thread fixes the split of its sums.
 * NumPy dispatches its loops (``exp``, ``sin``, reductions …) to AVX-512 versions where the
   processor has them; ``NPY_DISABLE_CPU_FEATURES`` keeps them at the AVX2 level.
 
