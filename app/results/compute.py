@@ -204,7 +204,7 @@ def point_result(case: CaseBase) -> PointResult:
     def compute() -> PointResult:
         m = model_for(point)
         op = point.operating_point()
-        result = eigen_analysis(m, op)
+        result = eigen_analysis(m, op, vectors="on_demand")  # the table's modes' vectors only
         modes = [_mode(m, result, int(i), number)
                  for number, i in enumerate(result.complex_index[:N_COMPLEX_TABLE], start=1)]
         law = creep_law(m.parameters, op.N0)
@@ -234,7 +234,7 @@ def mode_near(case: CaseBase, re: float, im: float) -> Mode:
 
     def compute() -> Mode:
         m = model_for(point)
-        result = eigen_analysis(m, point.operating_point())
+        result = eigen_analysis(m, point.operating_point(), vectors="on_demand")
         index = int(np.argmin(np.abs(result.eigenvalues - complex(re, im))))
         ranks = {int(i): k for k, i in enumerate(result.complex_index, start=1)}
         return _mode(m, result, index, ranks.get(index, 0))

@@ -14,8 +14,10 @@ with vectors is shared with the short-circuit response through :func:`bogie_syst
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Literal
 
 import numpy as np
 
@@ -89,6 +91,12 @@ class EigenResult:
     vectors: np.ndarray | None  # state eigenvectors (N x len(eigenvalues)), [Δq; Δq̇_inertial]
     n_rigid: int  # identified rigid-body zero eigenvalues
     n_coordinates: int  # n: the first n rows of a state vector are Δq
+    # where ``vectors`` is None: the state eigenvectors of the given indices, computed when a
+    # mode's shape is asked (eigen_analysis(..., vectors="on_demand"); it keeps the decomposed
+    # system alive while the result lives), and the shapes computed so far
+    vectors_of: Callable[[np.ndarray], np.ndarray] | None = field(
+        default=None, repr=False, compare=False)
+    _shapes: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def complex_index(self) -> np.ndarray:
@@ -145,9 +153,15 @@ class EigenResult:
 
     def mode_shape(self, index: int) -> np.ndarray:
         """Displacement part Δq of eigenvector ``index``, scaled to unit largest entry."""
-        if self.vectors is None:
+        if self.vectors is not None:
+            q = self.vectors[:self.n_coordinates, index]
+        elif self.vectors_of is not None:
+            index = int(index)
+            if index not in self._shapes:
+                self._shapes[index] = self.vectors_of(np.array([index]))[:self.n_coordinates, 0]
+            q = self._shapes[index]
+        else:
             raise ValueError("eigenvectors were not computed")
-        q = self.vectors[:self.n_coordinates, index]
         return q / q[np.argmax(np.abs(q))]
 
 
@@ -196,12 +210,16 @@ def forget_systems(model: BogieModel) -> None:
     model.__dict__.pop("_running_systems", None)
 
 
-def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) -> EigenResult:
+def eigen_analysis(model: BogieModel, op: OperatingPoint,
+                   vectors: bool | Literal["on_demand"] = True) -> EigenResult:
     """All eigenvalues (and eigenvectors) at ``op`` with the rigid-body ones deflated.
 
     With ``vectors`` the decomposition is cached for the operating point (the response reuses
     it); without, a point already decomposed is not decomposed again, and a new one is not cached
     (root finding and sweeps would only evict the points the user is looking at).
+    ``vectors="on_demand"``: decomposed and cached as with True, but the state eigenvectors are
+    formed only for the modes whose shape is asked (:meth:`EigenResult.mode_shape`;
+    ``vectors`` None): a table of ten modes does not pay for all of them.
 
     Example::
 
@@ -222,4 +240,7 @@ def eigen_analysis(model: BogieModel, op: OperatingPoint, vectors: bool = True) 
             system = bogie_system(model, op, cached=False)
         return EigenResult(op, system.eigenvalues(), None, n_rigid, model.n)
     system = bogie_system(model, op)
+    if vectors == "on_demand":
+        return EigenResult(op, system.eigen[0], None, n_rigid, model.n,
+                           vectors_of=system.state_vectors)
     return EigenResult(op, system.eigen[0], system.state_vectors(), n_rigid, model.n)

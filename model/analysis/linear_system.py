@@ -472,10 +472,14 @@ class LinearSystem:
         _count_dense()
         return sla.eigvals(self.reduced[1], overwrite_a=False, check_finite=False)
 
-    def state_vectors(self) -> np.ndarray:
+    def state_vectors(self, columns: np.ndarray | None = None) -> np.ndarray:
         """Unit eigenvectors x = Q1 (λ − N)⁻¹ A12 y + Q2 y of A for the eigenvalues of
-        :attr:`eigen` (N x N − r); (λ − N)⁻¹ = (I + N/λ)/λ since N² = 0."""
+        :attr:`eigen` (N x N − r; ``columns``: only those, N x len(columns)); (λ − N)⁻¹ =
+        (I + N/λ)/λ since N² = 0."""
         lam, Yb, scale = self.eigen
+        if columns is not None:
+            columns = np.asarray(columns, dtype=int)
+            lam, Yb = lam[columns], Yb[:, columns]
         Y = Yb * scale[:, None]
         rigid = (self.reduced[0] @ Y) / lam
         rigid = rigid + (self.rigid_block @ rigid) / lam

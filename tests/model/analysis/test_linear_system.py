@@ -105,6 +105,29 @@ def _random_system(n: int = 190, seed: int = 3) -> LinearSystem:
     return LinearSystem(M, B, K, rng.standard_normal(n), np.zeros((n, 0)))
 
 
+
+def test_on_demand_vectors_are_the_full_vectors_columns():
+    """``eigen_analysis(..., vectors="on_demand")``: the same eigenvalues (the same cached
+    decomposition), no vector matrix, and each asked mode's shape equal to the full vectors'
+    (rounding: the columns' products are formed alone, 1e-12 of the shape's largest entry);
+    a mode asked twice is formed once."""
+    parameters = load_parameters()
+    model = build_model(parameters)
+    op = default_operating_point(parameters, 0.007, 140.0)
+    full = eigen_analysis(model, op)
+    lazy = eigen_analysis(model, op, vectors="on_demand")
+    assert lazy.vectors is None
+    assert lazy.eigenvalues is full.eigenvalues
+    indices = [int(i) for i in full.complex_index[:10]] + [int(full.real_index[0])]
+    for index in indices:
+        assert np.abs(lazy.mode_shape(index) - full.mode_shape(index)).max() <= 1e-12
+    assert sorted(lazy._shapes) == sorted(indices)
+    shape = lazy._shapes[indices[0]]
+    lazy.mode_shape(indices[0])
+    assert lazy._shapes[indices[0]] is shape
+    with pytest.raises(ValueError, match="not computed"):
+        eigen_analysis(model, op, vectors=False).mode_shape(indices[0])
+
 def test_concurrent_solves_with_the_cached_factors_are_exact():
     """Sessions of the dashboard solve with one cached LU of the eigenvectors at once.  SciPy's
     getrs wrapper shifts the pivot array in place; with a shared pivot array this test aborted
