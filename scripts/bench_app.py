@@ -22,7 +22,8 @@ Starts ``bogie serve`` on a free port (a separate process, as users run it), the
    they are done (a reviewer who looks at the new speed's results first);
 3. ``--sessions`` pages at once, each with its own wheel force N0 (so no session profits from
    another's cache), pressing s0 steps at random moments (0.3–1.5 s apart);
-4. the same number of sessions, but only one of them a Chromium page (measured as in 3) and the
+4. the same page's s0 steps alone (as in 3, before any other session connects: the reference),
+   then the same number of sessions, but only one of them a Chromium page (measured as in 3) and the
    others *protocol clients*: Bokeh's Python client (``bokeh.client``) in a separate process,
    one thread per session, changing s0 exactly as a page does (new ``value_throttled``, own
    N0) and waiting for the same two results, but drawing nothing.  On this 2-core machine ten
@@ -522,15 +523,20 @@ async def pages_at_once(browser, url: str, args, results: dict) -> None:
 
 
 async def page_among_clients(browser, url: str, args, results: dict) -> None:
-    """4: one Chromium page among ``args.sessions − 1`` protocol clients."""
+    """4: one Chromium page among ``args.sessions − 1`` protocol clients, and the same page's
+    steps alone first (the same protocol and count, before the clients connect): the ratio's
+    reference."""
+    page = await open_page(browser, url)
+    await settle_n0(page, 2 + args.sessions)  # an N0 no other session has
+    await wait_settled(page)
+    log(f"1 page alone: {args.mixed_presses} s0 steps")
+    results["alone_page_s"] = await session(page, 98, args.mixed_presses)
+    await wait_settled(page)  # its follow-ups done, as the clients' before they step
     log(f"1 page + {args.sessions - 1} protocol clients: connecting")
     load = subprocess.Popen([sys.executable, __file__, "--protocol-clients", url,
                              "--sessions", str(args.sessions - 1)],
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
     try:
-        page = await open_page(browser, url)
-        await settle_n0(page, 2 + args.sessions)  # an N0 no other session has
-        await wait_settled(page)
         line = await asyncio.to_thread(load.stdout.readline)
         if line.strip() != "ready":
             raise SystemExit(f"bench_app: protocol clients failed: {line.strip()}")
@@ -648,10 +654,15 @@ def report_pages_at_once(results: dict, sessions: int, single: float) -> None:
 
 def report_page_among_clients(results: dict, sessions: int, single: float) -> None:
     mixed = statistics.median(results["mixed_page_s"])
+    alone = statistics.median(results["alone_page_s"])
     clients = results["mixed_clients_s"]
+    print(f"1 page alone (the same steps before the clients connect): median "
+          f"{alone * 1e3:.0f} ms (n = {len(results['alone_page_s'])}, "
+          f"max {max(results['alone_page_s']) * 1e3:.0f})")
     print(f"1 page + {sessions - 1} protocol clients: page median {mixed * 1e3:.0f} ms "
           f"(n = {len(results['mixed_page_s'])}, max {max(results['mixed_page_s']) * 1e3:.0f}) "
-          f"= {mixed / single:.2f} x single; clients median "
+          f"= {mixed / alone:.2f} x alone ({mixed / single:.2f} x the single session's "
+          f"back-to-back steps); clients median "
           f"{statistics.median(clients) * 1e3:.0f} ms (n = {len(clients)})")
     cpu = results["mixed_cpu"]
     print(f"  during it ({cpu['wall_s']:.1f} s): server {cpu['server_cpu_s']:.1f} CPU-s, its "
