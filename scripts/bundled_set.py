@@ -49,22 +49,12 @@ KEY_LOADS = ("ID1.disc_clutch.torque", "ID1.driving_shaft.torque", "ID2.disc_clu
 
 
 def pin_numerics() -> None:
-    """Run this script again with the calibration's numerics pinned
-    (:mod:`model.studies.numerics`), as ``bogie calibrate`` does: its calibrations then write
-    the bundled set's bytes on any x86-64 processor with AVX2."""
-    import os
+    """Run this script again with the calibration's numerics pinned, as ``bogie calibrate``
+    does (:func:`app.cli.calibrate.run_pinned`): its calibrations then write the bundled set's
+    bytes on any x86-64 processor with AVX2."""
+    from app.cli.calibrate import run_pinned
 
-    from model.studies.numerics import description, is_pinned, reproducible_environment
-
-    if is_pinned(os.environ):
-        return
-    environment = reproducible_environment(os.environ)
-    if environment is None:
-        print("this processor cannot take the pinned numerics: the calibrations' last digits "
-              "are its own", file=sys.stderr, flush=True)
-        return
-    print(f"numerics pinned ({description()})", file=sys.stderr, flush=True)
-    os.execve(sys.executable, [sys.executable, *sys.orig_argv[1:]], environment)
+    run_pinned(f"{Path(sys.argv[0]).name}: ")
 
 
 def calibrate_at(weight: float, free: tuple | None = None) -> dict:

@@ -146,20 +146,28 @@ def cmd_calibrate(args: argparse.Namespace) -> None:
 
 
 def _pin_numerics(args: argparse.Namespace) -> None:
-    """Run this command again in the pinned environment (before any work; NumPy's dispatch is
-    chosen when it is imported, so the pins need a new process).  Only a command of its own:
-    a call of :func:`app.cli.main.main` from Python runs in its caller's numerics."""
+    """Run this command again in the pinned environment (before any work).  Only a command of
+    its own: a call of :func:`app.cli.main.main` from Python runs in its caller's numerics."""
+    if getattr(args, "command_line", False):
+        run_pinned("bogie calibrate: ")
+
+
+def run_pinned(prefix: str = "") -> None:
+    """Run this process's command line again in the calibration's pinned environment
+    (:mod:`model.studies.numerics`; NumPy's dispatch is chosen when it is imported, so the pins
+    need a new process), unless it runs in it already; a processor that cannot take the pins is
+    told so on stderr (``prefix``: the program's name there) and the process goes on."""
     from model.studies.numerics import description, is_pinned, reproducible_environment
 
-    if not getattr(args, "command_line", False) or is_pinned(os.environ):
+    if is_pinned(os.environ):
         return
     environment = reproducible_environment(os.environ)
     if environment is None:
-        print("bogie calibrate: this processor cannot take the pinned numerics (x86-64 with AVX2 "
+        print(f"{prefix}this processor cannot take the pinned numerics (x86-64 with AVX2 "
               "and FMA): the values written may differ in their last digits from another "
               "machine's", file=sys.stderr, flush=True)
         return
-    print(f"bogie calibrate: numerics pinned for reproducible bytes ({description()})",
+    print(f"{prefix}numerics pinned for reproducible bytes ({description()})",
           file=sys.stderr, flush=True)
     sys.stdout.flush()
     os.execve(sys.executable, [sys.executable, *sys.orig_argv[1:]], environment)
