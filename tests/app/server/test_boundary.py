@@ -492,11 +492,8 @@ def test_five_sessions_queue_with_one_running(setup, chromium):
         while len(done_at) < len(pages) and time.monotonic() < deadline:
             texts = [_status(page) for page in pages]
             most_running = max([most_running, *filter(None, map(_server_running, texts))])
-            # the study processes (the engine's scheduler and workers); a study's store records
-            # the code's version through a short-lived `git describe`, and the server's
-            # background processes (app.services.background) are not study processes
-            below = [pid for pid in _study_processes(setup["pid"])
-                     if not _command_line(pid).startswith("git ")]
+            # the study processes (the engine's scheduler and workers)
+            below = _study_processes(setup["pid"])
             if 1 + len(below) > most_processes:
                 most_processes, crowd = 1 + len(below), [_command_line(pid) for pid in below]
             for index, text in enumerate(texts):
@@ -678,11 +675,23 @@ def test_a_stopped_server_leaves_no_worker_behind(tmp_path, chromium):
 
 
 def _study_processes(server_pid: int) -> list[int]:
-    """The server's descendant processes but its background ones (their command line is
-    Python's multiprocessing start code: the forkserver, the workers it forks and the resource
-    tracker)."""
-    return [pid for pid in descendants(server_pid)
-            if "multiprocessing" not in _command_line(pid)]
+    """The server's live descendant processes but its background ones and short-lived helpers.
+
+    Not counted: the background processes (their command line is Python's multiprocessing start
+    code: the forkserver, the workers it forks and the resource tracker); the `git describe` a
+    study's store runs to record the code's version; and a process that has ended, whether gone
+    or a zombie its parent has not reaped yet (a zombie's command line is empty, so a finished
+    `git` would otherwise count as a study process), or one forked and not yet running its own
+    program (its command line is still the server's).
+    """
+    server = _command_line(server_pid)
+    found = []
+    for pid in descendants(server_pid):
+        command = _command_line(pid)
+        if (_running(pid) and command.strip() and command != server
+                and "multiprocessing" not in command and not command.startswith("git ")):
+            found.append(pid)
+    return found
 
 
 def _running(pid: int) -> bool:
