@@ -134,8 +134,8 @@ def test_the_single_calibration_is_start_0(capsys, tmp_path):
 def _calibrate_process(out, environment: dict) -> subprocess.CompletedProcess:
     """``python -m app calibrate --start 0`` on a budget of one trial set per phase, as its own
     process started with ``environment`` (added to this one's, less the pins' variables)."""
-    base = {k: v for k, v in os.environ.items()
-            if k not in pinned_values() and not k.startswith("OPENBLAS_")}
+    pins = pinned_values()
+    base = {k: v for k, v in os.environ.items() if k not in pins and not k.startswith("OPENBLAS_")}
     return subprocess.run([sys.executable, "-m", "app", "calibrate", "--start", "0",
                            "--max-evaluations", "1", "--out", str(out), "--json"],
                           capture_output=True, text=True, timeout=300, check=False,

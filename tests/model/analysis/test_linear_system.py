@@ -105,7 +105,6 @@ def _random_system(n: int = 190, seed: int = 3) -> LinearSystem:
     return LinearSystem(M, B, K, rng.standard_normal(n), np.zeros((n, 0)))
 
 
-
 def test_on_demand_vectors_are_the_full_vectors_columns():
     """``eigen_analysis(..., vectors="on_demand")``: the same eigenvalues (the same cached
     decomposition), no vector matrix, and each asked mode's shape equal to the full vectors'
@@ -127,6 +126,7 @@ def test_on_demand_vectors_are_the_full_vectors_columns():
     assert lazy._shapes[indices[0]] is shape
     with pytest.raises(ValueError, match="not computed"):
         eigen_analysis(model, op, vectors=False).mode_shape(indices[0])
+
 
 def test_concurrent_solves_with_the_cached_factors_are_exact():
     """Sessions of the dashboard solve with one cached LU of the eigenvectors at once.  SciPy's
